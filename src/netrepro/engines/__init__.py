@@ -1,0 +1,1 @@
+"""Shared numerical engines used by several papers."""

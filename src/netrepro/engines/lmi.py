@@ -1,0 +1,161 @@
+"""LMI helpers: parametrised cvxpy feasibility problems, certification, bisection.
+
+A sweep over a probability builds its cvxpy problem once with
+:class:`cvxpy.Parameter` objects (DPP-compliant), so every further solve only
+updates parameter values. A solver's "optimal" is never taken as proof: every
+candidate certificate is checked by an independent computation (for Riccati
+stabilisability, the spectral radius of the expected closed-loop second-moment
+operator), and the status string of every solve is kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cvxpy as cp
+import numpy as np
+
+__all__ = [
+    "LMIOutcome",
+    "BisectionResult",
+    "bisect_monotone",
+    "second_moment_radius",
+    "MareStabilizabilityLMI",
+]
+
+SOLVER = "CLARABEL"
+
+
+@dataclass
+class LMIOutcome:
+    """One solve: the solver's status, its margin, and our independent verdict."""
+
+    status: str
+    margin: float  # the maximised t in Psi >= t I (nan when the solver failed)
+    solver_feasible: bool  # status optimal and margin above tolerance
+    certified: bool  # independent check passed
+    certificate_value: float  # e.g. spectral radius of the closed loop (nan if none)
+    variables: dict = field(default_factory=dict)
+
+
+@dataclass
+class BisectionResult:
+    threshold: float  # smallest value found feasible (upper end of the final bracket)
+    lower: float  # largest value found infeasible
+    n_evals: int
+    history: list  # (value, feasible) pairs, in evaluation order
+    bracketed: bool  # True when lo was infeasible and hi feasible
+
+
+def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_evals: int = 60) -> BisectionResult:
+    """Smallest x in [lo, hi] with ``is_feasible(x)`` for a monotone predicate (False ... False True ... True).
+
+    The ends are evaluated first; if ``lo`` is feasible, the threshold is ``lo``;
+    if ``hi`` is infeasible the result has ``threshold = nan``.
+    """
+    history = []
+
+    def check(x):
+        ok = bool(is_feasible(x))
+        history.append((float(x), ok))
+        return ok
+
+    if check(lo):
+        return BisectionResult(lo, np.nan, len(history), history, False)
+    if not check(hi):
+        return BisectionResult(np.nan, hi, len(history), history, False)
+    a, b = lo, hi
+    while b - a > tol and len(history) < max_evals:
+        mid = 0.5 * (a + b)
+        if check(mid):
+            b = mid
+        else:
+            a = mid
+    return BisectionResult(b, a, len(history), history, True)
+
+
+def second_moment_radius(closed_loops, weights) -> float:
+    """Spectral radius of X -> sum_i w_i F_i X F_i^T, i.e. of sum_i w_i kron(F_i, F_i).
+
+    The expected error covariance of a switched linear recursion with i.i.d.
+    mode weights ``w_i`` stays bounded for every noise level iff this is < 1.
+    """
+    op = sum(w * np.kron(F, F) for F, w in zip(closed_loops, weights))
+    return float(np.max(np.abs(np.linalg.eigvals(np.atleast_2d(op)))))
+
+
+class MareStabilizabilityLMI:
+    """Existence of gains K_i and X > 0 with X > sum_i w_i (A + K_i C_i) X (A + K_i C_i)^T.
+
+    This is the LMI test of Sinopoli et al. (2004, Thm 5) generalised to
+    several independent loss modes as in Liu & Goldsmith (2004): mode i
+    occurs with probability w_i and delivers the rows C_i (None: nothing
+    arrives, closed loop A). By duality (the operator and its adjoint share
+    their spectral radius) it is equivalent to Y > 0 with
+    Y > sum_i w_i F_i^T Y F_i, and with Z_i = Y K_i the Schur complement gives
+
+    .. math::
+
+        \\Psi = \\begin{bmatrix} Y & \\sqrt{w_1}(YA+Z_1C_1)^T & \\cdots \\\\
+                 \\sqrt{w_1}(YA+Z_1C_1) & Y & 0 \\\\ \\vdots & 0 & \\ddots \\end{bmatrix} \\succ 0 .
+
+    The problem maximises t subject to Psi >= t I and 0 <= Y <= I (the LMI is
+    homogeneous, so the bound only fixes the scale). The weights' square
+    roots are :class:`cvxpy.Parameter` objects: a sweep compiles once.
+    """
+
+    def __init__(self, A, mode_outputs, margin_tol: float = 1e-7):
+        self.A = np.atleast_2d(np.asarray(A, dtype=float))
+        n = self.A.shape[0]
+        self.mode_outputs = [None if C is None else np.atleast_2d(np.asarray(C, dtype=float)) for C in mode_outputs]
+        self.margin_tol = margin_tol
+        self.sqrt_w = cp.Parameter(len(self.mode_outputs), nonneg=True, name="sqrt_w")
+        self.Y = cp.Variable((n, n), symmetric=True, name="Y")
+        self.Z = [None if C is None else cp.Variable((n, C.shape[0]), name=f"Z{i}") for i, C in enumerate(self.mode_outputs)]
+        self.t = cp.Variable(name="t")
+        m = len(self.mode_outputs)
+        blocks = []
+        cols = []
+        for i, C in enumerate(self.mode_outputs):
+            YF = self.Y @ self.A if C is None else self.Y @ self.A + self.Z[i] @ C
+            cols.append(self.sqrt_w[i] * YF)
+        zero = np.zeros((n, n))
+        first_row = [self.Y] + [c.T for c in cols]
+        blocks.append(first_row)
+        for i in range(m):
+            row = [cols[i]] + [self.Y if j == i else zero for j in range(m)]
+            blocks.append(row)
+        psi = cp.bmat(blocks)
+        size = n * (m + 1)
+        constraints = [0.5 * (psi + psi.T) >> self.t * np.eye(size), self.Y << np.eye(n), self.Y >> 0]
+        self.problem = cp.Problem(cp.Maximize(self.t), constraints)
+        self.n_solves = 0
+
+    def solve(self, weights) -> LMIOutcome:
+        """Solve for mode probabilities ``weights``; certify any feasible answer independently."""
+        weights = np.asarray(weights, dtype=float)
+        if weights.shape != (len(self.mode_outputs),) or np.any(weights < 0):
+            raise ValueError(f"weights must be {len(self.mode_outputs)} non-negative numbers, got {weights}")
+        self.sqrt_w.value = np.sqrt(weights)
+        self.n_solves += 1
+        try:
+            self.problem.solve(solver=SOLVER)
+            status = str(self.problem.status)
+        except cp.error.SolverError as exc:
+            return LMIOutcome(f"solver_error: {exc}", np.nan, False, False, np.nan)
+        margin = float(self.t.value) if self.t.value is not None else np.nan
+        solver_feasible = status == cp.OPTIMAL and margin > self.margin_tol
+        if not solver_feasible:
+            return LMIOutcome(status, margin, False, False, np.nan)
+        Y = self.Y.value
+        gains, loops = [], []
+        for C, Z in zip(self.mode_outputs, self.Z):
+            if C is None:
+                gains.append(None)
+                loops.append(self.A)
+            else:
+                K = np.linalg.solve(Y, Z.value)
+                gains.append(K)
+                loops.append(self.A + K @ C)
+        rho = second_moment_radius(loops, weights)
+        return LMIOutcome(status, margin, True, rho < 1.0, rho, {"Y": Y, "K": gains})

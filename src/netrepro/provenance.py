@@ -1,0 +1,157 @@
+"""Provenance sidecars: ``<output>.meta.json`` beside every table and figure.
+
+A sidecar records what made a file: rule, source function, parameters and
+their hash, git commit and dirty flag, package versions, seeds, input
+checksums, the output's own checksum and the wall time. :func:`verify_output`
+uses the recorded checksum to detect truncated or edited results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import subprocess
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+
+from .io import sha256_file, write_json
+
+__all__ = [
+    "params_hash",
+    "git_state",
+    "package_versions",
+    "find_seeds",
+    "sidecar_path",
+    "write_sidecar",
+    "read_sidecar",
+    "verify_output",
+    "CorruptOutputError",
+]
+
+TRACKED_PACKAGES = (
+    "numpy", "scipy", "cvxpy", "clarabel", "matplotlib", "pandas", "snakemake", "papermill",
+)
+
+
+class CorruptOutputError(RuntimeError):
+    """A result file does not match the checksum recorded in its sidecar."""
+
+
+def params_hash(params) -> str:
+    """SHA-256 (first 16 hex digits) of the canonical JSON of ``params``."""
+    blob = json.dumps(params, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def git_state(repo: str | Path = ".") -> dict:
+    """Commit hash and dirty flag of the repository holding ``repo`` (None outside git)."""
+    def _git(*args):
+        return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, timeout=20)
+
+    try:
+        head = _git("rev-parse", "HEAD")
+        if head.returncode != 0:
+            return {"commit": None, "dirty": None}
+        status = _git("status", "--porcelain", "--untracked-files=no")
+        return {"commit": head.stdout.strip(), "dirty": bool(status.stdout.strip())}
+    except (OSError, subprocess.TimeoutExpired):
+        return {"commit": None, "dirty": None}
+
+
+def package_versions(names=TRACKED_PACKAGES) -> dict:
+    """Installed versions of the packages that shape the numbers."""
+    versions = {"python": platform.python_version()}
+    for name in names:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return versions
+
+
+def find_seeds(params, prefix="") -> dict:
+    """All entries of a nested parameter dict whose key contains 'seed'."""
+    seeds = {}
+    if isinstance(params, dict):
+        for key, value in params.items():
+            path = f"{prefix}.{key}" if prefix else str(key)
+            if "seed" in str(key).lower() and not isinstance(value, dict):
+                seeds[path] = value
+            else:
+                seeds.update(find_seeds(value, path))
+    return seeds
+
+
+def sidecar_path(output: str | Path) -> Path:
+    output = Path(output)
+    return output.with_name(output.name + ".meta.json")
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """What the runner knows about one executed step."""
+
+    rule: str
+    function: str
+    source_file: str
+    source_line: int
+    params: dict
+    inputs: dict
+    wall_time_s: float
+    extra: dict
+
+
+def write_sidecar(output: str | Path, record: StepRecord) -> Path:
+    """Write the provenance sidecar of ``output`` (which must exist)."""
+    output = Path(output)
+    meta = {
+        "output": str(output),
+        "output_sha256": sha256_file(output),
+        "rule": record.rule,
+        "function": record.function,
+        "source_file": record.source_file,
+        "source_line": record.source_line,
+        "params": record.params,
+        "params_hash": params_hash(record.params),
+        "seeds": find_seeds(record.params),
+        "inputs": {
+            name: {"path": str(path), "sha256": sha256_file(path)}
+            for name, path in record.inputs.items()
+            if Path(path).is_file()
+        },
+        "git": git_state(),
+        "packages": package_versions(),
+        "machine": {"platform": platform.platform(), "processor": platform.machine()},
+        "wall_time_s": round(record.wall_time_s, 3),
+        **({"extra": record.extra} if record.extra else {}),
+    }
+    return write_json(meta, sidecar_path(output))
+
+
+def read_sidecar(output: str | Path) -> dict:
+    return json.loads(sidecar_path(output).read_text())
+
+
+def verify_output(output: str | Path) -> dict:
+    """Check ``output`` against its sidecar checksum; return the sidecar.
+
+    Raises
+    ------
+    CorruptOutputError
+        If the sidecar is missing or the checksum differs (truncated or edited file).
+    """
+    output = Path(output)
+    side = sidecar_path(output)
+    if not side.is_file():
+        raise CorruptOutputError(f"{output}: no provenance sidecar {side.name}; rebuild it with snakemake")
+    meta = json.loads(side.read_text())
+    actual = sha256_file(output)
+    if actual != meta.get("output_sha256"):
+        raise CorruptOutputError(
+            f"{output}: checksum {actual[:12]}… differs from the sidecar's "
+            f"{str(meta.get('output_sha256'))[:12]}…; the file was truncated or edited. "
+            f"Delete it and rerun snakemake to rebuild it."
+        )
+    return meta

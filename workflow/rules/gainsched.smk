@@ -1,0 +1,1 @@
+# Rules of the `gainsched` paper (placeholder until the paper is added).

@@ -1,0 +1,1 @@
+# Rules of the `hinf` paper (placeholder until the paper is added).

@@ -1,0 +1,240 @@
+# Paper `intermittent` (000): Teerikoski, Kalman filtering with measurement losses.
+# Compute steps -> tables under results/intermittent/, one rule per figure, claims, errata, notebook.
+
+ICFG = config.get("intermittent", {})
+
+
+rule intermittent_exact_mean:
+    input:
+        code=src("papers/intermittent.py", "engines/riccati.py"),
+    output:
+        table="results/intermittent/exact_mean.csv",
+    params:
+        cfg=as_json(ICFG.get("scalar")),
+        io=io_json,
+    log:
+        "logs/intermittent/exact_mean.log",
+    shell:
+        step("netrepro.papers.intermittent:exact_mean_step")
+
+
+rule intermittent_monte_carlo:
+    input:
+        code=src("papers/intermittent.py", "engines/riccati.py", "engines/channels.py", "engines/montecarlo.py"),
+    output:
+        table="results/intermittent/monte_carlo.csv",
+    params:
+        cfg=as_json(ICFG.get("scalar")),
+        io=io_json,
+    log:
+        "logs/intermittent/monte_carlo.log",
+    threads: 1
+    resources:
+        mem_mb=4000,
+        runtime=20,
+    shell:
+        step("netrepro.papers.intermittent:monte_carlo_step")
+
+
+rule intermittent_scalar_bounds:
+    input:
+        code=src("papers/intermittent.py"),
+        exact="results/intermittent/exact_mean.csv",
+        mc="results/intermittent/monte_carlo.csv",
+    output:
+        table="results/intermittent/scalar_bounds.csv",
+    params:
+        cfg=as_json(ICFG.get("scalar")),
+        io=io_json,
+    log:
+        "logs/intermittent/scalar_bounds.log",
+    shell:
+        step("netrepro.papers.intermittent:scalar_bounds_step")
+
+
+rule intermittent_two_sensor_region:
+    input:
+        code=src("papers/intermittent.py", "engines/lmi.py", "engines/channels.py"),
+    output:
+        table="results/intermittent/two_sensor_region.csv",
+    params:
+        cfg=as_json(ICFG.get("two_sensor")),
+        io=io_json,
+    log:
+        "logs/intermittent/two_sensor_region.log",
+    shell:
+        step("netrepro.papers.intermittent:two_sensor_region_step")
+
+
+rule intermittent_two_sensor_simulation:
+    input:
+        code=src("papers/intermittent.py", "engines/riccati.py", "engines/montecarlo.py"),
+    output:
+        table="results/intermittent/two_sensor_simulation.csv",
+    params:
+        cfg=as_json(ICFG.get("two_sensor")),
+        io=io_json,
+    log:
+        "logs/intermittent/two_sensor_simulation.log",
+    shell:
+        step("netrepro.papers.intermittent:two_sensor_simulation_step")
+
+
+rule intermittent_errata:
+    input:
+        code=src("papers/intermittent.py", "claims.py"),
+    output:
+        table="results/errata/intermittent.csv",
+    params:
+        cfg=as_json(ICFG),
+        io=io_json,
+    log:
+        "logs/intermittent/errata.log",
+    shell:
+        step("netrepro.papers.intermittent:errata_step")
+
+
+rule intermittent_reconstructions:
+    input:
+        code=src("papers/intermittent.py", "claims.py"),
+    output:
+        table="results/reconstructions/intermittent.csv",
+    params:
+        cfg=as_json(ICFG),
+        io=io_json,
+    log:
+        "logs/intermittent/reconstructions.log",
+    shell:
+        step("netrepro.papers.intermittent:reconstructions_step")
+
+
+rule intermittent_claims:
+    input:
+        code=src("papers/intermittent.py", "claims.py"),
+        bounds="results/intermittent/scalar_bounds.csv",
+        region="results/intermittent/two_sensor_region.csv",
+        simulation="results/intermittent/two_sensor_simulation.csv",
+    output:
+        table="results/claims/intermittent.csv",
+    params:
+        cfg=as_json(ICFG),
+        io=io_json,
+    log:
+        "logs/intermittent/claims.log",
+    shell:
+        step("netrepro.papers.intermittent:claims_step")
+
+
+rule intermittent_fig1:
+    input:
+        code=src("papers/intermittent.py", "plotting.py"),
+        bounds="results/intermittent/scalar_bounds.csv",
+    output:
+        figure=report("figures/intermittent/fig1.png", caption="../report/intermittent/fig1.rst", category="intermittent"),
+    params:
+        cfg=as_json({"which": "stable"}),
+        io=io_json,
+    log:
+        "logs/intermittent/fig1.log",
+    shell:
+        step("netrepro.papers.intermittent:figure_bounds")
+
+
+rule intermittent_fig2:
+    input:
+        code=src("papers/intermittent.py", "plotting.py"),
+        bounds="results/intermittent/scalar_bounds.csv",
+    output:
+        figure=report("figures/intermittent/fig2.png", caption="../report/intermittent/fig2.rst", category="intermittent"),
+    params:
+        cfg=as_json({"which": "unstable"}),
+        io=io_json,
+    log:
+        "logs/intermittent/fig2.log",
+    shell:
+        step("netrepro.papers.intermittent:figure_bounds")
+
+
+rule intermittent_fig4:
+    input:
+        code=src("papers/intermittent.py", "plotting.py"),
+        region="results/intermittent/two_sensor_region.csv",
+    output:
+        figure=report("figures/intermittent/fig4.png", caption="../report/intermittent/fig4.rst", category="intermittent"),
+    params:
+        cfg=as_json({"show_upper": False}),
+        io=io_json,
+    log:
+        "logs/intermittent/fig4.log",
+    shell:
+        step("netrepro.papers.intermittent:figure_region")
+
+
+rule intermittent_fig5:
+    input:
+        code=src("papers/intermittent.py", "plotting.py"),
+        region="results/intermittent/two_sensor_region.csv",
+        simulation="results/intermittent/two_sensor_simulation.csv",
+    output:
+        figure=report("figures/intermittent/fig5.png", caption="../report/intermittent/fig5.rst", category="intermittent"),
+    params:
+        cfg=as_json({"show_upper": True}),
+        io=io_json,
+    log:
+        "logs/intermittent/fig5.log",
+    shell:
+        step("netrepro.papers.intermittent:figure_region")
+
+
+rule intermittent_figS1:
+    input:
+        code=src("papers/intermittent.py", "plotting.py"),
+        mc="results/intermittent/monte_carlo.csv",
+        exact="results/intermittent/exact_mean.csv",
+    output:
+        figure=report("figures/intermittent/figS1.png", caption="../report/intermittent/figS1.rst", category="intermittent"),
+    params:
+        cfg=as_json({}),
+        io=io_json,
+    log:
+        "logs/intermittent/figS1.log",
+    shell:
+        step("netrepro.papers.intermittent:figure_estimators")
+
+
+INTERMITTENT_FIGURES = [f"figures/intermittent/{f}.png" for f in ("fig1", "fig2", "fig4", "fig5", "figS1")]
+INTERMITTENT_TABLES = [
+    "results/intermittent/scalar_bounds.csv",
+    "results/intermittent/exact_mean.csv",
+    "results/intermittent/monte_carlo.csv",
+    "results/intermittent/two_sensor_region.csv",
+    "results/intermittent/two_sensor_simulation.csv",
+]
+
+
+rule intermittent_notebook:
+    input:
+        notebook="workflow/notebooks/intermittent.ipynb",
+        code=src("reportgen.py"),
+        figures=INTERMITTENT_FIGURES,
+        tables=INTERMITTENT_TABLES,
+        claims="results/claims/intermittent.csv",
+        errata="results/errata/intermittent.csv",
+        reconstructions="results/reconstructions/intermittent.csv",
+    output:
+        html="report/intermittent.html",
+    log:
+        "logs/intermittent/notebook.log",
+    shell:
+        notebook("intermittent")
+
+
+if enabled("intermittent"):
+    PAPER_OUTPUTS["intermittent"] = dict(
+        figures=INTERMITTENT_FIGURES,
+        tables=INTERMITTENT_TABLES,
+        claims="results/claims/intermittent.csv",
+        errata="results/errata/intermittent.csv",
+        reconstructions="results/reconstructions/intermittent.csv",
+        notebook="report/intermittent.html",
+    )

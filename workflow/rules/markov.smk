@@ -1,0 +1,1 @@
+# Rules of the `markov` paper (placeholder until the paper is added).

@@ -1,0 +1,1 @@
+# Rules of the `onebit` paper (placeholder until the paper is added).
