@@ -1,0 +1,1 @@
+"""Paper `gainsched` (placeholder until the paper is added)."""

@@ -1,0 +1,1 @@
+"""Paper `hinf` (placeholder until the paper is added)."""

@@ -1,0 +1,1 @@
+"""Paper `markov` (placeholder until the paper is added)."""

@@ -1,0 +1,1 @@
+"""Paper `onebit` (placeholder until the paper is added)."""
