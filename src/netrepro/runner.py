@@ -44,8 +44,23 @@ def resolve(spec: str):
         raise ValueError(f"{module_name} has no function {func_name!r}") from exc
 
 
+def _as_paths(value):
+    return [Path(v) for v in value] if isinstance(value, (list, tuple)) else Path(value)
+
+
+def _flatten(named: dict) -> dict:
+    """``{name: path or [paths]}`` -> ``{name or name[i]: path}``."""
+    flat = {}
+    for name, value in named.items():
+        if isinstance(value, list):
+            flat.update({f"{name}[{i}]": v for i, v in enumerate(value)})
+        else:
+            flat[name] = value
+    return flat
+
+
 def _check_inputs(inputs: dict) -> None:
-    for name, path in inputs.items():
+    for path in _flatten(inputs).values():
         if sidecar_path(path).is_file():
             verify_output(path)
 
@@ -53,7 +68,7 @@ def _check_inputs(inputs: dict) -> None:
 def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dict) -> None:
     """Run one step and write its outputs and their provenance sidecars."""
     func = resolve(func_spec)
-    inputs = {k: Path(v) for k, v in inputs.items()}
+    inputs = {k: _as_paths(v) for k, v in inputs.items()}
     outputs = {k: Path(v) for k, v in outputs.items()}
     _check_inputs(inputs)
     for path in outputs.values():
@@ -79,7 +94,7 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
         source_file=source_file,
         source_line=inspect.getsourcelines(func)[1],
         params=params,
-        inputs={k: str(v) for k, v in inputs.items()},
+        inputs={k: str(v) for k, v in _flatten(inputs).items()},
         wall_time_s=elapsed,
         extra=extra,
     )

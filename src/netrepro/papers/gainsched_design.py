@@ -1,0 +1,288 @@
+"""Theorem 3 of the `gainsched` paper: the 16 vertex LMIs (24)-(25) and the gain recovery (26).
+
+Variables (all in the coordinates of the congruence T of the proof of Theorem 2):
+Q̄0, Q̄p (2n x 2n, symmetric), S11, R1, R2 (n x n), Ḡ0, Ḡf (n x n), H̄0, H̄f (n x m).
+The vertex of indices (i, j, r, l) in {1, 2}^4 is (24):
+
+.. math::
+
+    M^{ijrl} = \\begin{bmatrix}
+    -\\bar Q^i & * & * & * & * \\\\
+    FZN & -2I & * & * & * \\\\
+    \\Gamma_1^{ij} & \\hat B & -\\Lambda^l & * & * \\\\
+    \\Gamma_3^{ijr} & 0 & 0 & -\\Theta^{jr}\\Lambda^l & * \\\\
+    \\Gamma_4 & 0 & 0 & 0 & -\\sigma^2\\Lambda^l
+    \\end{bmatrix} < 0
+
+with (25): :math:`\\bar Q^i = \\bar Q_0 + p_i \\bar Q_p`, :math:`\\Theta^{jr} = p_j(1-p_r)`,
+:math:`\\bar H^i = \\bar H_0 + p_i\\bar H_f`, :math:`\\bar G^i = \\bar G_0 + p_i \\bar G_f`,
+
+.. math::
+
+    \\Gamma_1^{ij} = \\begin{bmatrix} S_{11}^T A + p_j \\bar H^i C + S_{11}^T B F_1 Z & \\bar G^i \\\\
+                                   R_1^T A + p_j \\bar H^i C + R_1^T B F_1 Z & \\bar G^i \\end{bmatrix},\\;
+    \\Lambda^l = \\begin{bmatrix} S_{11}+S_{11}^T & R_1 + R_2^T \\\\ R_1^T + R_2 & R_2 + R_2^T\\end{bmatrix} - \\bar Q^l,
+
+.. math::
+
+    \\Gamma_3^{ijr} = \\Theta^{jr}\\begin{bmatrix} 0 \\\\ \\bar H^i C\\end{bmatrix} N,\\;
+    \\Gamma_4 = \\sigma^2 \\begin{bmatrix} S_{11}^T D \\\\ R_1^T D\\end{bmatrix} N,\\;
+    \\hat B = \\begin{bmatrix} S_{11}^T B \\\\ R_1^T B \\end{bmatrix}.
+
+The transposes in Γ1, Λ and B̂ are our reading of the garbled print: they are
+the ones the congruence T = diag(I, S22^{-1} S21) of S = [S_ij] produces
+(checked in the tests by rebuilding (12) from a recovered S).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import cvxpy as cp
+import numpy as np
+
+from ..engines.lmi import SOLVER
+from .gainsched_model import Gains, GainschedError, System
+
+__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "REALISATIONS"]
+
+REALISATIONS = ("identity_T", "S21_identity")
+
+
+@dataclass
+class Theorem3Solution:
+    """One solve of Theorem 3: status, margin/objective and the variable values."""
+
+    status: str
+    margin: float
+    objective: float
+    solver_feasible: bool
+    values: dict = field(default_factory=dict)
+    solve_time_s: float = np.nan
+    n_scalar_variables: int = 0
+
+
+class Theorem3:
+    """The 16 vertex LMIs (24)-(25), built once with ``sigma2`` as a :class:`cvxpy.Parameter`.
+
+    Parameters
+    ----------
+    sys : System
+        The example; ``sys.sigma2`` is only the default value of the parameter.
+    scheduled : bool
+        ``False`` forces Ḡf = H̄f = 0 (a fixed-gain filter with the same machinery).
+    performance : bool
+        Add :math:`L^TL`, :math:`L = [I\\; -I]`, to the (1,1) block of every vertex
+        (so that :math:`E\\Delta V \\le -E\\|e(k)\\|^2`) and minimise
+        :math:`\\gamma \\ge \\mathrm{tr}(\\bar Q^l X_0)`, l = 1, 2: then
+        :math:`\\sum_k E\\|e(k)\\|^2 \\le \\gamma` for :math:`E\\bar z(0)\\bar z(0)^T = X_0`
+        and any admissible p(k), when the gains are recovered with the
+        ``identity_T`` realisation (T = I, so Q = Q̄).
+    qp_positive : bool
+        Impose Q̄p > 0 as stated under (27) (the paper's reading).
+    eps : float
+        Strictness margin: vertices <= -eps I, Q̄0 >= eps I (and Q̄p >= eps I).
+    bound : float
+        Entry-wise bound on all variables (scale fixing in the feasibility problem).
+    X0 : ndarray (2n, 2n) or None
+        Second moment of the initial augmented state for the performance objective.
+    """
+
+    def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
+                 eps: float = 1e-6, bound: float = 1e3, X0=None):
+        self.sys = sys
+        self.scheduled = scheduled
+        self.performance = performance
+        n, m, nz = sys.n, sys.m, sys.nz
+        nn = 2 * n
+        self.sigma2 = cp.Parameter(nonneg=True, name="sigma2", value=sys.sigma2)
+        v = {
+            "Q0": cp.Variable((nn, nn), symmetric=True, name="Qbar0"),
+            "Qp": cp.Variable((nn, nn), symmetric=True, name="Qbarp"),
+            "S11": cp.Variable((n, n), name="S11"),
+            "R1": cp.Variable((n, n), name="R1"),
+            "R2": cp.Variable((n, n), name="R2"),
+            "G0": cp.Variable((n, n), name="Gbar0"),
+            "H0": cp.Variable((n, m), name="Hbar0"),
+        }
+        if scheduled:
+            v["Gf"] = cp.Variable((n, n), name="Gbarf")
+            v["Hf"] = cp.Variable((n, m), name="Hbarf")
+        self.vars = v
+        self.t = cp.Variable(name="t")
+        ps = (sys.p1, sys.p2)
+        cons = [cp.abs(x) <= bound for x in v.values()]
+        cons.append(v["Q0"] >> eps * np.eye(nn))
+        if qp_positive:
+            cons.append(v["Qp"] >> eps * np.eye(nn))
+        else:
+            cons += [v["Q0"] + p * v["Qp"] >> eps * np.eye(nn) for p in ps]
+        L = np.hstack([np.eye(n), -np.eye(n)])
+        self.n_vertices = 0
+        for i in range(2):
+            for j in range(2):
+                for r in range(2):
+                    for l in range(2):
+                        M = self.vertex(ps[i], ps[j], ps[r], ps[l])
+                        size = M.shape[0]
+                        Msym = 0.5 * (M + M.T)
+                        if performance:
+                            E = np.zeros((size, size))
+                            E[:nn, :nn] = L.T @ L
+                            cons.append(Msym + E << -eps * np.eye(size))
+                        else:
+                            cons.append(Msym << -self.t * np.eye(size))
+                        self.n_vertices += 1
+        if performance:
+            X0 = np.asarray(X0, dtype=float)
+            if X0.shape != (nn, nn):
+                raise GainschedError(f"X0 must have shape {(nn, nn)}, got {X0.shape}")
+            self.gamma = cp.Variable(name="gamma")
+            cons += [cp.trace((v["Q0"] + p * v["Qp"]) @ X0) <= self.gamma for p in ps]
+            self.problem = cp.Problem(cp.Minimize(self.gamma), cons)
+        else:
+            self.gamma = None
+            cons.append(self.t <= 1.0)
+            self.problem = cp.Problem(cp.Maximize(self.t), cons)
+        self.margin_tol = eps
+
+    # -- the blocks of (24)-(25), one function each, so they read against the paper
+    def Qbar(self, p):
+        """Q̄^i = Q̄0 + p_i Q̄p (25), (27)."""
+        return self.vars["Q0"] + p * self.vars["Qp"]
+
+    def Gbar(self, p):
+        """Ḡ^i = Ḡ0 + p_i Ḡf (25)."""
+        return self.vars["G0"] + p * self.vars["Gf"] if self.scheduled else self.vars["G0"]
+
+    def Hbar(self, p):
+        """H̄^i = H̄0 + p_i H̄f (25)."""
+        return self.vars["H0"] + p * self.vars["Hf"] if self.scheduled else self.vars["H0"]
+
+    def Lambda(self, pl):
+        """Λ^l = [[S11 + S11^T, R1 + R2^T], [R1^T + R2, R2 + R2^T]] - Q̄^l (25)."""
+        v = self.vars
+        SS = cp.bmat([[v["S11"] + v["S11"].T, v["R1"] + v["R2"].T], [v["R1"].T + v["R2"], v["R2"] + v["R2"].T]])
+        return SS - self.Qbar(pl)
+
+    def Gamma1(self, pi, pj):
+        """Γ1^{ij} = [[S11^T A + p_j H̄^i C + S11^T B F1 Z, Ḡ^i], [R1^T A + p_j H̄^i C + R1^T B F1 Z, Ḡ^i]] (25)."""
+        s, v = self.sys, self.vars
+        AF = s.A + s.B @ s.F1 @ s.Z
+        HC = pj * (self.Hbar(pi) @ s.C)
+        return cp.bmat([[v["S11"].T @ AF + HC, self.Gbar(pi)], [v["R1"].T @ AF + HC, self.Gbar(pi)]])
+
+    def Gamma3(self, pi, pj, pr):
+        """Γ3^{ijr} = Θ^{jr} [0; H̄^i C] N, Θ^{jr} = p_j (1 - p_r) (25)."""
+        s = self.sys
+        theta = pj * (1.0 - pr)
+        n = s.n
+        return theta * cp.bmat([[np.zeros((n, n)), np.zeros((n, n))], [self.Hbar(pi) @ s.C, np.zeros((n, n))]])
+
+    def Gamma4(self):
+        """Γ4 = σ² [S11^T D; R1^T D] N (22)."""
+        s, v = self.sys, self.vars
+        n = s.n
+        return self.sigma2 * cp.bmat([[v["S11"].T @ s.D, np.zeros((n, n))], [v["R1"].T @ s.D, np.zeros((n, n))]])
+
+    def Bhat(self):
+        """B̂ = [S11^T B; R1^T B] (22)."""
+        s, v = self.sys, self.vars
+        return cp.vstack([v["S11"].T @ s.B, v["R1"].T @ s.B])
+
+    def vertex(self, pi, pj, pr, pl):
+        """The vertex matrix M^{ijrl} of (24) (lower triangle written, upper by transposition)."""
+        s = self.sys
+        nn, nz = 2 * s.n, s.nz
+        theta = pj * (1.0 - pr)
+        FZN = s.F @ s.Z @ s.N
+        G1, G3, G4, Bh, Lam = self.Gamma1(pi, pj), self.Gamma3(pi, pj, pr), self.Gamma4(), self.Bhat(), self.Lambda(pl)
+        O = np.zeros
+        return cp.bmat([
+            [-self.Qbar(pi), FZN.T, G1.T, G3.T, G4.T],
+            [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn)), O((nz, nn))],
+            [G1, Bh, -Lam, O((nn, nn)), O((nn, nn))],
+            [G3, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
+            [G4, O((nn, nz)), O((nn, nn)), O((nn, nn)), -self.sigma2 * Lam],
+        ])
+
+    def n_scalar_variables(self) -> int:
+        return int(sum(x.size for x in self.vars.values()))
+
+    def solve(self, sigma2: float | None = None) -> Theorem3Solution:
+        """Solve at noise variance ``sigma2`` (default: the system's); keep the status string."""
+        self.sigma2.value = self.sys.sigma2 if sigma2 is None else float(sigma2)
+        start = time.perf_counter()
+        try:
+            self.problem.solve(solver=SOLVER)
+            status = str(self.problem.status)
+        except cp.error.SolverError as exc:
+            return Theorem3Solution(f"solver_error: {exc}", np.nan, np.nan, False,
+                                    solve_time_s=time.perf_counter() - start,
+                                    n_scalar_variables=self.n_scalar_variables())
+        elapsed = time.perf_counter() - start
+        values = {k: (None if x.value is None else np.array(x.value)) for k, x in self.vars.items()}
+        if not self.scheduled and values["G0"] is not None:
+            values["Gf"] = np.zeros_like(values["G0"])
+            values["Hf"] = np.zeros_like(values["H0"])
+        ok_status = status == cp.OPTIMAL
+        if self.performance:
+            margin = self.margin_tol if ok_status else np.nan
+            objective = float(self.gamma.value) if self.gamma.value is not None else np.nan
+            feasible = ok_status
+        else:
+            margin = float(self.t.value) if self.t.value is not None else np.nan
+            objective = margin
+            feasible = ok_status and margin > self.margin_tol
+        return Theorem3Solution(status, margin, objective, feasible, values if ok_status else {}, elapsed,
+                                self.n_scalar_variables())
+
+
+def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains, dict]:
+    """Filter gains from a Theorem 3 solution by (26), for a choice of S21, S22 with R2 = S21^T S22^{-T} S21.
+
+    .. math::
+
+        G_0 = S_{21}^{-T}\\bar G_0 S_{21}^{-1} S_{22},\\; G_f = S_{21}^{-T}\\bar G_f S_{21}^{-1} S_{22},\\;
+        H_0 = S_{21}^{-T}\\bar H_0,\\; H_f = S_{21}^{-T}\\bar H_f .
+
+    ``realisation``:
+
+    * ``"identity_T"``: S21 = S22 = R2, so T = diag(I, S22^{-1} S21) = I, Q = Q̄,
+      and G = R2^{-T} Ḡ, H = R2^{-T} H̄.
+    * ``"S21_identity"``: S21 = I, S22 = R2^{-T} (Algorithm 1 lets the user
+      choose), giving G = Ḡ R2^{-T}, H = H̄. Similar to the first as a
+      system, but the *estimate* x_f differs by the factor J = R2^T.
+
+    Returns the gains and the full slack S = [[S11, S12], [S21, S22]] with
+    S12 = R1 S21^{-1} S22 (from R1 = S12 S22^{-1} S21, (23)) and T.
+    """
+    R2 = values["R2"]
+    if realisation == "identity_T":
+        S21, S22 = R2.copy(), R2.copy()
+    elif realisation == "S21_identity":
+        S21, S22 = np.eye(R2.shape[0]), np.linalg.inv(R2).T
+    else:
+        raise GainschedError(f"realisation must be one of {REALISATIONS}, got {realisation!r}")
+    S21inv_T = np.linalg.inv(S21).T
+    right = np.linalg.solve(S21, S22)  # S21^{-1} S22
+    gains = Gains(
+        G0=S21inv_T @ values["G0"] @ right,
+        Gf=S21inv_T @ values["Gf"] @ right,
+        H0=S21inv_T @ values["H0"],
+        Hf=S21inv_T @ values["Hf"],
+    )
+    S12 = values["R1"] @ right
+    S = np.block([[values["S11"], S12], [S21, S22]])
+    n = R2.shape[0]
+    J = np.linalg.solve(S22, S21)
+    T = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), J]])
+    return gains, {"S": S, "T": T}
+
+
+def certificate_from_solution(values: dict, realisation: str = "identity_T") -> dict:
+    """Theorem 1 certificate (Q0, Qp, S) in original coordinates: Q = T^{-T} Q̄ T^{-1} (proof of Thm 2)."""
+    _, extra = recover_gains(values, realisation)
+    Tinv = np.linalg.inv(extra["T"])
+    return {"Q0": Tinv.T @ values["Q0"] @ Tinv, "Qp": Tinv.T @ values["Qp"] @ Tinv, "S": extra["S"]}
