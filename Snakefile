@@ -12,3 +12,6 @@ include: "workflow/rules/onebit.smk"
 include: "workflow/rules/gainsched.smk"
 include: "workflow/rules/hinf.smk"
 include: "workflow/rules/report.smk"
+
+
+finalize_rules(workflow)

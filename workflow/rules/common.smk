@@ -22,6 +22,11 @@ def enabled(slug):
     return slug in config["papers"]
 
 
+def pick(section, *keys):
+    """The entries of a config section that a step uses: only these trigger its rerun."""
+    return {k: section[k] for k in keys if k in section}
+
+
 def as_json(obj):
     """A shell-quoted JSON string: the params of a rule, so a config change reruns it."""
     return shlex.quote(json.dumps(obj, sort_keys=True))
@@ -37,10 +42,22 @@ def src(*modules):
     return [f"src/netrepro/{m}" for m in modules] + ["src/netrepro/runner.py"]
 
 
+def finalize_rules(workflow):
+    """Write each rule's own name into its runner command (the `--rule` of the provenance)."""
+    for each in workflow.rules:
+        if each.shellcmd and RULE_PLACEHOLDER in each.shellcmd:
+            each.shellcmd = each.shellcmd.replace(RULE_PLACEHOLDER, each.name)
+
+
+RULE_PLACEHOLDER = "@RULE@"
+# Software of every rule, for --use-conda (the default route is the .venv/ that `make` builds).
+CONDA_ENV = "../envs/netrepro.yaml"
+
+
 def step(func):
     """Shell command of a pipeline step: one call into the package."""
     return (
-        f"{PYTHON} -m netrepro run --rule {{rule}} --func {func} "
+        f"{PYTHON} -m netrepro run --rule {RULE_PLACEHOLDER} --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )
 
@@ -51,3 +68,15 @@ def notebook(slug):
         f"{PYTHON} -m netrepro.reportgen notebook --slug {slug} "
         "--notebook {input.notebook} --html {output.html} > {log} 2>&1"
     )
+
+
+def report_inputs(wildcards):
+    """Every registered output of every enabled paper, as named inputs of the report rule."""
+    named = {}
+    for slug, spec in PAPER_OUTPUTS.items():
+        named[f"{slug}_figures"] = spec["figures"]
+        named[f"{slug}_claims"] = spec["claims"]
+        named[f"{slug}_errata"] = spec["errata"]
+        named[f"{slug}_reconstructions"] = spec["reconstructions"]
+        named[f"{slug}_notebook"] = spec["notebook"]
+    return named

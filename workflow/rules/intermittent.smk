@@ -10,8 +10,10 @@ rule intermittent_exact_mean:
     output:
         table="results/intermittent/exact_mean.csv",
     params:
-        cfg=as_json(ICFG.get("scalar")),
+        cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "exact_horizon")),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/exact_mean.log",
     shell:
@@ -24,8 +26,10 @@ rule intermittent_monte_carlo:
     output:
         table="results/intermittent/monte_carlo.csv",
     params:
-        cfg=as_json(ICFG.get("scalar")),
+        cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "block_size", "seed")),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/monte_carlo.log",
     threads: 1
@@ -44,8 +48,10 @@ rule intermittent_scalar_bounds:
     output:
         table="results/intermittent/scalar_bounds.csv",
     params:
-        cfg=as_json(ICFG.get("scalar")),
+        cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "horizon")),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/scalar_bounds.log",
     shell:
@@ -58,8 +64,10 @@ rule intermittent_two_sensor_region:
     output:
         table="results/intermittent/two_sensor_region.csv",
     params:
-        cfg=as_json(ICFG.get("two_sensor")),
+        cfg=as_json(pick(ICFG.get("two_sensor", {}), "a", "lambda1_grid", "bisection_tol")),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/two_sensor_region.log",
     shell:
@@ -72,8 +80,13 @@ rule intermittent_two_sensor_simulation:
     output:
         table="results/intermittent/two_sensor_simulation.csv",
     params:
-        cfg=as_json(ICFG.get("two_sensor")),
+        cfg=as_json(
+            pick(ICFG.get("two_sensor", {}), "a", "R1", "sigma2", "check_lambda1", "check_offset",
+                 "check_horizon", "check_paths", "block_size", "seed")
+        ),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/two_sensor_simulation.log",
     shell:
@@ -86,8 +99,15 @@ rule intermittent_errata:
     output:
         table="results/errata/intermittent.csv",
     params:
-        cfg=as_json(ICFG),
+        cfg=as_json(
+            {
+                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
+                "two_sensor": pick(ICFG.get("two_sensor", {}), "sigma2"),
+            }
+        ),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/errata.log",
     shell:
@@ -102,6 +122,8 @@ rule intermittent_reconstructions:
     params:
         cfg=as_json(ICFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/reconstructions.log",
     shell:
@@ -117,8 +139,15 @@ rule intermittent_claims:
     output:
         table="results/claims/intermittent.csv",
     params:
-        cfg=as_json(ICFG),
+        cfg=as_json(
+            {
+                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
+                "two_sensor": pick(ICFG.get("two_sensor", {}), "bisection_tol"),
+            }
+        ),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/claims.log",
     shell:
@@ -134,6 +163,8 @@ rule intermittent_fig1:
     params:
         cfg=as_json({"which": "stable"}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/fig1.log",
     shell:
@@ -149,6 +180,8 @@ rule intermittent_fig2:
     params:
         cfg=as_json({"which": "unstable"}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/fig2.log",
     shell:
@@ -164,6 +197,8 @@ rule intermittent_fig4:
     params:
         cfg=as_json({"show_upper": False}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/fig4.log",
     shell:
@@ -180,6 +215,8 @@ rule intermittent_fig5:
     params:
         cfg=as_json({"show_upper": True}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/fig5.log",
     shell:
@@ -196,6 +233,8 @@ rule intermittent_figS1:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/figS1.log",
     shell:
@@ -223,6 +262,8 @@ rule intermittent_notebook:
         reconstructions="results/reconstructions/intermittent.csv",
     output:
         html="report/intermittent.html",
+    conda:
+        CONDA_ENV
     log:
         "logs/intermittent/notebook.log",
     shell:

@@ -4,17 +4,6 @@ import platform
 from netrepro.provenance import params_hash
 
 
-def report_inputs(wildcards):
-    """Every registered output of every enabled paper, as named inputs."""
-    named = {}
-    for slug, spec in PAPER_OUTPUTS.items():
-        named[f"{slug}_figures"] = spec["figures"]
-        named[f"{slug}_claims"] = spec["claims"]
-        named[f"{slug}_errata"] = spec["errata"]
-        named[f"{slug}_reconstructions"] = spec["reconstructions"]
-        named[f"{slug}_notebook"] = spec["notebook"]
-    return named
-
 
 rule report:
     input:
@@ -31,6 +20,8 @@ rule report:
             }
         ),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/report.log",
     shell:

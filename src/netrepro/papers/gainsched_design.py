@@ -87,10 +87,13 @@ class Theorem3:
         Entry-wise bound on all variables (scale fixing in the feasibility problem).
     X0 : ndarray (2n, 2n) or None
         Second moment of the initial augmented state for the performance objective.
+    margin_cap : float
+        Feasibility problems maximise the margin t (vertices <= -t I) subject to
+        t <= margin_cap; uncapped, Clarabel ends ``optimal_inaccurate``.
     """
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
-                 eps: float = 1e-6, bound: float = 1e3, X0=None):
+                 eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1):
         self.sys = sys
         self.scheduled = scheduled
         self.performance = performance
@@ -143,7 +146,7 @@ class Theorem3:
             self.problem = cp.Problem(cp.Minimize(self.gamma), cons)
         else:
             self.gamma = None
-            cons.append(self.t <= 1.0)
+            cons.append(self.t <= margin_cap)
             self.problem = cp.Problem(cp.Maximize(self.t), cons)
         self.margin_tol = eps
 
@@ -227,15 +230,16 @@ class Theorem3:
             values["Gf"] = np.zeros_like(values["G0"])
             values["Hf"] = np.zeros_like(values["H0"])
         ok_status = status == cp.OPTIMAL
+        has_values = status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and values.get("R2") is not None
         if self.performance:
-            margin = self.margin_tol if ok_status else np.nan
+            margin = self.margin_tol if has_values else np.nan
             objective = float(self.gamma.value) if self.gamma.value is not None else np.nan
             feasible = ok_status
         else:
-            margin = float(self.t.value) if self.t.value is not None else np.nan
+            margin = float(self.t.value) if (has_values and self.t.value is not None) else np.nan
             objective = margin
             feasible = ok_status and margin > self.margin_tol
-        return Theorem3Solution(status, margin, objective, feasible, values if ok_status else {}, elapsed,
+        return Theorem3Solution(status, margin, objective, feasible, values if has_values else {}, elapsed,
                                 self.n_scalar_variables())
 
 

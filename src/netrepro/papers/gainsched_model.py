@@ -311,14 +311,17 @@ class Theorem1Result:
     n_pairs: int
 
 
-def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float = 1e-7, bound: float = 1e3):
+def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float = 1e-7, bound: float = 1e3,
+                 margin_cap: float = 0.1):
     """Search Q(p) = Q0 + p Qp (27) and S satisfying Theorem 1 (12) for fixed gains.
 
     (12) is not affine in (p(k), p(k+1)) for fixed gains (p H(p), Theta Lambda),
     so the constraints are imposed on an ``n_grid`` x ``n_grid`` grid of pairs
     that includes the four vertices; :func:`theorem1_grid_check` then checks the
     certificate on a much finer grid. Maximises t subject to (12) <= -t I,
-    Q(p) >= t I, with entries of S and Q bounded by ``bound`` (scale fixing).
+    Q(p) >= t I, t <= ``margin_cap``, with entries of S and Q bounded by
+    ``bound`` (scale fixing; an uncapped margin drives the solver to
+    ``optimal_inaccurate``).
     """
     nn = 2 * sys.n
     Q0 = cp.Variable((nn, nn), symmetric=True, name="Q0")
@@ -326,7 +329,7 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     S = cp.Variable((nn, nn), name="S")
     t = cp.Variable(name="t")
     grid = np.linspace(sys.p1, sys.p2, max(2, n_grid))
-    cons = [cp.abs(S) <= bound, cp.abs(Q0) <= bound, cp.abs(Qp) <= bound, t <= 1.0]
+    cons = [cp.abs(S) <= bound, cp.abs(Q0) <= bound, cp.abs(Qp) <= bound, t <= margin_cap]
     for p in grid:
         cons.append(Q0 + p * Qp >> t * np.eye(nn))
         for pn in grid:
@@ -346,12 +349,15 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     return Theorem1Result(status, margin, ok, Q0.value, Qp.value, S.value, len(grid) ** 2)
 
 
-def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41):
+def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, performance: bool = False):
     """Largest eigenvalue of (12) and smallest of Q(p) over an ``n_fine`` x ``n_fine`` grid of (p(k), p(k+1)).
 
     An independent numerical check (no solver) of a Theorem 1 certificate.
+    With ``performance`` the (1,1) block carries :math:`+L^TL`, :math:`L = [I\; -I]`
+    (the bound :math:`E\Delta V \le -E\|e\|^2` of the performance design).
     Returns ``(max_eig_12, min_eig_Q, max_eig_at_vertices)``.
     """
+    L = np.hstack([np.eye(sys.n), -np.eye(sys.n)])
     grid = np.linspace(sys.p1, sys.p2, n_fine)
     worst, worst_vertex, qmin = -np.inf, -np.inf, np.inf
     for p in grid:
@@ -359,6 +365,8 @@ def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41):
         qmin = min(qmin, float(np.linalg.eigvalsh(0.5 * (Q_now + Q_now.T)).min()))
         for pn in grid:
             M = theorem1_matrix(sys, gains, Q_now, Q0 + pn * Qp, S, p)
+            if performance:
+                M[: 2 * sys.n, : 2 * sys.n] += L.T @ L
             e = float(np.linalg.eigvalsh(0.5 * (M + M.T)).max())
             worst = max(worst, e)
             if p in (grid[0], grid[-1]) and pn in (grid[0], grid[-1]):

@@ -1,0 +1,9 @@
+"""Shared fixtures. Tests never write into the repository's results/ or figures/."""
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(12345)

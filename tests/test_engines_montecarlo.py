@@ -1,0 +1,40 @@
+import numpy as np
+import pytest
+
+from netrepro.engines.montecarlo import merge_block_sums, run_blocks, run_monte_carlo
+
+
+def _sim(rng, n):
+    x = rng.exponential(2.0, size=(n, 3))
+    return {"x": x, "x2": x**2}
+
+
+@pytest.mark.parametrize("chunks", [1, 2, 3, 7])
+def test_result_independent_of_chunking(chunks):
+    ref = run_monte_carlo(_sim, 10_000, 700, seed=5, n_chunks=1)
+    got = run_monte_carlo(_sim, 10_000, 700, seed=5, n_chunks=chunks)
+    assert np.array_equal(ref.mean("x"), got.mean("x"))
+    assert np.array_equal(ref.std("x2"), got.std("x2"))
+
+
+def test_shards_merged_in_any_order_equal_single_run():
+    ref = run_monte_carlo(_sim, 5000, 500, seed=9)
+    parts = [run_blocks(_sim, 5000, 500, 9, blocks=b) for b in ([7, 8, 9], [0, 1, 2, 3], [4, 5, 6])]
+    merged = merge_block_sums(parts)
+    assert np.array_equal(ref.mean("x"), merged.mean("x"))
+    with pytest.raises(ValueError, match="same block"):
+        merge_block_sums([parts[0], parts[0]])
+
+
+def test_mean_and_interval_cover_truth():
+    res = run_monte_carlo(_sim, 200_000, 20_000, seed=1)
+    m, lo, hi = res.ci("x")
+    assert np.all((lo < 2.0) & (2.0 < hi))
+    assert np.allclose(m, 2.0, atol=0.02)
+    assert res.n == 200_000
+
+
+def test_different_seeds_differ():
+    a = run_monte_carlo(_sim, 1000, 100, seed=1).mean("x")
+    b = run_monte_carlo(_sim, 1000, 100, seed=2).mean("x")
+    assert not np.array_equal(a, b)
