@@ -1,0 +1,131 @@
+"""The whole workflow on the small test configuration, in a scratch copy of the repository.
+
+Checks what a user does: a full `report` build, a no-op rerun, a rerun of
+exactly the steps a parameter change touches, one figure rebuilt by rule
+name and by file path, `--lint`, and that a bad configuration stops before
+any job runs.
+"""
+
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
+                                "*.egg-info", ".pytest_cache", ".hypothesis")
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
+
+
+def snakemake(workdir, *args, check=True):
+    cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", *args]
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=900)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    return proc
+
+
+def jobs_planned(workdir, *targets):
+    """Rule names a dry run would execute."""
+    out = snakemake(workdir, "-n", *targets).stdout
+    rules = set()
+    for line in out.splitlines():
+        match = re.match(r"^(\w+)\s+\d+$", line.strip())
+        if match and match.group(1) not in ("total", "job"):
+            rules.add(match.group(1))
+    return rules
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    work = tmp_path_factory.mktemp("wf") / "repo"
+    shutil.copytree(ROOT, work, ignore=IGNORE)
+    (work / "report").mkdir()
+    (work / "figures").mkdir()
+    snakemake(work, "-j2", "report")
+    return work
+
+
+def test_report_and_interface_tables(built):
+    assert (built / "report" / "index.html").stat().st_size > 10_000
+    bounds = pd.read_csv(built / "results/intermittent/scalar_bounds.csv")
+    assert list(bounds.columns[:9]) == ["lam", "k", "s", "r", "report_estimate", "mean", "mean_lo", "mean_hi",
+                                        "mean_method"]
+    region = pd.read_csv(built / "results/intermittent/two_sensor_region.csv")
+    assert list(region.columns[:3]) == ["lambda1", "lambda2c_lower", "lambda2c_upper"]
+    for claims in (built / "results/claims").glob("*.csv"):
+        frame = pd.read_csv(claims)
+        assert list(frame.columns[:8]) == ["paper", "claim_id", "statement", "paper_value", "reproduced_value",
+                                           "tolerance", "verdict", "note"]
+        assert set(frame["verdict"]) <= {"reproduced", "differs", "erratum"}
+    for table in (built / "results").rglob("*.csv"):
+        assert table.with_name(table.name + ".meta.json").is_file(), f"no provenance sidecar for {table}"
+
+
+def test_second_run_does_nothing(built):
+    assert jobs_planned(built, "report") == set()
+
+
+def test_parameter_change_reruns_exactly_dependents(built):
+    cfg_path = built / "config/test.yaml"
+    original = cfg_path.read_text()
+    cfg = yaml.safe_load(original)
+    cfg["intermittent"]["two_sensor"]["lambda1_grid"] += 1
+    cfg_path.write_text(yaml.safe_dump(cfg))
+    try:
+        planned = jobs_planned(built, "report")
+    finally:
+        cfg_path.write_text(original)
+    assert {"intermittent_two_sensor_region", "intermittent_fig4", "intermittent_fig5", "report"} <= planned
+    untouched = {"intermittent_monte_carlo", "intermittent_exact_mean", "intermittent_scalar_bounds",
+                 "intermittent_fig1", "intermittent_fig2", "intermittent_two_sensor_simulation"}
+    assert not planned & untouched
+
+
+def test_n_chunks_does_not_trigger_rerun(built):
+    cfg_path = built / "config/test.yaml"
+    original = cfg_path.read_text()
+    cfg = yaml.safe_load(original)
+    cfg["intermittent"]["scalar"]["n_chunks"] = 5
+    cfg_path.write_text(yaml.safe_dump(cfg))
+    try:
+        assert "intermittent_monte_carlo" not in jobs_planned(built, "report")
+    finally:
+        cfg_path.write_text(original)
+
+
+def test_single_figure_by_rule_name_and_by_path(built):
+    fig = built / "figures/intermittent/fig4.png"
+    fig.unlink()
+    assert jobs_planned(built, "intermittent_fig4") == {"intermittent_fig4"}
+    snakemake(built, "-j2", "intermittent_fig4")
+    assert fig.is_file()
+    fig.unlink()
+    assert jobs_planned(built, "figures/intermittent/fig4.png") == {"intermittent_fig4"}
+    snakemake(built, "-j2", "figures/intermittent/fig4.png")
+    assert fig.is_file()
+
+
+def test_lint_clean(built):
+    out = snakemake(built, "--lint")
+    assert "good condition" in out.stdout + out.stderr
+
+
+def test_bad_config_stops_before_any_job(built):
+    bad = built / "config/bad.yaml"
+    cfg = yaml.safe_load((built / "config/test.yaml").read_text())
+    cfg["intermittent"]["scalar"]["R2"] = -1
+    bad.write_text(yaml.safe_dump(cfg))
+    before = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "--configfile", "config/bad.yaml", "-j2", "--forceall",
+                           "report"], cwd=built, capture_output=True, text=True, timeout=300)
+    assert proc.returncode != 0
+    assert "intermittent.scalar.R2" in proc.stdout + proc.stderr
+    after = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
+    assert before == after
