@@ -807,6 +807,14 @@ def check_config(section: dict) -> None:
     g = section["snr_grid_db"]
     if g["stop"] <= g["start"]:
         raise ConfigError(f"config key 'onebit.snr_grid_db' = {g!r}: stop must exceed start")
+    if section["fig1_one_minus_alpha"] not in section["one_minus_alpha"]:
+        raise ConfigError(f"config key 'onebit.fig1_one_minus_alpha' = {section['fig1_one_minus_alpha']!r} must be one "
+                          f"of onebit.one_minus_alpha = {section['one_minus_alpha']!r}")
+    conv = section["convergence"]
+    for key in ("n_steps", "n_lag_steps"):
+        if len(conv[key]) != len(section["one_minus_alpha"]):
+            raise ConfigError(f"config key 'onebit.convergence.{key}' = {conv[key]!r} needs one entry per "
+                              f"onebit.one_minus_alpha ({len(section['one_minus_alpha'])})")
     est = section["estimator"]
     w0, w1 = est["window"]
     if not 0 <= w0 < w1 <= est["horizon"]:
