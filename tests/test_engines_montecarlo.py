@@ -38,3 +38,14 @@ def test_different_seeds_differ():
     a = run_monte_carlo(_sim, 1000, 100, seed=1).mean("x")
     b = run_monte_carlo(_sim, 1000, 100, seed=2).mean("x")
     assert not np.array_equal(a, b)
+
+
+def test_shards_saved_and_loaded_merge_to_single_run(tmp_path):
+    from netrepro.engines.montecarlo import load_sums, save_sums, shard_blocks
+
+    ref = run_monte_carlo(_sim, 3000, 400, seed=4)
+    for shard in range(3):
+        part = run_blocks(_sim, 3000, 400, 4, blocks=shard_blocks(3000, 400, 3, shard))
+        save_sums(tmp_path / f"s{shard}.npz", {"a": part})
+    merged = merge_block_sums(load_sums(tmp_path / f"s{i}.npz")["a"] for i in (2, 0, 1))
+    assert np.array_equal(ref.mean("x"), merged.mean("x")) and merged.n == 3000

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-__all__ = ["block_rng", "n_blocks", "run_blocks", "merge_block_sums", "MonteCarloSums", "run_monte_carlo"]
+__all__ = ["block_rng", "n_blocks", "run_blocks", "merge_block_sums", "MonteCarloSums", "run_monte_carlo",
+           "shard_blocks", "save_sums", "load_sums"]
 
 
 def block_rng(seed: int, block: int) -> np.random.Generator:
@@ -126,3 +127,40 @@ def run_monte_carlo(fn, n_paths: int, block_size: int, seed: int, n_chunks: int 
     nb = n_blocks(n_paths, block_size)
     chunks = np.array_split(np.arange(nb), max(1, min(n_chunks, nb)))
     return merge_block_sums(run_blocks(fn, n_paths, block_size, seed, blocks=c) for c in chunks if len(c))
+
+
+def shard_blocks(n_paths: int, block_size: int, n_shards: int, shard: int) -> np.ndarray:
+    """Block indices of shard ``shard`` (0-based) when all blocks are split into ``n_shards`` contiguous shards."""
+    if not 0 <= shard < n_shards:
+        raise ValueError(f"shard must be in [0, {n_shards}), got {shard}")
+    return np.array_split(np.arange(n_blocks(n_paths, block_size)), n_shards)[shard]
+
+
+def save_sums(path, named: dict) -> None:
+    """Write several :class:`MonteCarloSums` (name -> sums) to one ``.npz`` file, atomically."""
+    from ..io import atomic_path
+
+    arrays = {}
+    for name, res in named.items():
+        arrays[f"{name}|blocks"] = res.blocks
+        arrays[f"{name}|counts"] = res.counts
+        for attr in ("sums", "sumsq", "maxima"):
+            for key, val in getattr(res, attr).items():
+                arrays[f"{name}|{attr}|{key}"] = val
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+
+
+def load_sums(path) -> dict:
+    """Inverse of :func:`save_sums`."""
+    out = {}
+    with np.load(path) as data:
+        for full in data.files:
+            parts = full.split("|")
+            entry = out.setdefault(parts[0], {"sums": {}, "sumsq": {}, "maxima": {}})
+            if len(parts) == 2:
+                entry[parts[1]] = data[full]
+            else:
+                entry[parts[1]][parts[2]] = data[full]
+    return {name: MonteCarloSums(e["blocks"], e["counts"], e["sums"], e["sumsq"], e["maxima"]) for name, e in out.items()}
