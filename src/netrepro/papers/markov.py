@@ -39,8 +39,9 @@ Tables (``results/markov/``)
     ``plain_mean`` (sample mean), ``rb_mean`` (conditional estimator), ``exact_mean`` (k <= depth+1).
 ``estimator_check.csv``
     ``example, p, q, k, exact_mean, plain_mean, plain_ci_high, rb_mean, rb_ci_low, rb_ci_high,
-    plain_over_exact, rb_over_exact, n_paths``: the plain sample mean failing, the conditional
-    estimator agreeing with the exact value.
+    plain_over_exact, rb_over_exact`` at ``k = depth + 1`` (conditional estimator against the
+    exact value); ``k_long, plain_mean_long, rb_mean_long, plain_over_rb_long`` at the long
+    horizon (the plain sample mean failing); ``n_paths``.
 """
 
 from __future__ import annotations
@@ -59,7 +60,8 @@ from . import markov_math as mm
 __all__ = [
     "check_config", "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step",
     "stability_map_step", "sample_paths_step", "claims_step", "errata_step", "reconstructions_step",
-    "figure_plane", "figure_path", "figure_mean", "figure_estimators", "classify_growth",
+    "figure_plane", "figure_path", "figure_mean", "figure_estimators", "figure_curves", "classify_growth",
+    "load_moments",
 ]
 
 SLUG = "markov"
@@ -285,19 +287,22 @@ def stability_map_step(params, inputs, outputs):
 
 
 # ----------------------------------------------------------------------------- sample paths (Figs 3-6)
-def _estimator_check(system, S0, example, p, q, em, n, rng):
-    """Plain sample mean and conditional estimator of E||P_k|| against the exact value at k = depth + 1."""
+def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
+    """Plain sample mean and conditional estimator of E||P_k||: against the exact value at k = depth + 1,
+    and against each other at the long horizon ``k = horizon + 1`` (where only the conditional one is trusted)."""
     exact = em.mean(p, q, "norm")
     k = len(exact)
-    norms, arrivals = mm.plain_mc(system, S0, p, q, n, k - 1, rng)
+    norms, arrivals = mm.plain_mc(system, S0, p, q, n, max(horizon, k - 1), rng)
     rb = mm.rb_mean_norm(system, S0, p, q, arrivals)
     plain, rbk = norms[:, k - 1], rb[:, k - 1]
     se_p, se_r = plain.std(ddof=1) / np.sqrt(n), rbk.std(ddof=1) / np.sqrt(n)
+    kl = rb.shape[1]
     return {"example": example, "p": p, "q": q, "k": k, "exact_mean": exact[k - 1],
             "plain_mean": plain.mean(), "plain_ci_high": plain.mean() + 1.96 * se_p,
             "rb_mean": rbk.mean(), "rb_ci_low": rbk.mean() - 1.96 * se_r, "rb_ci_high": rbk.mean() + 1.96 * se_r,
             "plain_over_exact": plain.mean() / exact[k - 1], "rb_over_exact": rbk.mean() / exact[k - 1],
-            "n_paths": n}
+            "k_long": kl, "plain_mean_long": norms[:, kl - 1].mean(), "rb_mean_long": rb[:, kl - 1].mean(),
+            "plain_over_rb_long": norms[:, kl - 1].mean() / rb[:, kl - 1].mean(), "n_paths": n}
 
 
 def sample_paths_step(params, inputs, outputs):
@@ -331,7 +336,7 @@ def sample_paths_step(params, inputs, outputs):
         em = load_moments(table, point["example"])
         rng = np.random.default_rng([sp["seed"], 100 + j])
         checks.append(_estimator_check(_system(ex), np.asarray(ex["Sigma0"], float), point["example"],
-                                       float(point["p"]), float(point["q"]), em, sp["rb_paths"], rng))
+                                       float(point["p"]), float(point["q"]), em, sp["rb_paths"], sp["rb_horizon"], rng))
     return {"table": pd.DataFrame(rows), "check": pd.DataFrame(checks)}
 
 
@@ -347,7 +352,6 @@ def claims_step(params, inputs, outputs):
     curves = pd.read_csv(inputs["curves"])
     iid = pd.read_csv(inputs["iid"]).set_index("example")
     smap = pd.read_csv(inputs["map"], keep_default_na=False)
-    est = pd.read_csv(inputs["estimators"])
     moments = pd.read_csv(inputs["moments"])
     rows = []
     add = rows.append
@@ -428,12 +432,241 @@ def claims_step(params, inputs, outputs):
                       f"Example {name}: stability map agrees with Thm 5 (sufficient) and the necessary condition "
                       "(decided points contradicting either)", 0, contra, 0, "count; must be zero",
                       note=f"{(s.verdict == 'undecided').sum()} of {len(s)} grid points undecided at the exact horizon"))
-    for _, r in est.iterrows():
-        pass
-    worst = est.loc[est.plain_over_long.idxmin()] if "plain_over_long" in est else None
-    if worst is not None:
-        add(claim_row(SLUG, "plain_mean_understates", "Issue: a plain sample mean understates E||P_k|| near/beyond the boundary "
-                      "(ratio plain / conditional estimator at the long horizon, worst point)", 1.0, float(worst.plain_over_long),
-                      0.5, "a factor of 2 counts as failure",
-                      note=f"example {worst.example}, (p, q) = ({worst.p}, {worst.q}), k = {int(worst.k_long)}"))
     return {"table": claims_frame(rows)}
+
+
+# ----------------------------------------------------------------------------- errata and reconstructions
+def _schur_residual(A, C, p, q, rng):
+    """max |Schur complement of Psi (11) - (X - sum_i w_i M_i' Y M_i)| on random data, with C^{(i)} = [C; ...; CA^{i-1}]."""
+    n, m = A.shape[0], C.shape[0]
+    l_o = mm.observability_index(A, C)
+    X = np.eye(n) * 50.0
+    G = rng.standard_normal((n, n))
+    Y = G @ G.T + np.eye(n)
+    F = [rng.standard_normal((m * i, n)) for i in range(1, l_o)]
+    cols = [np.sqrt(p * (1 - p) ** (i - 1)) * (Y @ np.linalg.matrix_power(A, i) + F[i - 1].T @ mm.stacked_output(A, C, i))
+            for i in range(1, l_o)]
+    schur = X - sum(c.T @ np.linalg.solve(Y, c) for c in cols)
+    K = [np.linalg.solve(Y, f.T) for f in F]
+    direct = X - sum(p * (1 - p) ** (i - 1) * M.T @ Y @ M for i, M in
+                     ((i, np.linalg.matrix_power(A, i) + K[i - 1] @ mm.stacked_output(A, C, i)) for i in range(1, l_o)))
+    return float(np.max(np.abs(schur - direct)))
+
+
+def errata_step(params, inputs, outputs):
+    """Every inconsistency of the text with its correction and a numerical demonstration."""
+    checks = pd.read_csv(inputs["checks"]).set_index("check")
+    ex1, ex2 = params["examples"]["I"], params["examples"]["II"]
+    A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
+    A2 = np.asarray(ex2["A"], float)
+    rng = np.random.default_rng(7)
+    schur = _schur_residual(A1, C1, 0.5, 0.65, rng)
+    lower = float(checks.loc["exII_q05_tight_lower", "p"])
+    analytic = float(mm.parity_bound_example2(mm.spectral_abs(A2), 0.5))
+    # adjoint check of eq (9) against eq (7): <L_K(X), P> = <X, H_K(P)>
+    K = [rng.standard_normal((2, 1))]
+    Xr, Pr = np.eye(2) + 0.1, np.diag([2.0, 0.5])
+    lhs = np.trace(mm.L_operator(A1, C1, K, 0.5, 0.65, Xr) @ Pr)
+    HP = (mm.H_matrix(A1, C1, K, 0.5, 0.65) @ Pr.reshape(-1, order="F")).real.reshape(2, 2, order="F")
+    adj = abs(lhs - np.trace(Xr @ HP))
+    m = C1.shape[0]
+    rows = [
+        {"erratum_id": "E1_C_i_undefined", "location": "eqs. (7), (9), (11), Theorems 1-2",
+         "printed": "C^{(i)} used but never defined",
+         "corrected": "C^{(i)} = [C; CA; ...; CA^{i-1}] (i-step observability matrix), K^{(i)} of size n x m i",
+         "demonstration": "with this reading L_K (9) is the adjoint of H(K) (7) and the Schur complement of (11) is "
+                          "X - sum_i w_i M_i'YM_i; residuals of both identities (printed: not evaluable)",
+         "residual_printed": np.nan, "residual_corrected": max(schur, adj)},
+        {"erratum_id": "E2_eq11_last_block", "location": "eq. (11), last row and column",
+         "printed": "(C^{(l_0)})' F_{l_0-1} and F^*_{l_0-1} C^{(l_0)}",
+         "corrected": "(C^{(l_o-1)})' F_{l_o-1} and F^*_{l_o-1} C^{(l_o-1)} (also l_0 -> l_o, Definition 2)",
+         "demonstration": "F_{l-1} has m(l-1) rows; C^{(l)} has m l rows: row mismatch (printed) vs none (corrected)",
+         "residual_printed": float(m), "residual_corrected": 0.0},
+        {"erratum_id": "E3_exII_0465", "location": "Section 5.2, Example II",
+         "printed": "Theorem 5: if p <= 0.465 the Kalman filter is mean-square stable (q = 0.5)",
+         "corrected": f"p < p_underline(0.5) = {analytic:.6f} (a supremum, not attained; rounded down: p < 0.4645)",
+         "demonstration": "distance of the printed bound and of our closed form from the certified bisection value; "
+                          "the LMI at p = 0.465 is infeasible",
+         "residual_printed": 0.465 - lower, "residual_corrected": abs(analytic - lower)},
+        {"erratum_id": "E4_ref16_value", "location": "Section 5.1, two paragraphs",
+         "printed": "[16] concludes p < 0.04 ... the criterion of [16] only covers failure rates lower than 4.5%",
+         "corrected": "one of 0.04 / 0.045 is a slip; [16]'s criterion cannot be recomputed from this text "
+                      f"(its norm relaxation with K = 0 gives p < {mm.norm_relaxation_bound(A1, 0.65):.3f})",
+         "demonstration": "difference between the two printed values", "residual_printed": 0.005,
+         "residual_corrected": np.nan},
+        {"erratum_id": "E5_item_reference", "location": "Section 5.1",
+         "printed": "the LMI in 2) of Theorem 2", "corrected": "the LMI in (iv) of Theorem 2 (item (ii) is a spectral radius)",
+         "demonstration": "textual", "residual_printed": np.nan, "residual_corrected": np.nan},
+        {"erratum_id": "E6_prop2_index", "location": "proof of Proposition 2",
+         "printed": "pi(z~_k = j | z~_k = i)", "corrected": "pi(z~_{k+1} = j | z~_k = i)",
+         "demonstration": "textual (index slip)", "residual_printed": np.nan, "residual_corrected": np.nan},
+        {"erratum_id": "E7_phi_definite", "location": "below eq. (9)",
+         "printed": "Phi_X is the positive definite solution of (1-q)A'Phi A + qA'XA = Phi",
+         "corrected": "Phi_X = sum_j q(1-q)^{j-1} (A')^j X A^j is positive semidefinite (definite if X > 0)",
+         "demonstration": "X = 0 gives Phi_X = 0", "residual_printed": np.nan, "residual_corrected": 0.0},
+        {"erratum_id": "E8_prop1_form", "location": "Section 5.1",
+         "printed": "Proposition 1 requires p < (1-|lambda|^2(1-q)) / (|lambda|^4 q)",
+         "corrected": "this closed form is eq. (8) for l_o = 2 only (true for Example I; stated without l_o)",
+         "demonstration": "eq. (8) with l_o = 2 vs the closed form at q = 0.65",
+         "residual_printed": abs(float(mm.prop1_bound(1.3, np.array([0.65]), 2)[0])
+                                 - (1 - 1.69 * 0.35) / (1.69 ** 2 * 0.65)), "residual_corrected": 0.0},
+        {"erratum_id": "E9_typo_equiblock", "location": "Definitions 5-6",
+         "printed": "quasi-eqiblock", "corrected": "quasi-equiblock", "demonstration": "textual",
+         "residual_printed": np.nan, "residual_corrected": np.nan},
+    ]
+    for r in rows:
+        r["paper"] = SLUG
+    return {"table": errata_frame(rows)}
+
+
+def reconstructions_step(params, inputs, outputs):
+    """Every parameter the paper does not state: key, value, reason, sensitivity."""
+    sp, ex = params["paths"], params["examples"]
+    rows = [
+        ("examples.*.Sigma0", str(ex["I"]["Sigma0"]) + " / " + str(ex["II"]["Sigma0"]),
+         "Sigma_0 >= 0 is never given", "boundedness does not depend on it (Prop. 2 holds for all Sigma_0); "
+         "finite-horizon means and the undecided band of the map do"),
+        ("gamma_1", "1", "paper: 'without loss of generality gamma_1 = 1'; used in every simulation and exact sum",
+         "none for boundedness"),
+        ("C^{(i)}", "[C; CA; ...; CA^{i-1}]", "undefined in the text (erratum E1)", "l_o = 2 in both examples, so only C^{(1)} = C enters"),
+        ("checks.eps", str(params["checks"]["eps"]), "footnote 4: p = 1 - eps, eps 'arbitrarily small'",
+         "the Example I LMI is feasible up to p ~ 1.4 (uncapped), so any eps works"),
+        ("paths.horizon", str(sp["horizon"]), "figure horizons not stated", "visual only"),
+        ("paths.seed", str(sp["seed"]), "sample paths of Figs 3-5 are random; the paper's realisations are lost",
+         "the drawn path changes; bands and means do not"),
+        ("paths.n_paths / rb_paths", f"{sp['n_paths']} / {sp['rb_paths']}", "Monte Carlo sizes for bands and conditional means",
+         "band edges move by ~1/sqrt(n)"),
+        ("exact.depth", str(params["exact"]["depth"]), "exact expectation over all 2^(depth-1) channel paths; memory/time budget",
+         "larger depth narrows the undecided band of the stability map"),
+        ("map.bounded_tol / unbounded_tol", f"{params['map']['bounded_tol']} / {params['map']['unbounded_tol']}",
+         "growth-rate thresholds of the map verdicts; chosen so that the finite-horizon transient of stable points near "
+         "the boundary is not called unbounded", "move points between decided and undecided"),
+        ("curves.p_uncapped_max", str(params["curves"]["p_uncapped_max"]),
+         "search cap of the uncapped Theorem 5 value (l_o = 2: the LMI depends on sqrt(p) only)",
+         "rows with thm5_saturated = True are lower bounds"),
+        ("LMI normalisation", "max t s.t. Psi >= t I, (10) >= 0, Y <= I; margin_tol 1e-7",
+         "the LMI (10)-(11) is homogeneous; strictness needs a margin", "feasible answers are certified by rho(H(K)) < 1 anyway"),
+        ("norm", "induced 2-norm ||P_k|| (largest eigenvalue)", "paper's notation section", "map uses the same norm"),
+    ]
+    return {"table": reconstructions_frame({"paper": SLUG, "key": k, "value": v, "reason": r, "sensitivity": s}
+                                           for k, v, r, s in rows)}
+
+
+# ----------------------------------------------------------------------------- figures
+_COLORS = {"bounded": "#2ca02c", "unbounded": "#d62728", "undecided": "#bbbbbb"}
+
+
+def figure_plane(params, inputs, outputs):
+    """Fig. 2 made quantitative: the p-q plane of both examples with the curves and the stability map."""
+    curves = pd.read_csv(inputs["curves"])
+    smap = pd.read_csv(inputs["map"], keep_default_na=False)
+    iid = pd.read_csv(inputs["iid"]).set_index("example")
+    names = list(params["examples"])
+    fig, axes = new_figure(1, len(names), figsize=(5.2 * len(names), 4.6), squeeze=False)
+    for ax, name in zip(axes[0], names):
+        s = smap[smap.example == name]
+        for verdict, color in _COLORS.items():
+            sub = s[s.verdict == verdict]
+            ax.scatter(sub.q, sub.p, s=7, marker="s", color=color, alpha=0.55, linewidths=0,
+                       label=f"exact E||P_k||: {verdict}")
+        c = curves[curves.example == name]
+        ax.plot(c.q, c.p_thm5, color="k", lw=2, label="Theorem 5 lower bound p(q)")
+        ax.plot(c.q, c.p_prop1, color="tab:blue", lw=1.5, ls="--", label="Proposition 1 (eq. 8)")
+        if c.p_reference.notna().any():
+            ax.plot(c.q, c.p_reference, color="tab:purple", lw=1, ls=":", label="reference p_c (table column reference)")
+        qn = c.q_necessary.iloc[0]
+        ax.axvline(qn, color="tab:orange", lw=1.5, label=f"necessary |lambda|^2(1-q) = 1 (q = {qn:.3f})")
+        ax.plot([0, 1], [1, 0], color="0.3", lw=1, ls="-.", label="i.i.d. line p + q = 1")
+        r = iid.loc[name]
+        ax.plot([r.q_thm5_on_iid_line], [1 - r.q_thm5_on_iid_line], "k*", ms=10, label="Thm 5 on the i.i.d. line")
+        ax.plot([r.lambda_lmi_upper], [1 - r.lambda_lmi_upper], "bv", ms=7, label="Sinopoli LMI bound")
+        ax.plot([r.lambda_lower], [1 - r.lambda_lower], "b^", ms=7, label="Sinopoli lower bound")
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1.02)
+        ax.set_xlabel("recovery rate q")
+        ax.set_ylabel("failure rate p")
+        ax.set_title(f"Example {name}")
+    axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_path(params, inputs, outputs):
+    """Figs. 3-5: a sample path of ||P_k|| and gamma_k, with Monte Carlo bands and trustworthy means."""
+    t = pd.read_csv(inputs["paths"])
+    t = t[t.figure == params["figure"]]
+    fig, (ax, ax2) = new_figure(2, 1, figsize=(6.4, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    ax.fill_between(t.k, t.q05, t.q95, color="tab:blue", alpha=0.15, label="5-95% of ||P_k|| (Monte Carlo)")
+    ax.plot(t.k, t.q50, color="tab:blue", lw=1, ls="--", label="median")
+    ax.plot(t.k, t.norm_path, color="k", lw=1.2, label="one sample path ||P_k||")
+    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.5, label="E||P_k|| (conditional estimator)")
+    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, ls=":", label="E||P_k|| (exact, all paths)")
+    ax.set_yscale("log")
+    ax.set_ylabel("||P_k||")
+    p, q = t.p.iloc[0], t.q.iloc[0]
+    ax.set_title(f"Example {t.example.iloc[0]}, p = {p}, q = {q}")
+    ax.legend(fontsize=7)
+    g = t.dropna(subset=["gamma"])
+    ax2.step(g.k, g.gamma, where="post", color="k", lw=0.8)
+    ax2.set_ylim(-0.2, 1.2)
+    ax2.set_yticks([0, 1])
+    ax2.set_ylabel("gamma_k")
+    ax2.set_xlabel("k")
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_mean(params, inputs, outputs):
+    """Fig. 6: divergence of E||P_k|| at (0.99, 0.5) on Example II (exact, conditional, plain)."""
+    t = pd.read_csv(inputs["paths"])
+    t = t[t.figure == params["figure"]]
+    fig, ax = new_figure()
+    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, label="E||P_k|| exact (all channel paths)")
+    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.2, label="conditional estimator (trailing loss run integrated)")
+    ax.plot(t.k, t.plain_mean, color="tab:blue", lw=1, ls="--", label="plain sample mean")
+    ax.plot(t.k, t.q50, color="0.5", lw=1, ls=":", label="median ||P_k||")
+    ax.set_yscale("log")
+    ax.set_xlabel("k")
+    ax.set_ylabel("E||P_k||")
+    ax.set_title(f"Example {t.example.iloc[0]}, p = {t.p.iloc[0]}, q = {t.q.iloc[0]}")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_estimators(params, inputs, outputs):
+    """Fig. S1: plain sample mean vs conditional estimator vs exact expectation."""
+    e = pd.read_csv(inputs["check"])
+    labels = [f"Ex {r.example}\n({r.p:g}, {r.q:g})" for r in e.itertuples()]
+    x = np.arange(len(e))
+    fig, ax = new_figure(figsize=(7.0, 4.0))
+    ax.bar(x - 0.27, e.plain_over_exact, 0.27, label="plain / exact  (k = depth+1)", color="tab:blue")
+    ax.bar(x, e.rb_over_exact, 0.27, label="conditional / exact  (k = depth+1)", color="tab:red")
+    ax.bar(x + 0.27, e.plain_over_rb_long, 0.27, label="plain / conditional  (long horizon)", color="0.5")
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xticks(x)
+    ax.set_xticklabels(labels, fontsize=7)
+    ax.set_ylabel("ratio of estimates of E||P_k||")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_curves(params, inputs, outputs):
+    """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values."""
+    curves = pd.read_csv(inputs["curves"])
+    fig, ax = new_figure()
+    for name, color in zip(params["examples"], ("tab:blue", "tab:green", "tab:red")):
+        c = curves[curves.example == name]
+        ax.plot(c.q, c.p_thm5_uncapped, color=color, lw=2, label=f"Ex {name}: Theorem 5 (uncapped)")
+        ax.plot(c.q, c.p_prop1_uncapped, color=color, lw=1, ls="--", label=f"Ex {name}: Proposition 1")
+        sat = c[c.thm5_saturated.astype(str).str.lower() == "true"]
+        ax.plot(sat.q, sat.p_thm5_uncapped, "^", color=color, ms=5, label=f"Ex {name}: search cap reached")
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel("q")
+    ax.set_ylabel("bound on p")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}

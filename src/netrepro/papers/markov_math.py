@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import cvxpy as cp
 import numpy as np
 
-from ..engines.channels import gilbert_elliott_arrivals
+from ..engines.channels import gilbert_elliott_arrivals, gilbert_elliott_stationary
 from ..engines.lmi import SOLVER, MareStabilizabilityLMI, bisect_monotone
 from ..engines.riccati import Sensor, covariance_paths
 
@@ -38,7 +38,7 @@ __all__ = [
     "LinearSystem", "observability_index", "stacked_output", "spectral_abs", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "GilbertElliottLMI", "LMIResult", "thm5_lower_bound",
     "rebuild_solve", "riccati_g", "riccati_h", "exact_moments", "ExactMoments", "rb_mean_norm", "plain_mc",
-    "sym_norm", "sinopoli_lmi_threshold", "parity_bound_example2", "norm_relaxation_bound",
+    "sym_norm", "sinopoli_lmi_threshold", "gilbert_elliott_stationary_loss", "parity_bound_example2", "norm_relaxation_bound",
 ]
 
 
@@ -532,6 +532,12 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
 
 
 # ----------------------------------------------------------------------------- i.i.d. line, analytic helpers
+def gilbert_elliott_stationary_loss(p, q) -> float:
+    """Stationary loss probability ``P(gamma = 0) = p / (p + q)`` of the chain (3)."""
+    return gilbert_elliott_stationary(p, q)[1]
+
+
+
 def sinopoli_lmi_threshold(A, C, tol: float = 1e-5):
     """Sinopoli et al. (2004, Thm 5) LMI upper bound on the critical arrival rate ``lambda_c`` (i.i.d. losses).
 
