@@ -2,6 +2,8 @@
 # Compute steps -> tables under results/intermittent/, one rule per figure, claims, errata, notebook.
 
 ICFG = config.get("intermittent", {})
+# keys the Monte Carlo results depend on (n_chunks and n_shards do not change them)
+MC_KEYS = ("a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "block_size", "seed")
 
 
 rule intermittent_exact_mean:
@@ -20,24 +22,56 @@ rule intermittent_exact_mean:
         step("netrepro.papers.intermittent:exact_mean_step")
 
 
-rule intermittent_monte_carlo:
+rule intermittent_monte_carlo_shard:
     input:
         code=src("papers/intermittent.py", "engines/riccati.py", "engines/channels.py", "engines/montecarlo.py"),
     output:
+        sums="results/intermittent/shards/monte_carlo_{shard}.npz",
+    wildcard_constraints:
+        shard=r"\d+",
+    params:
+        cfg=lambda w: as_json(
+            {
+                **pick(ICFG["scalar"], *MC_KEYS),
+                "shard": int(w.shard),
+                "n_shards": ICFG["scalar"].get("n_shards", 1),
+            }
+        ),
+        io=io_json,
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=20,
+    conda:
+        CONDA_ENV
+    log:
+        "logs/intermittent/monte_carlo_{shard}.log",
+    shell:
+        step("netrepro.papers.intermittent:monte_carlo_shard_step")
+
+
+rule intermittent_monte_carlo:
+    input:
+        code=src("papers/intermittent.py", "engines/montecarlo.py"),
+        shards=expand(
+            "results/intermittent/shards/monte_carlo_{shard}.npz",
+            shard=range(ICFG.get("scalar", {}).get("n_shards", 1)),
+        ),
+    output:
         table="results/intermittent/monte_carlo.csv",
     params:
-        cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "block_size", "seed")),
+        cfg=as_json(pick(ICFG.get("scalar", {}), *MC_KEYS)),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     conda:
         CONDA_ENV
     log:
         "logs/intermittent/monte_carlo.log",
-    threads: 1
-    resources:
-        mem_mb=4000,
-        runtime=20,
     shell:
-        step("netrepro.papers.intermittent:monte_carlo_step")
+        step("netrepro.papers.intermittent:monte_carlo_merge_step")
 
 
 rule intermittent_scalar_bounds:
@@ -58,9 +92,41 @@ rule intermittent_scalar_bounds:
         step("netrepro.papers.intermittent:scalar_bounds_step")
 
 
-rule intermittent_two_sensor_region:
+rule intermittent_two_sensor_region_shard:
     input:
         code=src("papers/intermittent.py", "engines/lmi.py", "engines/channels.py"),
+    output:
+        table="results/intermittent/shards/two_sensor_region_{shard}.csv",
+    wildcard_constraints:
+        shard=r"\d+",
+    params:
+        cfg=lambda w: as_json(
+            {
+                **pick(ICFG["two_sensor"], "a", "lambda1_grid", "bisection_tol"),
+                "shard": int(w.shard),
+                "n_shards": ICFG["two_sensor"].get("n_shards", 1),
+            }
+        ),
+        io=io_json,
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=20,
+    conda:
+        CONDA_ENV
+    log:
+        "logs/intermittent/two_sensor_region_{shard}.log",
+    shell:
+        step("netrepro.papers.intermittent:two_sensor_region_shard_step")
+
+
+rule intermittent_two_sensor_region:
+    input:
+        code=src("papers/intermittent.py"),
+        shards=expand(
+            "results/intermittent/shards/two_sensor_region_{shard}.csv",
+            shard=range(ICFG.get("two_sensor", {}).get("n_shards", 1)),
+        ),
     output:
         table="results/intermittent/two_sensor_region.csv",
     params:
@@ -71,7 +137,7 @@ rule intermittent_two_sensor_region:
     log:
         "logs/intermittent/two_sensor_region.log",
     shell:
-        step("netrepro.papers.intermittent:two_sensor_region_step")
+        step("netrepro.papers.intermittent:two_sensor_region_merge_step")
 
 
 rule intermittent_two_sensor_simulation:

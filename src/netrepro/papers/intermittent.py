@@ -43,7 +43,7 @@ from ..claims import claim_row, claims_frame, errata_frame, reconstructions_fram
 from ..config import ConfigError
 from ..engines.channels import arrival_patterns, iid_arrivals
 from ..engines.lmi import MareStabilizabilityLMI, bisect_monotone
-from ..engines.montecarlo import run_monte_carlo
+from ..engines.montecarlo import load_sums, merge_block_sums, run_blocks, run_monte_carlo, save_sums, shard_blocks
 from ..engines.riccati import Sensor, covariance_paths
 from ..io import read_table
 from ..plotting import new_figure, save_figure
@@ -316,12 +316,24 @@ def _scalar_simulator(params, lam):
     return simulate
 
 
-def monte_carlo_step(params, inputs, outputs):
-    """Step: plain and conditional Monte Carlo estimates of E(p_k) with 95% bands."""
+def monte_carlo_shard_step(params, inputs, outputs):
+    """Step: block sums of one Monte Carlo shard (both lambdas); merged by :func:`monte_carlo_merge_step`."""
+    blocks = shard_blocks(params["n_paths"], params["block_size"], params["n_shards"], params["shard"])
+    named = {}
+    for i, (lam, _) in enumerate(_lambdas(params)):
+        named[f"lam{i}"] = run_blocks(_scalar_simulator(params, lam), params["n_paths"], params["block_size"],
+                                      params["seed"] + i, blocks=blocks)
+    save_sums(outputs["sums"], named)
+    return {"provenance": {"blocks": [int(b) for b in blocks]}}
+
+
+def monte_carlo_merge_step(params, inputs, outputs):
+    """Step: merge the shards (in block order, so any shard count gives identical results) into the
+    plain and conditional Monte Carlo estimates of E(p_k) with 95% bands."""
+    shards = [load_sums(path) for path in inputs["shards"]]
     frames = []
     for i, (lam, _) in enumerate(_lambdas(params)):
-        mc = run_monte_carlo(_scalar_simulator(params, lam), params["n_paths"], params["block_size"],
-                             params["seed"] + i, params.get("n_chunks", 1))
+        mc = merge_block_sums(shard[f"lam{i}"] for shard in shards)
         cm, clo, chi = mc.ci("cond")
         pm, plo, phi = mc.ci("plain")
         frames.append(pd.DataFrame({
@@ -359,12 +371,18 @@ def scalar_bounds_step(params, inputs, outputs):
     return {"table": pd.concat(frames, ignore_index=True)}
 
 
-def two_sensor_region_step(params, inputs, outputs):
-    """Step: Figs 4-5 table, lower bound (closed form) and LMI upper bound (bisection) on a lambda1 grid."""
-    grid = np.linspace(0.0, 1.0, params["lambda1_grid"])
+def two_sensor_region_shard_step(params, inputs, outputs):
+    """Step: lower bound (closed form) and LMI upper bound (bisection) on one shard of the lambda1 grid."""
+    grid = np.array_split(np.linspace(0.0, 1.0, params["lambda1_grid"]), params["n_shards"])[params["shard"]]
     upper = two_sensor_upper_bound(grid, params["a"], params["bisection_tol"])
     upper.insert(1, "lambda2c_lower", two_sensor_lower_bound(grid, params["a"]))
-    return {"table": upper, "provenance": {"total_lmi_solves": int(upper["n_solves"].sum())}}
+    return {"table": upper, "provenance": {"lmi_solves": int(upper["n_solves"].sum())}}
+
+
+def two_sensor_region_merge_step(params, inputs, outputs):
+    """Step: the Figs 4-5 table, concatenating the lambda1 shards."""
+    table = pd.concat([read_table(p) for p in inputs["shards"]], ignore_index=True).sort_values("lambda1")
+    return {"table": table.reset_index(drop=True), "provenance": {"total_lmi_solves": int(table["n_solves"].sum())}}
 
 
 def two_sensor_simulation_step(params, inputs, outputs):
