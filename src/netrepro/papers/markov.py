@@ -54,7 +54,6 @@ import pandas as pd
 
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from ..config import ConfigError, require_matrix, require_pd
-from ..plotting import new_figure, save_figure
 from . import markov_math as mm
 
 __all__ = [
@@ -558,6 +557,8 @@ _COLORS = {"bounded": "#2ca02c", "unbounded": "#d62728", "undecided": "#bbbbbb"}
 
 def figure_plane(params, inputs, outputs):
     """Fig. 2 made quantitative: the p-q plane of both examples with the curves and the stability map."""
+    from ..plotting import new_figure, save_figure
+
     curves = pd.read_csv(inputs["curves"])
     smap = pd.read_csv(inputs["map"], keep_default_na=False)
     iid = pd.read_csv(inputs["iid"]).set_index("example")
@@ -593,6 +594,8 @@ def figure_plane(params, inputs, outputs):
 
 def figure_path(params, inputs, outputs):
     """Figs. 3-5: a sample path of ||P_k|| and gamma_k, with Monte Carlo bands and trustworthy means."""
+    from ..plotting import new_figure, save_figure
+
     t = pd.read_csv(inputs["paths"])
     t = t[t.figure == params["figure"]]
     fig, (ax, ax2) = new_figure(2, 1, figsize=(6.4, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
@@ -618,6 +621,8 @@ def figure_path(params, inputs, outputs):
 
 def figure_mean(params, inputs, outputs):
     """Fig. 6: divergence of E||P_k|| at (0.99, 0.5) on Example II (exact, conditional, plain)."""
+    from ..plotting import new_figure, save_figure
+
     t = pd.read_csv(inputs["paths"])
     t = t[t.figure == params["figure"]]
     fig, ax = new_figure()
@@ -636,6 +641,8 @@ def figure_mean(params, inputs, outputs):
 
 def figure_estimators(params, inputs, outputs):
     """Fig. S1: plain sample mean vs conditional estimator vs exact expectation."""
+    from ..plotting import new_figure, save_figure
+
     e = pd.read_csv(inputs["check"])
     labels = [f"Ex {r.example}\n({r.p:g}, {r.q:g})" for r in e.itertuples()]
     x = np.arange(len(e))
@@ -655,6 +662,8 @@ def figure_estimators(params, inputs, outputs):
 
 def figure_curves(params, inputs, outputs):
     """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values."""
+    from ..plotting import new_figure, save_figure
+
     curves = pd.read_csv(inputs["curves"])
     fig, ax = new_figure()
     for name, color in zip(params["examples"], ("tab:blue", "tab:green", "tab:red")):

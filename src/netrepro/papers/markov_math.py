@@ -27,17 +27,32 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-import cvxpy as cp
 import numpy as np
 
 from ..engines.channels import gilbert_elliott_arrivals, gilbert_elliott_stationary
-from ..engines.lmi import SOLVER, MareStabilizabilityLMI, bisect_monotone
-from ..engines.riccati import Sensor, covariance_paths
+
+# cvxpy (and the shared LMI engine, which imports it) are imported lazily: the simulation
+# steps do not need them, and importing cvxpy costs seconds per pipeline job.
+SOLVER = "CLARABEL"
+OPTIMAL = "optimal"
+
+
+def _cp():
+    import cvxpy
+
+    return cvxpy
+
+
+def bisect_monotone(*args, **kwargs):
+    """:func:`netrepro.engines.lmi.bisect_monotone` (imported lazily)."""
+    from ..engines.lmi import bisect_monotone as _bisect
+
+    return _bisect(*args, **kwargs)
 
 __all__ = [
     "LinearSystem", "observability_index", "stacked_output", "spectral_abs", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "GilbertElliottLMI", "LMIResult", "thm5_lower_bound",
-    "rebuild_solve", "riccati_g", "riccati_h", "exact_moments", "ExactMoments", "rb_mean_norm", "plain_mc",
+    "rebuild_solve", "riccati_g", "riccati_h", "covariance_paths_ge", "exact_moments", "ExactMoments", "rb_mean_norm", "plain_mc",
     "sym_norm", "sinopoli_lmi_threshold", "gilbert_elliott_stationary_loss", "parity_bound_example2", "norm_relaxation_bound",
 ]
 
@@ -232,6 +247,7 @@ class GilbertElliottLMI:
     """
 
     def __init__(self, A, C, l_o: int | None = None, margin_tol: float = 1e-7):
+        cp = _cp()
         self.A = np.atleast_2d(np.asarray(A, dtype=float))
         self.C = np.atleast_2d(np.asarray(C, dtype=float))
         n, m = self.A.shape[0], self.C.shape[0]
@@ -276,6 +292,7 @@ class GilbertElliottLMI:
         """Solve at ``(p, q)``; recover ``K^{(i)} = Y^{-1} F_i'`` and certify ``rho(H(K)) < 1``."""
         if not (0 < q <= 1) or p < 0 or (self.l_o > 2 and p > 1):
             raise ValueError(f"need 0 < q <= 1 and 0 <= p (<= 1 when l_o > 2), got p={p}, q={q}")
+        cp = _cp()
         self._set(p, q)
         start = time.perf_counter()
         try:
@@ -292,7 +309,7 @@ class GilbertElliottLMI:
 def certify(A, C, p, q, status, t, X, Y, F, margin_tol) -> LMIResult:
     """Independent check of a solver answer: ``rho(H(K)) < 1`` (eq. 7) and ``X - L_K(X) > 0`` (Thm 2 (iii))."""
     margin = float(t) if t is not None else np.nan
-    feasible = status == cp.OPTIMAL and margin > margin_tol
+    feasible = status == OPTIMAL and margin > margin_tol
     if not feasible or Y is None or any(f is None for f in F):
         return LMIResult(p, q, status, margin, False, False, np.nan, np.nan)
     K = [np.linalg.solve(Y, f.T) for f in F]
@@ -303,6 +320,7 @@ def certify(A, C, p, q, status, t, X, Y, F, margin_tol) -> LMIResult:
 
 def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
     """The same LMI (10)-(11) built from scratch with constants (benchmark baseline: no Parameters)."""
+    cp = _cp()
     A = np.atleast_2d(np.asarray(A, dtype=float))
     C = np.atleast_2d(np.asarray(C, dtype=float))
     n, m = A.shape[0], C.shape[0]
@@ -470,9 +488,28 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
 
 
 # ----------------------------------------------------------------------------- Monte Carlo estimators
+def covariance_paths_ge(system, Sigma0, arrivals) -> np.ndarray:
+    """``P_1..P_{T+1}`` along each path, shape ``(N, T+1, n, n)``: ``P_{k+1} = g(P_k)`` if ``gamma_k = 1``
+    else ``h(P_k)`` (eqs. 4-5), batched over paths, loop over time only.
+
+    Same recursion as :func:`netrepro.engines.riccati.covariance_paths` for one sensor (cross-checked
+    in the unit tests); kept here so that this paper's steps depend only on eqs. (4)-(5).
+    """
+    arrivals = np.asarray(arrivals, dtype=bool)
+    N, T = arrivals.shape
+    A, C, Q, R = system.A, system.C, system.Q, system.R
+    out = np.empty((N, T + 1) + A.shape)
+    P = np.broadcast_to(np.asarray(Sigma0, dtype=float), (N,) + A.shape).copy()
+    out[:, 0] = P
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(T):
+            P = np.where(arrivals[:, k, None, None], riccati_g(P, A, C, Q, R), riccati_h(P, A, Q))
+            out[:, k + 1] = P
+    return out
+
+
 def _paths(system, Sigma0, arrivals):
-    """``P_1..P_{T+1}`` along each path (shape ``(N, T+1, n, n)``) via the shared batched engine."""
-    return covariance_paths(Sigma0, system.A, system.Q, [Sensor(system.C, system.R)], arrivals, keep="all")
+    return covariance_paths_ge(system, Sigma0, arrivals)
 
 
 def plain_mc(system, Sigma0, p, q, n_paths, horizon, rng):
@@ -544,6 +581,8 @@ def sinopoli_lmi_threshold(A, C, tol: float = 1e-5):
     Smallest ``lambda`` with a certified-feasible ``Y > (1-lambda) A'YA + lambda (A+KC)'Y(A+KC)`` (shared
     :class:`~netrepro.engines.lmi.MareStabilizabilityLMI`, certified by the second-moment radius).
     """
+    from ..engines.lmi import MareStabilizabilityLMI
+
     lmi = MareStabilizabilityLMI(A, [None, C])
     res = bisect_monotone(lambda lam: lmi.solve([1 - lam, lam]).certified, 1e-6, 1.0, tol=tol)
     return res.threshold, lmi.n_solves
