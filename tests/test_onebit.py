@@ -270,7 +270,7 @@ def test_transient_iteration_reaches_fixed_point():
 def test_grid_smoother_and_kalman_against_bounds(cfg):
     c = copy.deepcopy(cfg)
     c["estimator"].update(snr_db=[0.0], n_runs=200, block_size=100)
-    frame = ob.estimator_step(c, {}, {})["table"].set_index("kind")
+    frame = ob.run_estimator(c).set_index("kind")
     assert set(frame.index) == {"filter_1bit", "smoother_1bit", "kalman_filter", "rts_smoother"}
     assert (frame["mse_hi"] >= frame["bound"]).all()
     assert frame.loc["smoother_1bit", "mse"] < frame.loc["filter_1bit", "mse"]
@@ -300,7 +300,7 @@ def test_errata_reconstructions_claims(cfg, tmp_path):
     c = copy.deepcopy(cfg)
     c["estimator"].update(snr_db=[0.0], n_runs=100, block_size=50)
     paths["estimator"] = tmp_path / "estimator.csv"
-    ob.estimator_step(c, {}, {})["table"].to_csv(paths["estimator"], index=False)
+    ob.run_estimator(c).to_csv(paths["estimator"], index=False)
     claims = ob.claims_step(cfg, paths, {})["table"]
     assert list(claims.columns) == CLAIM_COLUMNS
     v = claims.set_index("claim_id")["verdict"]
@@ -331,3 +331,15 @@ def test_check_config_rejects_bad_sections(cfg):
     bad["fig1_one_minus_alpha"] = 0.5
     with pytest.raises(ConfigError, match="fig1_one_minus_alpha"):
         ob.check_config(bad)
+
+
+def test_estimator_shards_merge_to_identical_results(cfg, tmp_path):
+    c = copy.deepcopy(cfg)
+    c["estimator"].update(snr_db=[0.0], n_runs=60, block_size=20, horizon=30, window=[10, 20])
+    one = ob.run_estimator(c)
+    paths = []
+    for shard in range(3):
+        paths.append(tmp_path / f"s{shard}.npz")
+        ob.estimator_shard_step(dict(c, shard=shard, n_shards=3), {}, {"sums": paths[-1]})
+    three = ob.estimator_step(c, {"shards": paths}, {})["table"]
+    pd.testing.assert_frame_equal(one, three)

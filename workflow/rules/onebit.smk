@@ -3,6 +3,33 @@
 
 OCFG = config.get("onebit", {})
 ONEBIT_CODE = "papers/onebit.py"
+# config keys each step reads (only these trigger its rerun)
+ONEBIT_KEYS = {
+    "efq": ("quadrature", "efq_grid_db"),
+    "ratios": ("snr_grid_db", "quadrature", "one_minus_alpha", "sigma_eta", "snr_definition"),
+    "lag": ("snr_grid_db", "lag_tol_db", "lag_iterate_max", "one_minus_alpha", "sigma_eta", "snr_definition"),
+    "convergence": ("convergence", "one_minus_alpha", "sigma_eta", "sigma_theta0", "mu_theta0", "snr_definition"),
+    "estimator": ("estimator", "sigma_eta", "snr_definition"),
+    "vector_check": ("vector_check",),
+    "errata": ("vector_check", "sigma_theta0"),
+    "reconstructions": (
+        "snr_definition",
+        "fig1_one_minus_alpha",
+        "reference_snr_db",
+        "sigma_eta",
+        "estimator",
+        "snr_grid_db",
+        "lag_tol_db",
+        "mu_theta0",
+    ),
+    "claims": ("fig1_one_minus_alpha",),
+}
+ONEBIT_SHARDS = OCFG.get("estimator", {}).get("n_shards", 2)
+
+
+def onebit_cfg(step_name, **extra):
+    """The params of one onebit step: the config keys it reads (plus `extra`), as shell-quoted JSON."""
+    return as_json({**pick(OCFG, *ONEBIT_KEYS[step_name]), **extra})
 
 
 rule onebit_efq:
@@ -11,8 +38,14 @@ rule onebit_efq:
     output:
         table="results/onebit/efq.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("efq"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/efq.log",
     shell:
@@ -25,8 +58,14 @@ rule onebit_ratios:
     output:
         table="results/onebit/ratios.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("ratios"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/ratios.log",
     shell:
@@ -39,8 +78,14 @@ rule onebit_lag:
     output:
         table="results/onebit/lag.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("lag"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/lag.log",
     shell:
@@ -54,8 +99,10 @@ rule onebit_convergence:
         table="results/onebit/convergence.csv",
         transient="results/onebit/transient.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("convergence"),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/convergence.log",
     threads: 1
@@ -66,20 +113,45 @@ rule onebit_convergence:
         step("netrepro.papers.onebit:convergence_step")
 
 
-rule onebit_estimator:
+rule onebit_estimator_shard:
     input:
         code=src(ONEBIT_CODE, "engines/montecarlo.py"),
     output:
-        table="results/onebit/estimator_mse.csv",
+        sums="results/onebit/shards/estimator_{shard}.npz",
+    wildcard_constraints:
+        shard=r"\d+",
     params:
-        cfg=as_json(OCFG),
+        cfg=lambda w: onebit_cfg("estimator", shard=int(w.shard), n_shards=ONEBIT_SHARDS),
         io=io_json,
-    log:
-        "logs/onebit/estimator.log",
     threads: 1
     resources:
-        mem_mb=2000,
+        mem_mb=1500,
         runtime=10,
+    conda:
+        CONDA_ENV
+    log:
+        "logs/onebit/estimator_{shard}.log",
+    shell:
+        step("netrepro.papers.onebit:estimator_shard_step")
+
+
+rule onebit_estimator:
+    input:
+        code=src(ONEBIT_CODE, "engines/montecarlo.py"),
+        shards=expand("results/onebit/shards/estimator_{shard}.npz", shard=range(ONEBIT_SHARDS)),
+    output:
+        table="results/onebit/estimator_mse.csv",
+    params:
+        cfg=onebit_cfg("estimator"),
+        io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
+    log:
+        "logs/onebit/estimator.log",
     shell:
         step("netrepro.papers.onebit:estimator_step")
 
@@ -90,8 +162,14 @@ rule onebit_vector_check:
     output:
         table="results/onebit/vector_check.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("vector_check"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/vector_check.log",
     shell:
@@ -104,8 +182,14 @@ rule onebit_errata:
     output:
         table="results/errata/onebit.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("errata"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/errata.log",
     shell:
@@ -118,8 +202,14 @@ rule onebit_reconstructions:
     output:
         table="results/reconstructions/onebit.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("reconstructions"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/reconstructions.log",
     shell:
@@ -136,8 +226,14 @@ rule onebit_claims:
     output:
         table="results/claims/onebit.csv",
     params:
-        cfg=as_json(OCFG),
+        cfg=onebit_cfg("claims"),
         io=io_json,
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/claims.log",
     shell:
@@ -151,8 +247,10 @@ rule onebit_fig1:
     output:
         figure=report("figures/onebit/fig1.png", caption="../report/onebit/fig1.rst", category="onebit"),
     params:
-        cfg=as_json({"fig1_one_minus_alpha": OCFG.get("fig1_one_minus_alpha")}),
+        cfg=as_json(pick(OCFG, "fig1_one_minus_alpha")),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/fig1.log",
     shell:
@@ -168,6 +266,8 @@ rule onebit_fig2:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/fig2.log",
     shell:
@@ -183,6 +283,8 @@ rule onebit_figS1:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/figS1.log",
     shell:
@@ -198,6 +300,8 @@ rule onebit_figS2:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/figS2.log",
     shell:
@@ -213,6 +317,8 @@ rule onebit_figS3:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/figS3.log",
     shell:
@@ -242,6 +348,8 @@ rule onebit_notebook:
         reconstructions="results/reconstructions/onebit.csv",
     output:
         html="report/onebit.html",
+    conda:
+        CONDA_ENV
     log:
         "logs/onebit/notebook.log",
     shell:
