@@ -67,7 +67,7 @@ rule markov_exact_moments:
     log:
         "logs/markov/exact_moments.log",
     resources:
-        mem_mb=3000,
+        mem_mb=1000,
     shell:
         step("netrepro.papers.markov:exact_moments_step")
 

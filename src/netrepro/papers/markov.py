@@ -363,6 +363,13 @@ def claims_step(params, inputs, outputs):
     add(claim_row(SLUG, "exII_l_o", "Example II: observable but not one-step observable (l_o = 2)", 2, lo2, 0, "integer"))
     add(claim_row(SLUG, "exI_prop1_q065", "Example I, q = 0.65: Proposition 1 requires p < 0.22", 0.22, p_prop1, 0.005,
                   "paper rounds to two decimals", note="p < (1-|lambda|^2(1-q))/(|lambda|^4 q), eq. (8) with l_o = 2"))
+    proxy = float(mm.norm_relaxation_bound(np.asarray(ex1["A"], float), 0.65))
+    for cid, val, where in (("ref16_p004", 0.04, "'[16] concludes that p < 0.04 guarantees peak-covariance stability'"),
+                            ("ref16_p0045", 0.045, "'the criterion of [16] only covers failure rates lower than 4.5%'")):
+        add(claim_row(SLUG, cid, f"Example I, q = 0.65: {where}", val, proxy, 0.005, "two significant digits",
+                      note="[16]'s constants cannot be recomputed from this text; our value is the norm relaxation "
+                           "q sum (1-q)^(j-1)||A^j||^2 p||A||^2 < 1 by which the paper says its Theorem 1 covers [15-17] "
+                           "(a proxy, not [16]'s criterion); the two printed values disagree with each other (erratum E4)"))
     rho0 = mm.h_radius(ex1["A"], ex1["C"], [np.zeros((2, 1))], p_prop1, 0.65)
     add(claim_row(SLUG, "exI_prop1_is_K0", "Proposition 1 is Theorem 1 with K = 0: rho(H(0)) = 1 at the Prop. 1 bound", 1.0,
                   rho0, 1e-9, "exact identity (H(0) is a function of A(x)A)"))
