@@ -1,0 +1,660 @@
+"""Benchmarks of the project's hot paths, each against a simple reference measured in the same run.
+
+``python -m netrepro.bench --out results/benchmarks.csv [--quick]`` (``make bench``) writes one
+table with the columns ``benchmark, metric, ours, reference, ratio, unit`` and a sidecar
+``<out>.meta.json`` (machine, BLAS kernels, load, sizes, repeats, notes). Times are medians
+over repeats; because ours and the reference run in the same process, one after the other,
+the *ratio* is comparable across machines and loads even where the absolute numbers are not.
+
+``ratio`` is always "how many times better ours is" (so >= 1 is good):
+
+* rates (path-steps/s, points/s, solves/s): ``ours / reference``;
+* times and counts (s, solves): ``reference / ours``;
+* ``fraction_of_peak``: ``ours / reference`` with ``reference`` the machine's measured peak
+  (so here the ratio is the achieved fraction, at most 1);
+* pipeline targets: ``reference`` is the target of issue 9 and ``ratio = target / measured``
+  (>= 1 means the target is met);
+* agreement rows (``max_rel_diff``): ``reference`` is the tolerance, ``ratio = tol / diff``.
+
+Benchmarks
+----------
+``riccati_{iid,ge}_n{1,2,3}``
+    :func:`netrepro.engines.riccati.covariance_paths` (batched over paths) against a per-path
+    Python loop, for i.i.d. and Gilbert-Elliott arrivals and state dimension 1 to 3; plus the
+    flop count per path-step and the achieved fraction of the single-core peak, measured by a
+    large matrix product in a child process with ``OPENBLAS_CORETYPE``/``OPENBLAS_L2_SIZE``
+    unset (the native kernel; see ``/work/.library/env/README.md``).
+``channel_ge``
+    :func:`netrepro.engines.channels.gilbert_elliott_arrivals` against a per-path loop.
+``lmi_sweep``
+    :class:`netrepro.engines.lmi.MareStabilizabilityLMI` compiled once and solved across a sweep
+    against rebuilding the cvxpy problem for every point.
+``lmi_bisection``
+    LMI solves per stability curve (the two-sensor region of the ``intermittent`` paper):
+    :func:`netrepro.engines.lmi.sweep_thresholds` warm-started against plain bisections.
+``fisher_1bit``
+    The expected 1-bit Fisher information (eq. (29)-(30) of the ``onebit`` paper) on a full SNR
+    grid, vectorised against per-point adaptive quadrature, with their agreement.
+``pipeline``
+    Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
+    rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
+    against the step's own compute time from its provenance sidecar). Skipped by ``--quick``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import json
+import math
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "COLUMNS",
+    "BenchRow",
+    "median_time",
+    "reference_covariance_loop",
+    "reference_ge_loop",
+    "bench_riccati",
+    "bench_channels",
+    "bench_lmi",
+    "bench_fisher",
+    "bench_pipeline",
+    "blas_peak",
+    "run_all",
+    "main",
+]
+
+COLUMNS = ["benchmark", "metric", "ours", "reference", "ratio", "unit"]
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def BenchRow(benchmark, metric, ours, reference, ratio, unit) -> dict:  # noqa: N802 (a row constructor)
+    """One row of the benchmark table."""
+    return dict(benchmark=benchmark, metric=metric, ours=float(ours), reference=float(reference),
+                ratio=float(ratio), unit=unit)
+
+
+def _div(a, b):
+    return a / b if b not in (0, 0.0) and np.isfinite(b) else float("nan")
+
+
+def median_time(fn, repeats: int = 5, min_time: float = 0.0) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls (one untimed warm-up call first).
+
+    With ``min_time`` > 0 each timed sample loops ``fn`` until at least that long has passed
+    and returns the time per call.
+    """
+    fn()
+    samples = []
+    for _ in range(repeats):
+        calls, start = 0, time.perf_counter()
+        while True:
+            fn()
+            calls += 1
+            elapsed = time.perf_counter() - start
+            if elapsed >= min_time:
+                break
+        samples.append(elapsed / calls)
+    return statistics.median(samples)
+
+
+@contextmanager
+def _single_thread_blas():
+    """Limit BLAS to one thread (threadpoolctl if installed; else a no-op, reported in the sidecar)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - depends on the environment
+        yield False
+        return
+    with threadpool_limits(1):
+        yield True
+
+
+def _blas_info() -> list[dict]:
+    try:
+        from threadpoolctl import threadpool_info
+    except ImportError:  # pragma: no cover
+        return []
+    return [{k: i.get(k) for k in ("internal_api", "version", "architecture", "num_threads")}
+            for i in threadpool_info()]
+
+
+# ============================================================================ peak
+_PEAK_SCRIPT = r"""
+import json, time, sys
+import numpy as np
+size, repeats = int(sys.argv[1]), int(sys.argv[2])
+out = {}
+try:
+    from threadpoolctl import threadpool_info, threadpool_limits
+    out["blas"] = [{k: i.get(k) for k in ("internal_api", "version", "architecture", "num_threads")}
+                   for i in threadpool_info()]
+except ImportError:
+    threadpool_limits = None
+    out["blas"] = []
+rng = np.random.default_rng(0)
+a, b = rng.random((size, size)), rng.random((size, size))
+c = np.empty((size, size))
+def best(fn):
+    fn()
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter(); fn(); times.append(time.perf_counter() - t)
+    return min(times)
+flops = 2.0 * size ** 3
+out["gflops_all_threads"] = flops / best(lambda: np.matmul(a, b, out=c)) / 1e9
+if threadpool_limits is not None:
+    with threadpool_limits(1):
+        out["gflops_1_thread"] = flops / best(lambda: np.matmul(a, b, out=c)) / 1e9
+print(json.dumps(out))
+"""
+
+
+def blas_peak(native: bool = True, size: int = 2048, repeats: int = 5) -> dict:
+    """Double-precision GEMM rate of this machine, measured in a child process.
+
+    ``native=True`` unsets ``OPENBLAS_CORETYPE`` and ``OPENBLAS_L2_SIZE`` (together, in the child
+    only) so OpenBLAS picks its own kernel for this processor; ``native=False`` keeps the
+    environment as it is (the kernel the pipeline's steps run with). Returns the best-of-repeats
+    ``gflops_1_thread`` and ``gflops_all_threads`` and the BLAS libraries with their kernels.
+    """
+    env = dict(os.environ)
+    if native:
+        env.pop("OPENBLAS_CORETYPE", None)
+        env.pop("OPENBLAS_L2_SIZE", None)
+    proc = subprocess.run([sys.executable, "-c", _PEAK_SCRIPT, str(size), str(repeats)], env=env,
+                          capture_output=True, text=True, timeout=600)
+    if proc.returncode != 0:
+        raise RuntimeError(f"peak measurement failed: {proc.stderr[-2000:]}")
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out["env"] = {k: env.get(k) for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE")}
+    return out
+
+
+# ============================================================================ (a) Riccati recursions
+def reference_covariance_loop(P0, A, Q, c, r, arrivals) -> np.ndarray:
+    """Per-path Python loop of the intermittent Riccati recursion with one scalar sensor (the reference).
+
+    ``P_{k+1} = A (P_k - gamma_k P_k c^T c P_k / (c P_k c^T + r)) A^T + Q``, path by path and
+    step by step, with plain floats for n = 1 and small numpy matrices otherwise.
+    Returns ``P_T`` for every path, shape ``(N, n, n)``.
+    """
+    A = np.atleast_2d(np.asarray(A, dtype=float))
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    n = A.shape[0]
+    N, T = arrivals.shape
+    out = np.empty((N, n, n))
+    if n == 1:
+        a2, q, cc = float(A[0, 0]) ** 2, float(Q[0, 0]), float(np.ravel(c)[0]) ** 2
+        for i in range(N):
+            p = float(np.asarray(P0, dtype=float).reshape(-1)[0])
+            row = arrivals[i].tolist()
+            for k in range(T):
+                if row[k]:
+                    p = p - p * cc * p / (cc * p + r)
+                p = a2 * p + q
+            out[i, 0, 0] = p
+        return out
+    c = np.asarray(c, dtype=float).reshape(1, n)
+    for i in range(N):
+        P = np.array(np.broadcast_to(P0, (n, n)), dtype=float)
+        for k in range(T):
+            if arrivals[i, k]:
+                u = P @ c.T
+                P = P - (u @ u.T) / ((c @ u).item() + r)
+            P = A @ P @ A.T + Q
+        out[i] = P
+    return out
+
+
+def _system(n: int):
+    """A fixed test system of dimension n: unstable (spectral radius 1.2), observable from c."""
+    A = {1: [[1.2]], 2: [[1.1, 0.3], [-0.2, 0.95]], 3: [[1.1, 0.3, 0.0], [-0.2, 0.95, 0.1], [0.0, 0.2, 0.8]]}[n]
+    A = np.array(A)
+    c = np.ones(n) / np.sqrt(n)
+    return A, 0.1 * np.eye(n), c, 0.5, np.eye(n)
+
+
+def _arrivals(kind: str, rng, N: int, T: int):
+    from .engines.channels import gilbert_elliott_arrivals, iid_arrivals
+
+    if kind == "iid":
+        return iid_arrivals(rng, N, T, 0.7)
+    return gilbert_elliott_arrivals(rng, N, T, p=0.2, q=0.6)
+
+
+def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak_gflops: float,
+                  dims=(1, 2, 3), kinds=("iid", "ge"), rows_out=None) -> list[dict]:
+    """Batched covariance recursions against the per-path loop; flops and fraction of peak."""
+    from .engines.riccati import Sensor, covariance_paths, packed_flops_per_step
+
+    rows = [] if rows_out is None else rows_out
+    rng = np.random.default_rng(20261122)
+    for kind in kinds:
+        for n in dims:
+            A, Q, c, r, P0 = _system(n)
+            sensors = [Sensor(c[None, :], [[r]])]
+            arr = _arrivals(kind, rng, n_paths, horizon)
+            ref_arr = arr[:ref_paths]
+            with _single_thread_blas():
+                t_ours = median_time(lambda: covariance_paths(P0, A, Q, sensors, arr, keep="last"), repeats)
+                ours_last = covariance_paths(P0, A, Q, sensors, ref_arr, keep="last")
+            t_ref = median_time(lambda: reference_covariance_loop(P0, A, Q, c, r, ref_arr), max(1, repeats // 2))
+            ref_last = reference_covariance_loop(P0, A, Q, c, r, ref_arr)
+            ours_last = np.asarray(ours_last).reshape(ref_paths, n, n)
+            scale = np.max(np.abs(ref_last), axis=(1, 2), keepdims=True)
+            diff = float(np.max(np.abs(ours_last - ref_last) / scale))
+            rate, ref_rate = n_paths * horizon / t_ours, ref_paths * horizon / t_ref
+            flops = 5 if n == 1 else packed_flops_per_step(n, 1)
+            name = f"riccati_{kind}_n{n}"
+            rows.append(BenchRow(name, "path_steps_per_s", rate, ref_rate, rate / ref_rate, "path-steps/s"))
+            rows.append(BenchRow(name, "flops_per_path_step", flops, np.nan, np.nan, "flop"))
+            achieved = flops * rate / 1e9
+            rows.append(BenchRow(name, "fraction_of_peak", achieved, peak_gflops, _div(achieved, peak_gflops),
+                                 "Gflop/s (1 core)"))
+            rows.append(BenchRow(name, "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf, "1"))
+    return rows
+
+
+def reference_ge_loop(rng, n_paths: int, horizon: int, p: float, q: float) -> np.ndarray:
+    """Gilbert-Elliott arrivals path by path, step by step (the reference sampler)."""
+    pi1 = q / (p + q)
+    out = np.empty((n_paths, horizon), dtype=bool)
+    for i in range(n_paths):
+        u = rng.random(horizon).tolist()
+        state = u[0] < pi1
+        row = [state]
+        for k in range(1, horizon):
+            state = (u[k] >= p) if state else (u[k] < q)
+            row.append(state)
+        out[i] = row
+    return out
+
+
+def bench_channels(n_paths: int, horizon: int, ref_paths: int, repeats: int) -> list[dict]:
+    """Vectorised Gilbert-Elliott sampling against a per-path loop (same law; different streams)."""
+    from .engines.channels import gilbert_elliott_arrivals
+
+    t_ours = median_time(lambda: gilbert_elliott_arrivals(np.random.default_rng(1), n_paths, horizon, 0.2, 0.6),
+                         repeats)
+    t_ref = median_time(lambda: reference_ge_loop(np.random.default_rng(1), ref_paths, horizon, 0.2, 0.6),
+                        max(1, repeats // 2))
+    rate, ref_rate = n_paths * horizon / t_ours, ref_paths * horizon / t_ref
+    return [BenchRow("channel_ge", "path_steps_per_s", rate, ref_rate, rate / ref_rate, "path-steps/s")]
+
+
+# ============================================================================ (b) LMI
+def _two_sensor_modes():
+    return [None, np.array([[1.0]]), np.array([[1.0]]), np.array([[1.0], [1.0]])]
+
+
+def bench_lmi(n_sweep: int, grid_points: int, tol: float, repeats: int) -> list[dict]:
+    """Parametrised LMI solved across a sweep vs rebuilt per point; solves per bisection curve."""
+    from .engines.channels import arrival_patterns
+    from .engines.lmi import MareStabilizabilityLMI, sweep_thresholds
+
+    rows = []
+    cases = {
+        "lmi_sweep_two_sensor_n1": ([[1.5]], _two_sensor_modes(),
+                                    [arrival_patterns([0.3, l2])[1] for l2 in np.linspace(0.05, 0.95, n_sweep)]),
+        "lmi_sweep_one_sensor_n2": ([[1.1, 0.3], [-0.2, 0.95]], [None, np.array([[1.0, 0.5]])],
+                                    [np.array([1 - lam, lam]) for lam in np.linspace(0.05, 0.95, n_sweep)]),
+    }
+    for name, (A, modes, weights) in cases.items():
+        lmi = MareStabilizabilityLMI(A, modes)
+        lmi.solve(weights[0])  # compile once (DPP); a sweep pays this once
+
+        def sweep_ours(lmi=lmi, weights=weights):
+            return [lmi.solve(w).certified for w in weights]
+
+        def sweep_rebuild(A=A, modes=modes, weights=weights):
+            return [MareStabilizabilityLMI(A, modes).solve(w).certified for w in weights]
+
+        t_ours = median_time(sweep_ours, repeats)
+        t_ref = median_time(sweep_rebuild, max(1, repeats // 2))
+        if sweep_ours() != sweep_rebuild():
+            raise AssertionError(f"{name}: parametrised and rebuilt LMIs disagree")
+        rows.append(BenchRow(name, "solves_per_s", len(weights) / t_ours, len(weights) / t_ref, t_ref / t_ours,
+                             "solves/s"))
+
+    # solves per stability curve: the two-sensor region (intermittent, Figs 4-5)
+    lmi = MareStabilizabilityLMI([[1.5]], _two_sensor_modes())
+
+    def make(l1):
+        def feasible(l2):
+            return lmi.solve(arrival_patterns([l1, l2])[1]).certified
+        return feasible
+
+    lmi.solve(arrival_patterns([0.5, 0.5])[1])  # compile before timing either variant
+    grid = np.linspace(0.0, 1.0, grid_points)
+    timings = {}
+    results = {}
+    for label, warm in (("warm", True), ("plain", False)):
+        start = time.perf_counter()
+        results[label] = sweep_thresholds(make, grid, 0.0, 1.0, tol, warm_start=warm)
+        timings[label] = time.perf_counter() - start
+    n_warm = sum(r.n_evals for r in results["warm"])
+    n_plain = sum(r.n_evals for r in results["plain"])
+    gap = max(abs(a.threshold - b.threshold) if np.isfinite(a.threshold) else 0.0
+              for a, b in zip(results["warm"], results["plain"]))
+    if gap > tol:
+        raise AssertionError(f"warm-started and plain bisections differ by {gap} > tol {tol}")
+    rows.append(BenchRow("lmi_bisection", f"solves_per_curve_{grid_points}pts", n_warm, n_plain, n_plain / n_warm,
+                         "solves"))
+    rows.append(BenchRow("lmi_bisection", "solves_per_grid_point", n_warm / grid_points, n_plain / grid_points,
+                         n_plain / n_warm, "solves"))
+    rows.append(BenchRow("lmi_bisection", "curve_time_s", timings["warm"], timings["plain"],
+                         timings["plain"] / timings["warm"], "s"))
+    rows.append(BenchRow("lmi_bisection", "max_threshold_gap", gap, tol, _div(tol, gap) if gap > 0 else np.inf, "1"))
+    return rows
+
+
+# ============================================================================ (c) 1-bit Fisher information
+_LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
+
+
+def _fisher_functions():
+    """The onebit paper's vectorised and quadrature forms of eq. (29), or local equivalents.
+
+    Returns ``(vectorised, quadrature, source)``. The local forms implement eqs. (29)-(30)
+    of ``shared/papers/002`` the same way (product-Gaussian trapezoid; scipy ``quad``) and
+    are used only when ``netrepro.papers.onebit`` does not provide them.
+    """
+    try:
+        from .papers.onebit import expected_fisher_1bit, expected_fisher_1bit_quad
+        return expected_fisher_1bit, (lambda v: expected_fisher_1bit_quad(v)[0]), "netrepro.papers.onebit"
+    except ImportError:  # pragma: no cover - only before the onebit paper exists
+        pass
+    from scipy import integrate
+    from scipy.special import log_ndtr
+
+    def log_h(x):
+        return -0.5 * x * x - _LOG_SQRT_2PI - log_ndtr(x) - log_ndtr(-x)
+
+    def fisher(theta):  # eq. (30), sigma_eta = 1
+        x = np.asarray(theta, dtype=float)
+        return np.exp(2.0 * (-0.5 * x * x - _LOG_SQRT_2PI) - log_ndtr(x) - log_ndtr(-x))
+
+    def vectorised(v, half_width=12.0, step=0.1):  # eq. (29), theta ~ N(0, v)
+        v = np.asarray(v, dtype=float)
+        u = np.arange(-half_width, half_width + step / 2, step)
+        w = np.exp(-0.5 * u * u - _LOG_SQRT_2PI) * step
+        tau = np.sqrt(v / (1.0 + v))[..., None]
+        return np.exp(log_h(tau * u)) @ w / np.sqrt(2.0 * np.pi * (1.0 + v))
+
+    def quadrature(v):
+        s = math.sqrt(v)
+        lo, hi = max(-40.0 * s, -60.0), min(40.0 * s, 60.0)
+        f = lambda t: float(fisher(t)) * math.exp(-0.5 * (t / s) ** 2) / (s * math.sqrt(2 * math.pi))  # noqa: E731
+        return integrate.quad(f, lo, hi, points=[0.0], epsabs=0.0, epsrel=1e-13, limit=500)[0]
+
+    return vectorised, quadrature, "netrepro.bench (local eqs. (29)-(30))"
+
+
+def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: int) -> tuple[list[dict], str]:
+    """Expected 1-bit Fisher information on an SNR grid: vectorised vs per-point adaptive quadrature."""
+    vectorised, quadrature, source = _fisher_functions()
+    snr_db = np.arange(snr_start, snr_stop + snr_step / 2, snr_step)
+    v = 10.0 ** (snr_db / 10.0)
+    t_ours = median_time(lambda: vectorised(v), repeats, min_time=0.05)
+    t_ref = median_time(lambda: [quadrature(float(x)) for x in v], max(1, repeats // 2))
+    ours = np.asarray(vectorised(v))
+    ref = np.array([quadrature(float(x)) for x in v])
+    diff = float(np.max(np.abs(ours / ref - 1.0)))
+    rows = [
+        BenchRow("fisher_1bit", f"grid_points_per_s_{len(v)}pts", len(v) / t_ours, len(v) / t_ref, t_ref / t_ours,
+                 "points/s"),
+        BenchRow("fisher_1bit", "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf, "1"),
+    ]
+    return rows, source
+
+
+# ============================================================================ (d) pipeline
+_IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
+                                 "*.egg-info", ".pytest_cache", ".hypothesis", "tmp")
+
+
+class _TreeMemory:
+    """Samples the summed resident memory of a process tree (from /proc) in a thread."""
+
+    def __init__(self, interval: float = 0.2):
+        self.interval, self.peak_kb, self._stop, self.pid = interval, 0, threading.Event(), None
+
+    def _tree_rss_kb(self):
+        children, rss = {}, {}
+        for entry in os.listdir("/proc"):
+            if not entry.isdigit():
+                continue
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    fields = fh.read().rsplit(")", 1)[1].split()
+                children.setdefault(int(fields[1]), []).append(int(entry))
+                rss[int(entry)] = int(fields[21]) * os.sysconf("SC_PAGE_SIZE") // 1024
+            except (OSError, IndexError, ValueError):
+                continue
+        total, stack = 0, [self.pid]
+        while stack:
+            pid = stack.pop()
+            total += rss.get(pid, 0)
+            stack.extend(children.get(pid, []))
+        return total
+
+    def _run(self):
+        while not self._stop.is_set():
+            self.peak_kb = max(self.peak_kb, self._tree_rss_kb())
+            self._stop.wait(self.interval)
+
+    def watch(self, pid):
+        self.pid = pid
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def stop(self):
+        self._stop.set()
+        self._thread.join()
+
+
+def _snakemake(work: Path, args, env, log: Path, memory: bool = False):
+    """Run snakemake in ``work``; return (wall seconds, returncode, max child RSS kB, tree peak kB)."""
+    cmd = [sys.executable, "-m", "snakemake", "--profile", "workflow/profiles/default", *args]
+    sampler = _TreeMemory() if memory else None
+    start = time.perf_counter()
+    with open(log, "a") as fh:
+        fh.write(f"\n$ {' '.join(cmd)}\n")
+        fh.flush()
+        proc = subprocess.Popen(cmd, cwd=work, env=env, stdout=fh, stderr=subprocess.STDOUT)
+        if sampler:
+            sampler.watch(proc.pid)
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    wall = time.perf_counter() - start
+    if sampler:
+        sampler.stop()
+    # ru_maxrss of a wait4 on snakemake: the largest resident set among it and its waited-for descendants
+    return wall, proc.returncode, usage.ru_maxrss, sampler.peak_kb if sampler else 0
+
+
+def _job_times(work: Path) -> pd.DataFrame:
+    """Per-output job start/end times from ``.snakemake/metadata`` and step times from the sidecars."""
+    records = []
+    meta_dir = work / ".snakemake" / "metadata"
+    for path in meta_dir.iterdir() if meta_dir.is_dir() else []:
+        try:
+            rec = json.loads(path.read_text())
+            output = base64.b64decode(path.name.replace("@", "/")).decode()
+        except (ValueError, UnicodeDecodeError):
+            continue
+        if rec.get("starttime") is None or rec.get("endtime") is None:
+            continue
+        step = np.nan
+        sidecar = work / (output + ".meta.json")
+        if sidecar.is_file():
+            try:
+                step = float(json.loads(sidecar.read_text()).get("wall_time_s", np.nan))
+            except ValueError:
+                pass
+        records.append(dict(rule=rec.get("rule"), output=output, start=rec["starttime"], end=rec["endtime"],
+                            step_s=step))
+    if not records:
+        return pd.DataFrame(columns=["rule", "job_s", "step_s", "n_outputs"])
+    df = pd.DataFrame(records)
+    jobs = df.groupby("rule").agg(start=("start", "min"), end=("end", "max"), step_s=("step_s", "max"),
+                                  n_outputs=("output", "count")).reset_index()
+    jobs["job_s"] = jobs["end"] - jobs["start"]
+    return jobs.sort_values("job_s", ascending=False)[["rule", "job_s", "step_s", "n_outputs"]]
+
+
+def _set_config_value(config_file: Path, dotted: str, factor: float) -> tuple[float, float]:
+    """Multiply a numeric config value (``a.b.c``) by ``factor`` in place, keeping the file's other lines."""
+    import yaml
+
+    data = yaml.safe_load(config_file.read_text())
+    node = data
+    keys = dotted.split(".")
+    for k in keys[:-1]:
+        node = node[k]
+    old = node[keys[-1]]
+    new = type(old)(old * factor)
+    node[keys[-1]] = new
+    config_file.write_text(yaml.safe_dump(data, sort_keys=False))
+    return old, new
+
+
+def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yaml", jobs: int = 2,
+                   change_key: str = "intermittent.two_sensor.check_offset", change_factor: float = 0.5,
+                   figure_target: str = "intermittent_fig5", keep: bool = False) -> tuple[list[dict], dict]:
+    """Cold build, no-op rerun, one figure after a parameter change, memory, slowest jobs.
+
+    Runs in a scratch copy of the repository (never in this checkout's own ``results/``), with
+    ``PYTHONPATH`` pointing at the copy's ``src/`` so the copy's package is the one that runs.
+    """
+    base = Path(tempfile.mkdtemp(prefix="netrepro-bench-", dir=scratch))
+    work = base / "repo"
+    shutil.copytree(ROOT, work, ignore=_IGNORE)
+    for d in ("report", "figures"):
+        (work / d).mkdir(exist_ok=True)
+    log = base / "snakemake.log"
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(work / "src") + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    common = [f"-j{jobs}", "--configfile", config]
+    info = {"scratch": str(work), "log": str(log), "config": config}
+    rows = []
+    cold, rc, maxrss_kb, tree_kb = _snakemake(work, [*common, "report"], env, log, memory=True)
+    info["cold_returncode"] = rc
+    if rc != 0:
+        info["error"] = f"cold build failed (exit {rc}); see {log}"
+        tail = log.read_text()[-3000:]
+        info["log_tail"] = tail
+        rows.append(BenchRow("pipeline", "cold_report_s", np.nan, 600.0, np.nan, "s"))
+        return rows, info
+    rows.append(BenchRow("pipeline", "cold_report_s", cold, 600.0, 600.0 / cold, "s"))
+    rows.append(BenchRow("pipeline", "peak_rss_largest_process_mb", maxrss_kb / 1024, np.nan, np.nan, "MB"))
+    rows.append(BenchRow("pipeline", "peak_rss_process_tree_mb", tree_kb / 1024, 24 * 1024, _div(24 * 1024, tree_kb / 1024),
+                         "MB"))
+    jobs_df = _job_times(work)
+    info["jobs"] = jobs_df.to_dict(orient="records")
+    for rec in jobs_df.head(3).itertuples():
+        rows.append(BenchRow(f"pipeline_rule:{rec.rule}", "job_s_vs_step_compute_s", rec.job_s, rec.step_s,
+                             _div(rec.step_s, rec.job_s), "s"))
+    noop, rc, _, _ = _snakemake(work, [*common, "report"], env, log)
+    rows.append(BenchRow("pipeline", "noop_rerun_s", noop if rc == 0 else np.nan, 5.0, _div(5.0, noop), "s"))
+    old, new = _set_config_value(work / config, change_key, change_factor)
+    info["parameter_change"] = {"key": change_key, "old": old, "new": new, "target": figure_target}
+    dry = subprocess.run([sys.executable, "-m", "snakemake", "--profile", "workflow/profiles/default", *common, "-n",
+                          figure_target], cwd=work, env=env, capture_output=True, text=True)
+    info["parameter_change"]["dry_run_tail"] = dry.stdout[-1500:]
+    single, rc, _, _ = _snakemake(work, [*common, figure_target], env, log)
+    rows.append(BenchRow("pipeline", "single_figure_rerun_s", single if rc == 0 else np.nan, 30.0, _div(30.0, single),
+                         "s"))
+    if not keep:
+        shutil.rmtree(base, ignore_errors=True)
+        info["scratch"] = "(removed)"
+    return rows, info
+
+
+# ============================================================================ driver
+SIZES = {
+    "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
+                 repeats=5, peak_size=2048),
+    "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
+                  repeats=2, peak_size=256),
+}
+
+
+def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = None, keep_scratch: bool = False,
+            only=None) -> tuple[pd.DataFrame, dict]:
+    """Every benchmark in one run; returns the table and the sidecar information."""
+    sizes = SIZES["quick" if quick else "full"]
+    reps = sizes["repeats"]
+    info = {"quick": quick, "python": sys.version.split()[0], "numpy": np.__version__,
+            "machine": platform.platform(), "cpu_count": os.cpu_count(), "sizes": sizes,
+            "loadavg_start": os.getloadavg(), "blas_in_process": _blas_info(),
+            "env": {k: os.environ.get(k) for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "OMP_NUM_THREADS")}}
+    want = (lambda name: only is None or name in only)
+    rows = []
+    peak = blas_peak(native=True, size=sizes["peak_size"], repeats=reps)
+    forced = blas_peak(native=False, size=sizes["peak_size"], repeats=reps)
+    info["peak_native"], info["peak_as_configured"] = peak, forced
+    peak1 = peak.get("gflops_1_thread", peak["gflops_all_threads"])
+    rows.append(BenchRow("blas_peak", "gemm_1_thread", peak1, forced.get("gflops_1_thread", np.nan),
+                         _div(peak1, forced.get("gflops_1_thread", np.nan)), "Gflop/s (native kernel vs as configured)"))
+    rows.append(BenchRow("blas_peak", "gemm_all_threads", peak["gflops_all_threads"], forced["gflops_all_threads"],
+                         _div(peak["gflops_all_threads"], forced["gflops_all_threads"]),
+                         "Gflop/s (native kernel vs as configured)"))
+    if want("riccati"):
+        bench_riccati(*sizes["riccati"], reps, peak1, rows_out=rows)
+    if want("channels"):
+        rows += bench_channels(*sizes["channels"], reps)
+    if want("lmi"):
+        rows += bench_lmi(*sizes["lmi"], repeats=max(1, reps // 2 if not quick else 1))
+    if want("fisher"):
+        fisher_rows, info["fisher_source"] = bench_fisher(*sizes["fisher"], reps)
+        rows += fisher_rows
+    if pipeline and not quick and want("pipeline"):
+        pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
+        rows += pipe_rows
+    info["loadavg_end"] = os.getloadavg()
+    return pd.DataFrame(rows, columns=COLUMNS), info
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m netrepro.bench", description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="results/benchmarks.csv", help="CSV to write (plus <out>.meta.json)")
+    parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
+    parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")
+    parser.add_argument("--only", default=None,
+                        help="comma-separated subset of riccati,channels,lmi,fisher,pipeline")
+    parser.add_argument("--scratch", default=None, help="folder for the pipeline's scratch copy (default: tmp)")
+    parser.add_argument("--keep-scratch", action="store_true", help="keep the pipeline's scratch copy")
+    args = parser.parse_args(argv)
+    only = set(args.only.split(",")) if args.only else None
+    table, info = run_all(quick=args.quick, pipeline=not args.no_pipeline,
+                          scratch=Path(args.scratch) if args.scratch else None, keep_scratch=args.keep_scratch,
+                          only=only)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(out.name + ".tmp")
+    table.to_csv(tmp, index=False, float_format="%.6g")
+    tmp.replace(out)
+    Path(str(out) + ".meta.json").write_text(json.dumps(info, indent=2, sort_keys=True, default=str))
+    with pd.option_context("display.width", 200, "display.max_rows", 200):
+        print(table.to_string(index=False))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

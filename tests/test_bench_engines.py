@@ -1,0 +1,147 @@
+"""Correctness of the engines' fast paths added for issue 9 (small-state kernel, scalar kernel, warm bisection)."""
+
+import numpy as np
+import pytest
+
+import netrepro.engines.riccati as ric
+from netrepro.engines.lmi import bisect_bracketed, bisect_monotone, sweep_thresholds
+from netrepro.engines.riccati import Sensor, covariance_paths, measurement_update, packed_flops_per_step
+
+
+def _original_scalar(p0, a, q, r_eff, arrivals, keep):
+    """The scalar recursion exactly as first written (np.where, fresh arrays)."""
+    N, T, m = arrivals.shape
+    p = np.full(N, p0)
+    out = np.empty((N, T + 1))
+    out[:, 0] = p
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        for k in range(T):
+            for j in range(m):
+                post = r_eff[j] / (1.0 + r_eff[j] / p)
+                p = np.where(arrivals[:, k, j], post, p)
+            p = a * a * p + q
+            out[:, k + 1] = p
+    return out if keep == "all" else p
+
+
+def _system(rng, n):
+    A = rng.normal(size=(n, n))
+    M = rng.normal(size=(n, n))
+    sensors = [Sensor(rng.normal(size=(1, n)), [[0.4]]),
+               Sensor(rng.normal(size=(2, n)), [[0.5, 0.1], [0.1, 0.3]])]  # correlated noise: whitened rows
+    return A, 0.3 * np.eye(n) + 0.01 * M @ M.T, sensors
+
+
+@pytest.mark.parametrize("keep", ["all", "last"])
+def test_scalar_kernel_is_bit_identical_to_original(rng, keep, monkeypatch):
+    monkeypatch.setattr(ric, "SCALAR_CHUNK_PATHS", 37)  # several chunks, a ragged last one
+    arrivals = rng.random((200, 300, 2)) < 0.35  # a = 1.6 with these losses: some paths overflow
+    new = covariance_paths(5.0, [[1.6]], [[0.1]], [Sensor([[1.0]], [[0.5]]), Sensor([[2.0]], [[0.8]])], arrivals, keep)
+    old = _original_scalar(5.0, 1.6, 0.1, [0.5, 0.2], arrivals, keep)
+    assert np.array_equal(new, old)
+
+
+@pytest.mark.parametrize("n", [2, 3])
+@pytest.mark.parametrize("keep", ["all", "last"])
+def test_small_state_kernel_matches_dense_form(rng, n, keep, monkeypatch):
+    monkeypatch.setattr(ric, "CHUNK_PATHS", 23)
+    A, Q, sensors = _system(rng, n)
+    A = 0.8 * A / np.max(np.abs(np.linalg.eigvals(A)))
+    arrivals = rng.random((101, 40, 2)) < 0.5
+    fast = covariance_paths(np.eye(n), A, Q, sensors, arrivals, keep)
+    dense = ric._dense_paths(np.eye(n), A, Q, sensors, arrivals, keep)
+    assert fast.shape == dense.shape
+    assert np.allclose(fast, dense, rtol=1e-10, atol=1e-12)
+
+
+def test_small_state_kernel_handles_scalar_P0_like_dense(rng):
+    A, Q, sensors = _system(rng, 2)
+    arrivals = rng.random((7, 5, 2)) < 0.5
+    assert np.allclose(covariance_paths(2.0, 0.5 * A, Q, sensors, arrivals),
+                       ric._dense_paths(2.0, 0.5 * A, Q, sensors, arrivals, "all"))
+
+
+def test_small_state_kernel_diverged_paths_stay_inf(rng):
+    A = np.array([[3.0, 0.0], [0.0, 0.5]])  # the unstable mode is unobserved by sensor 2
+    sensors = [Sensor([[0.0, 1.0]], [[1.0]])]
+    arrivals = rng.random((6, 1500)) < 0.5
+    arrivals[0] = False
+    out = covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="all")
+    assert not np.isnan(out).any()
+    dead_at = np.argmax(~np.isfinite(out).all(axis=(2, 3)), axis=1)
+    assert np.all(dead_at > 0)
+    for i, k in enumerate(dead_at):  # once non-finite, the whole matrix is inf for ever after
+        assert np.isinf(out[i, k:]).all()
+    assert np.isinf(covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="last")).all()
+
+
+def test_singular_noise_falls_back_to_dense_form(rng, monkeypatch):
+    calls = []
+    original = ric._dense_paths
+    monkeypatch.setattr(ric, "_dense_paths", lambda *a: calls.append(1) or original(*a))
+    sensors = [Sensor([[1.0, 0.0], [0.0, 1.0]], [[1.0, 1.0], [1.0, 1.0]])]  # R singular: no Cholesky
+    covariance_paths(np.eye(2), 0.5 * np.eye(2), np.eye(2), sensors, rng.random((3, 4)) < 0.5)
+    assert calls
+
+
+def test_scalar_innovation_update_equals_solve(rng):
+    M = rng.normal(size=(5, 3, 3))
+    P = M @ np.swapaxes(M, 1, 2) + np.eye(3)
+    s = Sensor(rng.normal(size=(1, 3)), [[0.3]])
+    got = measurement_update(P, s, np.ones(5, dtype=bool))
+    S = s.C @ P @ s.C.T + s.R
+    want = P - P @ s.C.T @ np.linalg.solve(S, s.C @ P)
+    assert np.allclose(got, want, rtol=1e-12)
+
+
+def test_flop_count():
+    # n = 2, one row: u (12), s (4), w (1), t (2), update (6), prediction 2*9 = 18
+    assert packed_flops_per_step(2, 1) == 43
+    assert packed_flops_per_step(3, 2) == 2 * (36 + 6 + 1 + 3 + 12) + 72
+
+
+# ----------------------------------------------------------------------------- bisection
+def _step(threshold):
+    calls = []
+
+    def feasible(x):
+        calls.append(x)
+        return x >= threshold
+    return feasible, calls
+
+
+@pytest.mark.parametrize("guess,width", [(0.3, 0.01), (0.31, 1e-3), (0.9, 0.01), (0.0, 0.2), (0.3137, 1e-5)])
+def test_bracketed_bisection_agrees_with_plain(guess, width):
+    f, _ = _step(0.3137)
+    plain = bisect_monotone(f, 0.0, 1.0, tol=1e-6)
+    warm = bisect_bracketed(f, 0.0, 1.0, guess, width, tol=1e-6)
+    assert warm.bracketed and warm.lower < 0.3137 <= warm.threshold
+    assert abs(warm.threshold - plain.threshold) <= 1e-6
+    assert warm.threshold - warm.lower <= 1e-6
+
+
+def test_bracketed_bisection_saves_solves_with_a_good_guess():
+    f, calls = _step(0.3137)
+    bisect_bracketed(f, 0.0, 1.0, 0.3136, 2e-4, tol=1e-6)
+    assert len(calls) <= 12 < bisect_monotone(_step(0.3137)[0], 0.0, 1.0, tol=1e-6).n_evals
+
+
+@pytest.mark.parametrize("threshold,expected", [(-1.0, 0.0), (2.0, np.nan)])
+def test_bracketed_bisection_end_points_like_plain(threshold, expected):
+    f, _ = _step(threshold)
+    res = bisect_bracketed(f, 0.0, 1.0, 0.5, 0.01, tol=1e-6)
+    plain = bisect_monotone(_step(threshold)[0], 0.0, 1.0, tol=1e-6)
+    assert not res.bracketed and not plain.bracketed
+    assert (np.isnan(res.threshold) and np.isnan(plain.threshold)) or res.threshold == plain.threshold == expected
+
+
+def test_sweep_warm_start_matches_plain_and_needs_fewer_solves():
+    curve = lambda x: max(0.0, 0.6 - 0.5 * x - 0.3 * x * x)  # noqa: E731  (hits 0 inside the grid)
+    grid = np.linspace(0.0, 1.0, 41)
+    make = lambda x: _step(curve(x))[0]  # noqa: E731
+    warm = sweep_thresholds(make, grid, 0.0, 1.0, tol=1e-5)
+    plain = sweep_thresholds(make, grid, 0.0, 1.0, tol=1e-5, warm_start=False)
+    for w, p, x in zip(warm, plain, grid):
+        assert abs(w.threshold - p.threshold) <= 1e-5
+        assert w.threshold >= curve(x) - 1e-12
+    assert sum(r.n_evals for r in warm) < 0.7 * sum(r.n_evals for r in plain)
