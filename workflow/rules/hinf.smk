@@ -6,14 +6,7 @@ HINF_SCENARIOS = ["fig2", "fig3", "static_fixed", "static_mobile", "evasive_hinf
 HINF_PIECES = ["errors", "single", "trajectories", "summary", "per_run"]
 HINF_CODE = src("papers/hinf.py", "papers/hinf_core.py")
 HINF_PLOT = src("papers/hinf.py", "papers/hinf_core.py", "plotting.py")
-
-
-def hinf_pieces(wildcards):
-    return {f"{kind}_{s}": f"results/hinf/sim/{s}_{kind}.csv" for kind in HINF_PIECES for s in HINF_SCENARIOS}
-
-
-def hinf_scenario_cfg(wildcards):
-    return as_json({"scenario": wildcards.scenario, "cfg": HCFG})
+HINF_SIM_PIECES = {f"{kind}_{s}": f"results/hinf/sim/{s}_{kind}.csv" for kind in HINF_PIECES for s in HINF_SCENARIOS}
 
 
 rule hinf_noise_model:
@@ -70,7 +63,7 @@ rule hinf_simulate:
         summary="results/hinf/sim/{scenario}_summary.csv",
         per_run="results/hinf/sim/{scenario}_per_run.csv",
     params:
-        cfg=hinf_scenario_cfg,
+        cfg=lambda wildcards: as_json({"scenario": wildcards.scenario, "cfg": HCFG}),
         io=io_json,
     wildcard_constraints:
         scenario="|".join(HINF_SCENARIOS),
@@ -82,7 +75,7 @@ rule hinf_simulate:
 
 rule hinf_tables:
     input:
-        unpack(hinf_pieces),
+        **HINF_SIM_PIECES,
         code=HINF_CODE,
     output:
         errors="results/hinf/errors.csv",
