@@ -352,7 +352,7 @@ def sensitivity_step(params, inputs, outputs):
                               **overrides)
         sc["filters"] = [f for f in ("local", "decentralized", "centralized") if f in sc["filters"]] or sc["filters"]
         if sc["mobile"]:
-            sc["filters"] = ["decentralized"]
+            sc["filters"] = [sc["driver"]]
         c = sc["consensus"]
         stable = pi_consensus_spectral_radius(lap, c["gamma_c"], c["h"], c["K_p"], c["K_i"]) < 1.0
         row = {"parameter": parameter, "value": value, "W": float(cfg["scenarios"][scen]["W"]), "scenario": scen,
@@ -366,11 +366,13 @@ def sensitivity_step(params, inputs, outputs):
             rows.append(row)
             return
         for f in ("local", "decentralized", "centralized"):
-            if f in out["errors"]:
-                e = out["errors"][f]
+            key = sc["driver"] if (sc["mobile"] and f == "decentralized") else f
+            if key in out["errors"]:
+                e = out["errors"][key]
                 row[f + "_error"] = float(e[..., start:].mean()) if np.all(np.isfinite(e)) else np.inf
         row["ratio_dec_local"] = row["decentralized_error"] / row["local_error"]
-        mean = out["errors"]["decentralized"].reshape(-1, sc["horizon"] + 1).mean(0)
+        dec = sc["driver"] if sc["mobile"] else "decentralized"
+        mean = out["errors"][dec].reshape(-1, sc["horizon"] + 1).mean(0)
         below = mean <= float(cfg["claims"]["settle_threshold"])
         row["settle_k"] = next((k for k in range(len(mean)) if below[k:].all()), -1)
         rows.append(row)
@@ -381,6 +383,10 @@ def sensitivity_step(params, inputs, outputs):
         for key in ("gamma_c", "K_p", "K_i", "h", "iters"):
             for val in sv[key]:
                 run(key, val, scen, {"consensus": {key: val}})
+    # does H-infinity pay off against the evasive target? gamma sweep; gamma = inf is the Kalman-driven scenario
+    for g in sv["gamma"]:
+        run("gamma_evasive", g, "evasive_hinf", {"filter": {"gamma": g}})
+    run("gamma_evasive", np.inf, "evasive_kalman", {})
     for key in ("Gamma", "v_max"):
         for val in sv[key]:
             run(key, val, sv["mobile_scenario"], {"control": {key: val}})
@@ -541,7 +547,7 @@ def sensitivity_text(sens: pd.DataFrame, parameter: str) -> str:
     for scen, g in sub.groupby("scenario", sort=False):
         ok = g[g["exists"] & np.isfinite(g["decentralized_error"])]
         bad = g[~(g["exists"] & np.isfinite(g["decentralized_error"]))]
-        if parameter in ("Gamma", "v_max"):
+        if parameter in ("Gamma", "v_max", "gamma_evasive"):
             txt = ", ".join(f"{v:g}: dec err {e:.3g}, settle k={s}" for v, e, s in
                             zip(ok["value"], ok["decentralized_error"], ok["settle_k"]))
         else:
@@ -558,6 +564,8 @@ def reconstructions_step(params, inputs, outputs):
     rows = []
     for key, reason, sweep in RECON:
         sensitivity = sensitivity_text(sens, sweep) if sweep else "not swept; see the reason"
+        if sweep == "gamma":
+            sensitivity += " | evasive target (gamma = inf: Kalman-driven agents): " + sensitivity_text(sens, "gamma_evasive")
         rows.append({"paper": PAPER, "key": f"hinf.{key}", "value": _get(params, key), "reason": reason,
                      "sensitivity": sensitivity})
     return {"table": reconstructions_frame(rows)}
@@ -712,7 +720,7 @@ def figure_noise(params, inputs, outputs):
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     ax.set_title(f"Measurement uncertainty ellipses ({scale:g}-sigma)")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
     save_figure(fig, outputs["figure"])
     return {}
 
@@ -801,7 +809,8 @@ def figure_sensitivity(params, inputs, outputs):
     new_figure, save_figure = _plotting()
     s = pd.read_csv(inputs["table"])
     pars = [p for p in ("gamma", "gamma_c", "K_p", "K_i", "h", "iters") if p in set(s["parameter"])]
-    fig, axes = new_figure(1, len(pars), figsize=(2.6 * len(pars), 3.2), squeeze=False)
+    ev = s[s["parameter"] == "gamma_evasive"]
+    fig, axes = new_figure(1, len(pars) + (len(ev) > 0), figsize=(2.6 * (len(pars) + 1), 3.2), squeeze=False)
     for ax, p in zip(axes[0], pars):
         for i, (scen, g) in enumerate(s[s["parameter"] == p].groupby("scenario", sort=False)):
             g = g.sort_values("value")
@@ -812,6 +821,19 @@ def figure_sensitivity(params, inputs, outputs):
         ax.set_xlabel(p)
         if p == "gamma":
             ax.set_xscale("log")
+    if len(ev):
+        ax = axes[0][-1]
+        fin = ev[np.isfinite(ev["value"]) & ev["exists"]]
+        ax.plot(fin["value"], fin["decentralized_error"], "o-", color="C2", label="H-inf (evasive)")
+        nx = ev[np.isfinite(ev["value"]) & ~ev["exists"]]
+        ax.plot(nx["value"], np.full(len(nx), np.nanmin(fin["decentralized_error"]) if len(fin) else 1.0), "x", color="C2")
+        kal = ev[~np.isfinite(ev["value"])]
+        if len(kal):
+            ax.axhline(kal["decentralized_error"].iloc[0], color="k", ls="--", label="Kalman (evasive)")
+        ax.set_xscale("log")
+        ax.set_xlabel("gamma (evasive target)")
+        ax.set_ylabel("decentralized late error")
+        ax.legend(fontsize=7)
     axes[0][0].set_ylabel("decentralized / local error")
     axes[0][0].legend(fontsize=7)
     fig.suptitle("Sensitivity of the Fig 2-3 comparison (x: no result)")
