@@ -24,8 +24,10 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(BIN)/snakemake --lint
 
+# Benchmarks with ratios against simple references (issue 9); `make bench BENCH_ARGS=--quick` skips the pipeline.
+BENCH_ARGS ?=
 bench: $(STAMP)
-	$(BIN)/python -m netrepro.bench --out results/benchmarks.csv
+	$(BIN)/python -m netrepro.bench --out results/benchmarks.csv $(BENCH_ARGS)
 
 clean-results:
 	rm -rf results logs .snakemake/metadata

@@ -15,6 +15,8 @@ def test_reference_loop_matches_engine(rng):
         arr = rng.random((6, 30)) < 0.6
         ours = np.asarray(covariance_paths(P0, A, Q, [Sensor(c[None, :], [[r]])], arr, keep="last")).reshape(6, n, n)
         assert np.allclose(ours, bench.reference_covariance_loop(P0, A, Q, c, r, arr), rtol=1e-12)
+        if n == 1:
+            assert np.allclose(ours, bench.reference_covariance_loop(P0, A, Q, c, r, arr, floats=True), rtol=1e-12)
 
 
 def test_reference_ge_loop_has_the_right_law():

@@ -186,11 +186,12 @@ def blas_peak(native: bool = True, size: int = 2048, repeats: int = 5) -> dict:
 
 
 # ============================================================================ (a) Riccati recursions
-def reference_covariance_loop(P0, A, Q, c, r, arrivals) -> np.ndarray:
+def reference_covariance_loop(P0, A, Q, c, r, arrivals, floats: bool = False) -> np.ndarray:
     """Per-path Python loop of the intermittent Riccati recursion with one scalar sensor (the reference).
 
     ``P_{k+1} = A (P_k - gamma_k P_k c^T c P_k / (c P_k c^T + r)) A^T + Q``, path by path and
-    step by step, with plain floats for n = 1 and small numpy matrices otherwise.
+    step by step with small numpy matrices (the textbook form, any n); ``floats=True`` (n = 1
+    only) runs the same recursion on plain Python floats, the fastest per-path loop there is.
     Returns ``P_T`` for every path, shape ``(N, n, n)``.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
@@ -198,7 +199,9 @@ def reference_covariance_loop(P0, A, Q, c, r, arrivals) -> np.ndarray:
     n = A.shape[0]
     N, T = arrivals.shape
     out = np.empty((N, n, n))
-    if n == 1:
+    if floats:
+        if n != 1:
+            raise ValueError(f"floats=True needs a scalar system, got n = {n}")
         a2, q, cc = float(A[0, 0]) ** 2, float(Q[0, 0]), float(np.ravel(c)[0]) ** 2
         for i in range(N):
             p = float(np.asarray(P0, dtype=float).reshape(-1)[0])
@@ -262,6 +265,22 @@ def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak
             flops = 5 if n == 1 else packed_flops_per_step(n, 1)
             name = f"riccati_{kind}_n{n}"
             rows.append(BenchRow(name, "path_steps_per_s", rate, ref_rate, rate / ref_rate, "path-steps/s"))
+            if n > 1:  # against the batched dense form this kernel replaced (np.linalg.solve per update)
+                from .engines.riccati import _dense_paths
+
+                sub = arr[: max(ref_paths, n_paths // 8)]
+                with _single_thread_blas():
+                    t_dense = median_time(lambda: _dense_paths(P0, A, Q, sensors, sub[:, :, None], "last"),
+                                          max(1, repeats // 2))
+                dense_rate = sub.size / t_dense
+                rows.append(BenchRow(name, "path_steps_per_s_vs_dense_batched", rate, dense_rate, rate / dense_rate,
+                                     "path-steps/s"))
+            if n == 1:  # also against the fastest per-path loop: plain Python floats
+                t_flt = median_time(lambda: reference_covariance_loop(P0, A, Q, c, r, ref_arr, floats=True),
+                                    max(1, repeats // 2))
+                flt_rate = ref_paths * horizon / t_flt
+                rows.append(BenchRow(name, "path_steps_per_s_vs_float_loop", rate, flt_rate, rate / flt_rate,
+                                     "path-steps/s"))
             rows.append(BenchRow(name, "flops_per_path_step", flops, np.nan, np.nan, "flop"))
             achieved = flops * rate / 1e9
             rows.append(BenchRow(name, "fraction_of_peak", achieved, peak_gflops, _div(achieved, peak_gflops),
@@ -595,6 +614,10 @@ SIZES = {
 }
 
 
+def _progress(msg):
+    print(f"[bench {time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
 def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = None, keep_scratch: bool = False,
             only=None) -> tuple[pd.DataFrame, dict]:
     """Every benchmark in one run; returns the table and the sidecar information."""
@@ -606,6 +629,7 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
             "env": {k: os.environ.get(k) for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE", "OMP_NUM_THREADS")}}
     want = (lambda name: only is None or name in only)
     rows = []
+    _progress(f"peak: large matrix products ({sizes['peak_size']}^2), native kernel and as configured")
     peak = blas_peak(native=True, size=sizes["peak_size"], repeats=reps)
     forced = blas_peak(native=False, size=sizes["peak_size"], repeats=reps)
     info["peak_native"], info["peak_as_configured"] = peak, forced
@@ -616,15 +640,20 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
                          _div(peak["gflops_all_threads"], forced["gflops_all_threads"]),
                          "Gflop/s (native kernel vs as configured)"))
     if want("riccati"):
+        _progress("riccati: batched covariance recursions vs per-path loop")
         bench_riccati(*sizes["riccati"], reps, peak1, rows_out=rows)
     if want("channels"):
+        _progress("channels: Gilbert-Elliott sampling")
         rows += bench_channels(*sizes["channels"], reps)
     if want("lmi"):
+        _progress("lmi: parametrised sweep vs rebuild; solves per bisection curve")
         rows += bench_lmi(*sizes["lmi"], repeats=max(1, reps // 2 if not quick else 1))
     if want("fisher"):
+        _progress("fisher: vectorised expected 1-bit Fisher information vs adaptive quadrature")
         fisher_rows, info["fisher_source"] = bench_fisher(*sizes["fisher"], reps)
         rows += fisher_rows
     if pipeline and not quick and want("pipeline"):
+        _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
         pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
         rows += pipe_rows
     info["loadavg_end"] = os.getloadavg()
