@@ -27,18 +27,13 @@ ONEBIT_KEYS = {
 ONEBIT_SHARDS = OCFG.get("estimator", {}).get("n_shards", 2)
 
 
-def onebit_cfg(step_name, **extra):
-    """The params of one onebit step: the config keys it reads (plus `extra`), as shell-quoted JSON."""
-    return as_json({**pick(OCFG, *ONEBIT_KEYS[step_name]), **extra})
-
-
 rule onebit_efq:
     input:
         code=src(ONEBIT_CODE),
     output:
         table="results/onebit/efq.csv",
     params:
-        cfg=onebit_cfg("efq"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["efq"])),
         io=io_json,
     threads: 1
     resources:
@@ -58,7 +53,7 @@ rule onebit_ratios:
     output:
         table="results/onebit/ratios.csv",
     params:
-        cfg=onebit_cfg("ratios"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["ratios"])),
         io=io_json,
     threads: 1
     resources:
@@ -78,7 +73,7 @@ rule onebit_lag:
     output:
         table="results/onebit/lag.csv",
     params:
-        cfg=onebit_cfg("lag"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["lag"])),
         io=io_json,
     threads: 1
     resources:
@@ -99,7 +94,7 @@ rule onebit_convergence:
         table="results/onebit/convergence.csv",
         transient="results/onebit/transient.csv",
     params:
-        cfg=onebit_cfg("convergence"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["convergence"])),
         io=io_json,
     conda:
         CONDA_ENV
@@ -121,7 +116,9 @@ rule onebit_estimator_shard:
     wildcard_constraints:
         shard=r"\d+",
     params:
-        cfg=lambda w: onebit_cfg("estimator", shard=int(w.shard), n_shards=ONEBIT_SHARDS),
+        cfg=lambda w: as_json(
+            {**pick(OCFG, *ONEBIT_KEYS["estimator"]), "shard": int(w.shard), "n_shards": ONEBIT_SHARDS}
+        ),
         io=io_json,
     threads: 1
     resources:
@@ -142,7 +139,7 @@ rule onebit_estimator:
     output:
         table="results/onebit/estimator_mse.csv",
     params:
-        cfg=onebit_cfg("estimator"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["estimator"])),
         io=io_json,
     threads: 1
     resources:
@@ -162,7 +159,7 @@ rule onebit_vector_check:
     output:
         table="results/onebit/vector_check.csv",
     params:
-        cfg=onebit_cfg("vector_check"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["vector_check"])),
         io=io_json,
     threads: 1
     resources:
@@ -182,7 +179,7 @@ rule onebit_errata:
     output:
         table="results/errata/onebit.csv",
     params:
-        cfg=onebit_cfg("errata"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["errata"])),
         io=io_json,
     threads: 1
     resources:
@@ -202,7 +199,7 @@ rule onebit_reconstructions:
     output:
         table="results/reconstructions/onebit.csv",
     params:
-        cfg=onebit_cfg("reconstructions"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["reconstructions"])),
         io=io_json,
     threads: 1
     resources:
@@ -226,7 +223,7 @@ rule onebit_claims:
     output:
         table="results/claims/onebit.csv",
     params:
-        cfg=onebit_cfg("claims"),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["claims"])),
         io=io_json,
     threads: 1
     resources:
