@@ -343,3 +343,14 @@ def test_estimator_shards_merge_to_identical_results(cfg, tmp_path):
         ob.estimator_shard_step(dict(c, shard=shard, n_shards=3), {}, {"sums": paths[-1]})
     three = ob.estimator_step(c, {"shards": paths}, {})["table"]
     pd.testing.assert_frame_equal(one, three)
+
+
+def test_grid_filter_reproduces_kalman_on_unquantized_data():
+    eps, s = 1e-2, float(ob.sigma_z2_from_snr(0.0, 1e-2))
+    rng = np.random.default_rng(11)
+    theta, y, r = ob.simulate_block(rng, 20, 60, eps, s, 1.0)
+    filt, smooth = ob.grid_filter_smoother(y, eps, s, 1.0, 8.0, 2.0, quantized=False)
+    kf, rts = ob._kalman_rts(y, eps, s, 1.0)
+    sd = math.sqrt(float(ob.stationary_variance(eps, s)))
+    assert np.max(np.abs(filt - kf)) < 1e-6 * sd
+    assert np.max(np.abs(smooth - rts)) < 1e-6 * sd

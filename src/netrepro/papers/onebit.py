@@ -45,7 +45,10 @@ Tables written (``results/onebit/``)
     k_converged`` -- each steady state (variance (33), filtering (24)/(34)
     started from sigma_theta0 with the transient E[F_q(theta_k)], smoothing
     gain (27)/(37)-(38)) against a long iteration; ``k_converged`` is the last
-    step at which the iterate was farther than ``rtol`` from the fixed point, + 1.
+    step at which the iterate was farther than ``rtol`` from the fixed point, + 1
+    (for ``var_theta`` the "iterate" is the corrected (32) at ``n_steps``, equal
+    to the recursion Var_k = alpha^2 Var_{k-1} + sigma_z^2, and ``k_converged``
+    its closed form).
 ``transient.csv``
     ``alpha, snr_db, k, var_ratio, efq_ratio, j_f_q_ratio, j_f_inf_ratio`` --
     trajectories (iterate / fixed point) at log-spaced steps (Fig S2).
@@ -723,7 +726,7 @@ def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, 
 
 
 def grid_filter_smoother(r, eps: float, sigma_z2: float, sigma_eta: float, grid_half_width: float = 6.0,
-                         points_per_sigma_z: float = 1.5):
+                         points_per_sigma_z: float = 1.5, quantized: bool = True):
     r"""Conditional means :math:`E[\theta_k|r_{1:k}]` and :math:`E[\theta_k|r_{1:K}]` on a grid, vectorised over runs.
 
     The point-mass approximation of the exact Bayesian recursions
@@ -737,7 +740,9 @@ def grid_filter_smoother(r, eps: float, sigma_z2: float, sigma_eta: float, grid_
     Parameters
     ----------
     r : ndarray (n_runs, K)
-        1-bit measurements (+-1) at k = 1..K.
+        1-bit measurements (+-1) at k = 1..K, or, with ``quantized=False``,
+        unquantized measurements (20) (Gaussian likelihood; the grid then
+        reproduces the Kalman filter / RTS smoother, which tests the grid).
 
     Returns
     -------
@@ -753,22 +758,26 @@ def grid_filter_smoother(r, eps: float, sigma_z2: float, sigma_eta: float, grid_
     T = np.exp(-0.5 * ((x[None, :] - alpha * x[:, None]) / sz) ** 2)
     T /= T.sum(axis=1, keepdims=True)
     lik_pos = ndtr(x / sigma_eta)
+
+    def likelihood(k):
+        if quantized:
+            return np.where(r[:, k : k + 1] > 0, lik_pos, 1.0 - lik_pos)
+        return np.exp(-0.5 * ((r[:, k : k + 1] - x) / sigma_eta) ** 2)
+
     n, K = r.shape
     prior = np.exp(-0.5 * (x / sd_inf) ** 2)
     prior /= prior.sum()
     post = np.empty((n, K + 1, len(x)))
     post[:, 0] = prior
     for k in range(K):
-        lik = np.where(r[:, k : k + 1] > 0, lik_pos, 1.0 - lik_pos)
-        p = (post[:, k] @ T) * lik
+        p = (post[:, k] @ T) * likelihood(k)
         post[:, k + 1] = p / p.sum(axis=1, keepdims=True)
     filt = post @ x
     beta = np.ones((n, len(x)))
     smooth = np.empty((n, K + 1))
     smooth[:, K] = filt[:, K]
     for k in range(K, 0, -1):
-        lik = np.where(r[:, k - 1 : k] > 0, lik_pos, 1.0 - lik_pos)
-        beta = (beta * lik) @ T.T
+        beta = (beta * likelihood(k - 1)) @ T.T
         beta /= beta.sum(axis=1, keepdims=True)
         g = post[:, k - 1] * beta
         smooth[:, k - 1] = (g @ x) / g.sum(axis=1)
