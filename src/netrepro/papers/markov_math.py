@@ -25,6 +25,7 @@ Contents
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,7 +35,8 @@ from ..engines.channels import gilbert_elliott_arrivals, gilbert_elliott_station
 # cvxpy (and the shared LMI engine, which imports it) are imported lazily: the simulation
 # steps do not need them, and importing cvxpy costs seconds per pipeline job.
 SOLVER = "CLARABEL"
-OPTIMAL = "optimal"
+# statuses whose answer is a *candidate*: it becomes a result only after the independent certificate
+CANDIDATE_STATUSES = ("optimal", "optimal_inaccurate")
 
 
 def _cp():
@@ -296,7 +298,9 @@ class GilbertElliottLMI:
         self._set(p, q)
         start = time.perf_counter()
         try:
-            self.problem.solve(solver=SOLVER)
+            with warnings.catch_warnings():  # "optimal_inaccurate" is kept as a status, not printed
+                warnings.simplefilter("ignore", UserWarning)
+                self.problem.solve(solver=SOLVER)
             status = str(self.problem.status)
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
@@ -309,7 +313,7 @@ class GilbertElliottLMI:
 def certify(A, C, p, q, status, t, X, Y, F, margin_tol) -> LMIResult:
     """Independent check of a solver answer: ``rho(H(K)) < 1`` (eq. 7) and ``X - L_K(X) > 0`` (Thm 2 (iii))."""
     margin = float(t) if t is not None else np.nan
-    feasible = status == OPTIMAL and margin > margin_tol
+    feasible = status in CANDIDATE_STATUSES and margin > margin_tol
     if not feasible or Y is None or any(f is None for f in F):
         return LMIResult(p, q, status, margin, False, False, np.nan, np.nan)
     K = [np.linalg.solve(Y, f.T) for f in F]
