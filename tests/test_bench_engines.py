@@ -145,3 +145,23 @@ def test_sweep_warm_start_matches_plain_and_needs_fewer_solves():
         assert abs(w.threshold - p.threshold) <= 1e-5
         assert w.threshold >= curve(x) - 1e-12
     assert sum(r.n_evals for r in warm) < 0.7 * sum(r.n_evals for r in plain)
+
+
+def test_small_state_kernel_is_exactly_symmetric_and_accurate():
+    """Over 200 steps of an unstable 3-state system: exact symmetry, and close to a long-double loop."""
+    rng = np.random.default_rng(7)
+    A = np.array([[1.1, 0.3, 0.0], [-0.2, 0.95, 0.1], [0.0, 0.2, 0.8]])
+    c, r = np.ones(3) / np.sqrt(3), 0.5
+    arrivals = rng.random((8, 200)) < 0.7
+    out = covariance_paths(np.eye(3), A, 0.1 * np.eye(3), [Sensor(c[None, :], [[r]])], arrivals)
+    assert np.array_equal(out, np.swapaxes(out, 2, 3))
+    L = np.longdouble
+    for i in range(8):
+        P, Al, cl = np.eye(3, dtype=L), A.astype(L), c.astype(L).reshape(1, 3)
+        for k in range(200):
+            if arrivals[i, k]:
+                u = P @ cl.T
+                P = P - (u @ u.T) / ((cl @ u)[0, 0] + L(r))
+            P = Al @ P @ Al.T + L(0.1) * np.eye(3, dtype=L)
+        P = P.astype(float)
+        assert np.max(np.abs(out[i, -1] - P)) <= 1e-5 * np.max(np.abs(P))
