@@ -354,3 +354,18 @@ def test_grid_filter_reproduces_kalman_on_unquantized_data():
     sd = math.sqrt(float(ob.stationary_variance(eps, s)))
     assert np.max(np.abs(filt - kf)) < 1e-6 * sd
     assert np.max(np.abs(smooth - rts)) < 1e-6 * sd
+
+
+def test_innovation_snr_definition_does_not_reproduce_the_asymptotes(cfg, tmp_path):
+    """The reconstruction argument: with SNR = sigma_z^2/sigma_eta^2 the paper's -0.98 dB (Fig 1) is not reached."""
+    c = copy.deepcopy(cfg)
+    c["snr_definition"] = "innovation"
+    paths = {}
+    for name, fn in (("ratios", ob.ratios_step), ("lag", ob.lag_step), ("efq", ob.efq_step)):
+        paths[name] = tmp_path / f"{name}.csv"
+        fn(c, {}, {})["table"].to_csv(paths[name], index=False)
+    c["estimator"].update(snr_db=[0.0], n_runs=40, block_size=20, horizon=40, window=[10, 30])
+    paths["estimator"] = tmp_path / "estimator.csv"
+    ob.run_estimator(c).to_csv(paths["estimator"], index=False)
+    v = ob.claims_step(c, paths, {})["table"].set_index("claim_id")["verdict"]
+    assert v["rho_sl_low_snr_fig1"] == "differs" and v["rho_s_positive"] == "differs"
