@@ -106,6 +106,20 @@ rule hinf_sensitivity:
         step("netrepro.papers.hinf:sensitivity_step")
 
 
+rule hinf_sensitivity_evasive:
+    input:
+        code=HINF_CODE,
+    output:
+        table="results/hinf/sensitivity_evasive.csv",
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    log:
+        "logs/hinf/sensitivity_evasive.log",
+    shell:
+        step("netrepro.papers.hinf:sensitivity_evasive_step")
+
+
 rule hinf_errata:
     input:
         code=src("papers/hinf.py", "papers/hinf_core.py", "claims.py"),
@@ -124,6 +138,7 @@ rule hinf_reconstructions:
     input:
         code=src("papers/hinf.py", "claims.py"),
         sensitivity="results/hinf/sensitivity.csv",
+        sensitivity_evasive="results/hinf/sensitivity_evasive.csv",
     output:
         table="results/reconstructions/hinf.csv",
     params:
@@ -274,6 +289,7 @@ rule hinf_figS2:
     input:
         code=HINF_PLOT,
         table="results/hinf/sensitivity.csv",
+        evasive="results/hinf/sensitivity_evasive.csv",
     output:
         figure=report("figures/hinf/figS2.png", caption="../report/hinf/figS2.rst", category="hinf"),
     params:
@@ -313,6 +329,7 @@ HINF_TABLES = [
     "results/hinf/attenuation.csv",
     "results/hinf/filter_checks.csv",
     "results/hinf/sensitivity.csv",
+    "results/hinf/sensitivity_evasive.csv",
 ]
 
 
