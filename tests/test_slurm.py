@@ -1,0 +1,174 @@
+"""The workflow on a real Slurm cluster, through ``workflow/profiles/slurm``.
+
+Starts a single-node Slurm cluster on this machine (``tests/slurm/cluster.py``:
+munged as the ``munge`` user, slurmctld and slurmd as root, no slurmdbd), runs the
+``intermittent`` tables of the small test configuration in a scratch copy of the
+repository with ``snakemake --profile workflow/profiles/slurm`` (every job an sbatch
+job, job states from squeue), and checks that
+
+* every planned job went through Slurm and the run ends with no job left in the queue;
+* the tables equal those of a local run of ``config/test.yaml`` in another scratch copy
+  (``netrepro.regression.compare_tables``), although the Slurm run splits the Monte Carlo
+  and the LMI sweep into a different number of shards (``n_shards`` + 1) when the
+  configuration has that key: results do not depend on the split.
+
+Needs root and the Debian packages munge, slurmctld, slurmd and slurm-client (CI installs
+them with ``.ci/setup.d/20-slurm.sh``) and ``snakemake-executor-plugin-slurm`` (the ``test``
+and ``slurm`` extras); skips with the reason otherwise. ``NETREPRO_SKIP_SLURM=1`` skips it.
+Every wait is bounded: a run that outlives its timeout is killed (its process group, then
+the cluster's jobs are cancelled and the daemons stopped by PID).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from netrepro.regression import compare_tables
+from tests.slurm.cluster import PARTITION, LocalSlurm, SlurmUnavailable, unavailable_reason
+
+ROOT = Path(__file__).resolve().parents[1]
+TOP_LEVEL_IGNORE = {".venv", ".git", "results", "logs", ".snakemake", "report", "figures", ".pytest_cache",
+                    ".hypothesis", "build", "dist"}
+TABLES = [
+    "results/intermittent/exact_mean.csv",
+    "results/intermittent/monte_carlo.csv",
+    "results/intermittent/scalar_bounds.csv",
+    "results/intermittent/two_sensor_region.csv",
+    "results/intermittent/two_sensor_simulation.csv",
+]
+LOCAL_TIMEOUT = 900  # s, the local reference run
+SLURM_TIMEOUT = 1500  # s, the whole run under Slurm
+STATUS_INTERVAL = 3  # s, first status check after a submission (the profile's 20 s is for real clusters)
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("slurm")]
+
+
+def _ignore(directory, names):
+    if Path(directory).resolve() == ROOT:
+        return [n for n in names if n in TOP_LEVEL_IGNORE]
+    return [n for n in names if n == "__pycache__" or n.endswith(".egg-info")]
+
+
+def _scratch_copy(dest: Path) -> Path:
+    shutil.copytree(ROOT, dest, ignore=_ignore)
+    for sub in ("report", "figures"):
+        (dest / sub).mkdir(exist_ok=True)
+    return dest
+
+
+def _env(workdir: Path, cluster: LocalSlurm) -> dict:
+    env = cluster.client_env()
+    env["PYTHONPATH"] = os.pathsep.join([str(workdir / "src"), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env["MPLBACKEND"] = "Agg"
+    env["NETREPRO_SLURM_PARTITION"] = PARTITION  # the profile's partition setting, exercised
+    env.pop("NETREPRO_SLURM_ACCOUNT", None)  # no slurmdbd here, so no account can be validated
+    return env
+
+
+def _run(cmd, cwd, env, timeout):
+    """Run a command in its own process group; on timeout SIGTERM the group, then SIGKILL it."""
+    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            stdin=subprocess.DEVNULL, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGTERM)  # snakemake cancels its Slurm jobs on SIGTERM
+        try:
+            out, _ = proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            out, _ = proc.communicate(timeout=30)
+        raise AssertionError(f"{' '.join(map(str, cmd))} timed out after {timeout} s:\n{out[-6000:]}") from None
+    if proc.returncode != 0:
+        raise AssertionError(f"{' '.join(map(str, cmd))} failed ({proc.returncode}):\n{out[-6000:]}")
+    return out
+
+
+def _snakemake(workdir, configfile, *options, targets=TABLES):
+    # targets first: --configfile takes several values and would swallow them
+    return [sys.executable, "-m", "snakemake", *targets, "--configfile", configfile, *options]
+
+
+def _planned_jobs(dry_run_output: str) -> int:
+    match = re.search(r"^total\s+(\d+)\s*$", dry_run_output, re.MULTILINE)
+    assert match, f"no job count in the dry run:\n{dry_run_output[-3000:]}"
+    return int(match.group(1))
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    reason = unavailable_reason()
+    if reason:
+        pytest.skip(f"no local Slurm cluster: {reason}")
+    if importlib.util.find_spec("snakemake_executor_plugin_slurm") is None:
+        pytest.skip("snakemake-executor-plugin-slurm is not installed (pip install -e '.[slurm]')")
+    local = LocalSlurm()
+    try:
+        local.start()
+    except SlurmUnavailable as exc:
+        if os.environ.get("CI"):
+            pytest.fail(f"CI has root and the Slurm packages, but the cluster did not start: {exc}")
+        pytest.skip(f"could not start a local Slurm cluster: {exc}")
+    try:
+        yield local
+    finally:
+        local.stop()
+
+
+@pytest.fixture(scope="module")
+def runs(cluster, tmp_path_factory):
+    base = tmp_path_factory.mktemp("slurm")
+    reference = _scratch_copy(base / "local")
+    on_slurm = _scratch_copy(base / "slurm")
+
+    # the Slurm run uses one shard more than the local one, where the configuration is sharded
+    cfg = yaml.safe_load((on_slurm / "config/test.yaml").read_text())
+    resharded = []
+    for section in ("scalar", "two_sensor"):
+        part = cfg.get("intermittent", {}).get(section, {})
+        if "n_shards" in part:
+            part["n_shards"] = int(part["n_shards"]) + 1
+            resharded.append(f"intermittent.{section}.n_shards={part['n_shards']}")
+    (on_slurm / "config/slurm_test.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+
+    _run(_snakemake(reference, "config/test.yaml", "-j2", "--profile", "workflow/profiles/default"),
+         reference, _env(reference, cluster), LOCAL_TIMEOUT)
+
+    profile = ["--profile", "workflow/profiles/slurm"]
+    planned = _planned_jobs(_run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile, "-n"), on_slurm,
+                                 _env(on_slurm, cluster), 300))
+    log = _run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile,
+                          "--slurm-init-seconds-before-status-checks", str(STATUS_INTERVAL)),
+               on_slurm, _env(on_slurm, cluster), SLURM_TIMEOUT)
+    return dict(reference=reference, on_slurm=on_slurm, planned=planned, log=log, resharded=resharded)
+
+
+def test_every_job_ran_as_a_slurm_job(runs, cluster):
+    submitted = re.findall(r"has been submitted with SLURM jobid (\d+)", runs["log"])
+    assert runs["planned"] >= len(TABLES)
+    assert len(submitted) == runs["planned"], runs["log"][-4000:]
+    known = {job_id: state for job_id, _, state in cluster.jobs()}
+    assert {known.get(job_id) for job_id in submitted} == {"COMPLETED"}, known
+    assert not cluster.jobs("PENDING,RUNNING,COMPLETING,CONFIGURING,SUSPENDED")
+
+
+def test_status_came_from_squeue(runs):
+    # without slurmdbd, sacct cannot answer; the profile makes the plugin ask squeue
+    assert "Falling back to 'sacct'" not in runs["log"]
+
+
+def test_tables_equal_a_local_run(runs):
+    problems = []
+    for table in TABLES:
+        problems += compare_tables(runs["reference"] / table, runs["on_slurm"] / table)
+    assert not problems, "\n".join(problems) + f"\n(Slurm run resharded: {runs['resharded'] or 'no'})"
