@@ -1347,6 +1347,14 @@ def _crossing_snr(lim):
 
 
 # ============================================================================ figures
+def _alpha_label(alpha):
+    """Legend text of an alpha: 1 - 10^n, or the limit."""
+    if alpha == 1.0:
+        return r"$\alpha \to 1$"
+    n = math.log10(1.0 - alpha)
+    return rf"$\alpha = 1 - 10^{{{n:.0f}}}$" if abs(n - round(n)) < 1e-6 else rf"$\alpha = {alpha:g}$"
+
+
 def _new_fig(figsize=(6.4, 4.0)):
     from ..plotting import new_figure
 
@@ -1362,7 +1370,7 @@ def figure_rho_sl(params, inputs, outputs):
     a_main = _alpha_of(params["fig1_one_minus_alpha"])
     for alpha, g in rat.groupby("alpha"):
         main = np.isclose(alpha, a_main, rtol=0, atol=1e-15)
-        lab = r"$\alpha \to 1$" if alpha == 1.0 else rf"$\alpha = 1 - 10^{{{math.log10(1 - alpha):.0f}}}$"
+        lab = _alpha_label(alpha)
         ax.plot(g["snr_db"], g["rho_sl_db"], lw=2.0 if main else 1.0, ls="-" if main else ":", label=lab)
     ax.axhline(5 * math.log10(2 / math.pi), color="k", lw=0.8, ls="--", label=r"$\sqrt{2/\pi}$ (-0.98 dB)")
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
@@ -1381,7 +1389,7 @@ def figure_rho_s_f(params, inputs, outputs):
     fig, ax = _new_fig()
     for alpha, g in rat.groupby("alpha"):
         lim = alpha == 1.0
-        lab = r"$\alpha \to 1$" if lim else rf"$\alpha = 1 - 10^{{{math.log10(1 - alpha):.0f}}}$"
+        lab = _alpha_label(alpha)
         ax.plot(g["snr_db"], g["rho_s_db"], color="C0", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
                 label=rf"$\rho_S$, {lab}")
         ax.plot(g["snr_db"], g["rho_f_db"], color="C3", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
@@ -1438,7 +1446,7 @@ def figure_convergence(params, inputs, outputs):
             ax.loglog(g["k"], np.abs(g["j_f_q_ratio"] - 1) + 1e-17, color=f"C{j}", label=f"{snr:g} dB")
             ax.loglog(g["k"], np.abs(g["var_ratio"] - 1) + 1e-17, color=f"C{j}", ls=":")
         ax.set_xlabel("k")
-        ax.set_title(f"alpha = 1 - {1 - alpha:.0e}", fontsize=9)
+        ax.set_title(_alpha_label(alpha), fontsize=9)
         ax.set_ylim(1e-16, 1e4)
         ax.legend(fontsize=7)
     axes[0][0].set_ylabel("relative distance to the fixed point")
@@ -1455,7 +1463,7 @@ def figure_lag(params, inputs, outputs):
     lag = pd.read_csv(inputs["lag"])
     fig, ax = _new_fig()
     for alpha, g in lag.groupby("alpha"):
-        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", label=rf"$\alpha = 1 - {1 - alpha:.0e}$")
+        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", label=_alpha_label(alpha))
     ax.set_xlabel("SNR [dB]")
     ax.set_ylabel(r"lag $\Delta$ for %g dB" % lag["tol_db"].iloc[0])
     ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed")
