@@ -1,38 +1,177 @@
-"""Configuration validation, run before any job starts.
+"""Configuration and environment checks, run before any job starts.
 
 The schema ``workflow/schemas/config.schema.yaml`` describes the top level
 and refers to one schema per paper (``<slug>.schema.yaml``). Structural checks
 (types, ranges, sizes) come from JSON Schema; checks a schema cannot express
 (matrix shapes that agree, positive definite covariances) come from the
-paper module's ``check_config(section)`` function, if it defines one.
+paper module's ``check_config(section)`` function, if it defines one. Checks
+that hold for every paper are made here: the configuration is a mapping,
+every paper listed in ``papers`` has its section, no number is NaN or
+infinite, and every ``seed`` is a non-negative integer.
 Every error names the key, the value and what was expected.
+
+:func:`check_dependencies` verifies, before anything is imported for real,
+that the packages the pipeline needs (the ``dependencies`` of the installed
+``netrepro`` distribution) are importable and recent enough, so that a
+missing solver or package is reported at start-up rather than as a traceback
+in the middle of a run.
 """
 
 from __future__ import annotations
 
+import copy
 import importlib
+import importlib.util
+import math
+import sys
+from importlib import metadata
 from pathlib import Path
 
-import jsonschema
 import numpy as np
-import yaml
-from referencing import Registry, Resource
 
-__all__ = ["ConfigError", "SCHEMA_DIR", "load_schemas", "validate_config", "require_matrix", "require_pd"]
+__all__ = [
+    "ConfigError",
+    "DependencyError",
+    "SCHEMA_DIR",
+    "REQUIRED_PACKAGES",
+    "load_schemas",
+    "validate_config",
+    "check_dependencies",
+    "require_matrix",
+    "require_pd",
+]
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
+
+# Used when the distribution metadata is unavailable (e.g. running from a source tree).
+REQUIRED_PACKAGES = (
+    "snakemake>=9", "numpy>=2", "scipy>=1.12", "cvxpy>=1.5", "clarabel>=0.9", "matplotlib>=3.8", "pandas>=2.2",
+    "papermill>=2.6", "ipykernel>=6", "nbconvert>=7", "jsonschema>=4.20", "pyyaml>=6",
+)
+# Distribution name -> import name, where they differ.
+IMPORT_NAMES = {"pyyaml": "yaml", "scikit-learn": "sklearn"}
+# What each package is for, to make the message actionable.
+PURPOSE = {
+    "cvxpy": "LMI feasibility problems",
+    "clarabel": "the conic solver of the LMI problems",
+    "papermill": "executing the report notebooks",
+    "nbconvert": "rendering the report notebooks to HTML",
+    "ipykernel": "the kernel of the report notebooks",
+    "jsonschema": "validating the configuration",
+    "snakemake": "the workflow",
+}
 
 
 class ConfigError(ValueError):
     """The configuration is invalid; the message names key, value and expectation."""
 
 
-def load_schemas(schema_dir: Path = SCHEMA_DIR) -> tuple[dict, Registry]:
+class DependencyError(RuntimeError):
+    """A required package is missing, broken or too old; the message says which and how to fix it."""
+
+
+# ----------------------------------------------------------------------------- dependencies
+def _requirements() -> list[str]:
+    try:
+        reqs = metadata.requires("netrepro") or []
+    except metadata.PackageNotFoundError:
+        reqs = []
+    reqs = [r for r in reqs if "extra ==" not in r]
+    return reqs or list(REQUIRED_PACKAGES)
+
+
+def _parse_requirement(text: str):
+    """``(distribution name, SpecifierSet or None)`` of a requirement string."""
+    try:
+        from packaging.requirements import Requirement
+
+        req = Requirement(text)
+        return req.name, req.specifier
+    except ImportError:  # packaging is nearly always present; degrade to presence checks
+        import re
+
+        return re.split(r"[<>=!~;\[ ]", text, maxsplit=1)[0], None
+
+
+def check_dependencies(requirements=None) -> list[str]:
+    """Check that every required package is importable and satisfies its version bound.
+
+    Parameters
+    ----------
+    requirements : sequence of str, optional
+        PEP 508 requirement strings; default: the installed ``netrepro``
+        distribution's dependencies (falling back to :data:`REQUIRED_PACKAGES`).
+
+    Returns
+    -------
+    list of str
+        The requirements checked.
+
+    Raises
+    ------
+    DependencyError
+        Naming every missing, unimportable or too old package, what it is
+        needed for, and the command that installs it.
+    """
+    requirements = list(requirements) if requirements is not None else _requirements()
+    problems = []
+    for text in requirements:
+        dist, spec = _parse_requirement(text)
+        module = IMPORT_NAMES.get(dist.lower(), dist.lower().replace("-", "_"))
+        why = f" (needed for {PURPOSE[dist.lower()]})" if dist.lower() in PURPOSE else ""
+        try:
+            found = importlib.util.find_spec(module) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            problems.append(f"required package '{dist}' is missing: cannot import '{module}'{why}; "
+                            f"expected {text!r}")
+            continue
+        if spec is None or not str(spec):
+            continue
+        try:
+            version = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            continue  # importable but not pip-installed (e.g. vendored): nothing to compare
+        if not spec.contains(version, prereleases=True):
+            problems.append(f"required package '{dist}' has version {version}{why}; expected {text!r}")
+    if problems:
+        raise DependencyError(
+            f"the Python environment ({sys.executable}) cannot run the pipeline:\n  " + "\n  ".join(problems)
+            + "\nFix: run `make` (creates .venv/ with everything), or `pip install -e .` in this environment.")
+    return requirements
+
+
+# ----------------------------------------------------------------------------- schemas
+_SCHEMA_CACHE: dict = {}
+
+
+def _read_schema(path: Path) -> dict:
+    """Parse one schema file (cached on its modification time and size: parsing YAML is slow)."""
+    import yaml
+
+    stat = path.stat()
+    key = (str(path), stat.st_mtime_ns, stat.st_size)
+    if key not in _SCHEMA_CACHE:
+        loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+        try:
+            doc = yaml.load(path.read_text(), Loader=loader)  # noqa: S506 (a safe loader)
+        except yaml.YAMLError as exc:
+            raise ConfigError(f"schema file {path} is not valid YAML: {exc}") from None
+        if not isinstance(doc, dict):
+            raise ConfigError(f"schema file {path} must hold a mapping, got {type(doc).__name__}")
+        _SCHEMA_CACHE[key] = doc
+    return _SCHEMA_CACHE[key]
+
+
+def load_schemas(schema_dir: Path = SCHEMA_DIR):
     """The top-level schema and a registry resolving ``$ref: <file>.schema.yaml``."""
+    from referencing import Registry, Resource
+
     resources = []
     top = None
     for path in sorted(Path(schema_dir).glob("*.schema.yaml")):
-        doc = yaml.safe_load(path.read_text())
+        doc = copy.deepcopy(_read_schema(path))
         doc.setdefault("$schema", "https://json-schema.org/draft/2020-12/schema")
         resources.append((path.name, Resource.from_contents(doc)))
         if path.name == "config.schema.yaml":
@@ -42,44 +181,152 @@ def load_schemas(schema_dir: Path = SCHEMA_DIR) -> tuple[dict, Registry]:
     return top, Registry().with_resources(resources)
 
 
-def _format_error(err: jsonschema.ValidationError) -> str:
-    key = ".".join(str(p) for p in err.absolute_path) or "<top level>"
-    value = err.instance if not isinstance(err.instance, (dict, list)) or len(str(err.instance)) < 80 else "…"
-    expected = err.schema.get("description") or err.message
-    return f"config key '{key}' = {value!r} is invalid: {err.message}. Expected: {expected}"
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _format_error(err, describe=None) -> str:
+    """One line naming the key, the value and what is expected."""
+    path = [str(p) for p in err.absolute_path]
+    expected = err.schema.get("description") if isinstance(err.schema, dict) else None
+    if not expected and describe is not None:
+        expected = describe(err.absolute_path)
+    if err.validator == "required":
+        # "'x' is a required property": name the missing key itself
+        missing = err.message.split("'")[1] if err.message.count("'") >= 2 else "?"
+        key = ".".join(path + [missing])
+        sub = err.schema.get("properties", {}).get(missing, {}) if isinstance(err.schema, dict) else {}
+        what = sub.get("description") if isinstance(sub, dict) else None
+        return (f"config key '{key}' is missing (value: none). Expected: {what or 'a value'} "
+                f"(required in '{'.'.join(path) or '<top level>'}')")
+    if err.validator == "additionalProperties":
+        known = sorted((err.schema.get("properties") or {}).keys()) if isinstance(err.schema, dict) else []
+        extra = sorted(set(err.instance) - set(known)) if isinstance(err.instance, dict) else []
+        lines = []
+        for name in extra or ["?"]:
+            key = ".".join(path + [name])
+            value = err.instance.get(name) if isinstance(err.instance, dict) else None
+            lines.append(f"config key '{key}' = {_short(value)} is not a known key (a typo?). "
+                         f"Expected one of: {', '.join(known)}")
+        return "\n  ".join(lines)
+    key = ".".join(path) or "<top level>"
+    return f"config key '{key}' = {_short(err.instance)} is invalid: {err.message}. Expected: {expected or err.message}"
+
+
+def _describer(top: dict, registry):
+    """``path -> description`` of the nearest schema along ``path`` that has one (follows ``$ref``)."""
+
+    def resolve(schema):
+        for _ in range(10):
+            if isinstance(schema, dict) and "$ref" in schema and not schema["$ref"].startswith("#"):
+                schema = registry[schema["$ref"]].contents
+            else:
+                break
+        return schema if isinstance(schema, dict) else {}
+
+    def describe(path):
+        schema, found = resolve(top), None
+        for part in path:
+            if isinstance(part, int):
+                schema = resolve(schema.get("items", {}))
+            else:
+                props = schema.get("properties", {})
+                extra = schema.get("additionalProperties")
+                schema = resolve(props.get(part, extra if isinstance(extra, dict) else {}))
+            found = schema.get("description", found)
+        return found
+
+    return describe
+
+
+def _walk(node, prefix=""):
+    """Yield ``(dotted key, value)`` for every leaf of a nested dict/list."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _walk(value, f"{prefix}.{key}" if prefix else str(key))
+    elif isinstance(node, (list, tuple)):
+        for i, value in enumerate(node):
+            yield from _walk(value, f"{prefix}[{i}]")
+    else:
+        yield prefix, node
+
+
+def _generic_problems(config: dict) -> list[str]:
+    """Checks that hold for every paper: finite numbers, integer seeds."""
+    problems = []
+    for key, value in _walk(config):
+        if isinstance(value, float) and not math.isfinite(value):
+            problems.append(f"config key '{key}' = {value!r} is invalid: not a finite number. "
+                            "Expected: a finite number (NaN and infinity are never valid configuration values)")
+        last = key.rsplit(".", 1)[-1].split("[", 1)[0].lower()
+        if "seed" in last and value is not None:
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                problems.append(f"config key '{key}' = {_short(value)} is invalid: not a seed. "
+                                "Expected: a non-negative integer (random seeds feed numpy.random.SeedSequence)")
+    return problems
+
+
+def _schema_requires(schema_dir: Path, slug: str) -> list:
+    path = Path(schema_dir) / f"{slug}.schema.yaml"
+    return list(_read_schema(path).get("required", [])) if path.is_file() else []
 
 
 def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
-    """Validate ``config`` (schema, then each paper's ``check_config``); return it unchanged.
+    """Validate ``config`` (schema, generic checks, then each paper's ``check_config``); return it unchanged.
 
     Raises
     ------
     ConfigError
         With every problem found, one per line.
     """
+    import jsonschema
+
+    if not isinstance(config, dict) or not config:
+        raise ConfigError(
+            f"invalid configuration: the configuration is {_short(config)}; expected a mapping with at least "
+            "the key 'papers' (is the --configfile empty or not YAML?)")
     top, registry = load_schemas(schema_dir)
     validator = jsonschema.Draft202012Validator(top, registry=registry)
     errors = sorted(validator.iter_errors(config), key=lambda e: list(map(str, e.absolute_path)))
-    if errors:
-        raise ConfigError("invalid configuration:\n  " + "\n  ".join(_format_error(e) for e in errors))
-    problems = []
-    for slug in config.get("papers", []):
+    describe = _describer(top, registry)
+    problems = [_format_error(e, describe) for e in errors]
+    problems += [p for p in _generic_problems(config) if p not in problems]
+    papers = config.get("papers") if isinstance(config.get("papers"), list) else []
+    for slug in papers:
+        if isinstance(slug, str) and slug not in config and _schema_requires(schema_dir, slug):
+            problems.append(
+                f"config key '{slug}' is missing (value: none): 'papers' lists {slug!r}, so a section '{slug}:' is "
+                f"expected, as described by workflow/schemas/{slug}.schema.yaml (copy it from config/config.yaml), "
+                f"or remove {slug!r} from 'papers'")
+    if problems:
+        raise ConfigError("invalid configuration:\n  " + "\n  ".join(problems))
+    for slug in papers:
         try:
             module = importlib.import_module(f"netrepro.papers.{slug}")
-        except ModuleNotFoundError:
-            problems.append(f"config key 'papers' lists {slug!r}, but there is no module netrepro.papers.{slug}")
-            continue
+        except ModuleNotFoundError as exc:
+            if exc.name in (f"netrepro.papers.{slug}", "netrepro.papers"):
+                problems.append(f"config key 'papers' lists {slug!r}, but there is no module netrepro.papers.{slug}")
+                continue
+            raise DependencyError(
+                f"paper {slug!r} needs the package '{exc.name}', which cannot be imported ({exc}). "
+                "Fix: run `make` or `pip install -e .`") from None
         check = getattr(module, "check_config", None)
         if check is not None and slug in config:
             try:
                 check(config[slug])
             except ConfigError as exc:
                 problems.append(str(exc))
+            except (KeyError, TypeError, ValueError, IndexError) as exc:
+                problems.append(f"config section '{slug}' could not be checked by netrepro.papers.{slug}.check_config "
+                                f"({type(exc).__name__}: {exc}); expected the keys and types of "
+                                f"workflow/schemas/{slug}.schema.yaml")
     if problems:
         raise ConfigError("invalid configuration:\n  " + "\n  ".join(problems))
     return config
 
 
+# ----------------------------------------------------------------------------- helpers for check_config
 def require_matrix(key: str, value, shape=None, square=False) -> np.ndarray:
     """A finite 2-D array from ``value``, or a :class:`ConfigError` naming ``key``."""
     try:

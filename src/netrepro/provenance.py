@@ -3,7 +3,9 @@
 A sidecar records what made a file: rule, source function, parameters and
 their hash, git commit and dirty flag, package versions, seeds, input
 checksums, the output's own checksum and the wall time. :func:`verify_output`
-uses the recorded checksum to detect truncated or edited results.
+uses the recorded checksum to detect truncated or edited results, and
+:func:`verify_tree` checks every result under a directory (``python -m
+netrepro verify``).
 """
 
 from __future__ import annotations
@@ -27,8 +29,14 @@ __all__ = [
     "write_sidecar",
     "read_sidecar",
     "verify_output",
+    "verify_tree",
+    "Verdict",
     "CorruptOutputError",
+    "PARTIAL_MARK",
 ]
+
+# Marker in the names of the temporary files of :func:`netrepro.io.atomic_path`.
+PARTIAL_MARK = ".part"
 
 TRACKED_PACKAGES = (
     "numpy", "scipy", "cvxpy", "clarabel", "matplotlib", "pandas", "snakemake", "papermill",
@@ -140,18 +148,103 @@ def verify_output(output: str | Path) -> dict:
     Raises
     ------
     CorruptOutputError
-        If the sidecar is missing or the checksum differs (truncated or edited file).
+        If the file or its sidecar is missing, the sidecar is unreadable, or
+        the checksum differs (truncated or edited file).
     """
     output = Path(output)
     side = sidecar_path(output)
+    if not output.is_file():
+        raise CorruptOutputError(f"{output}: missing, but its sidecar {side.name} exists; rebuild it with snakemake")
     if not side.is_file():
         raise CorruptOutputError(f"{output}: no provenance sidecar {side.name}; rebuild it with snakemake")
-    meta = json.loads(side.read_text())
+    try:
+        meta = json.loads(side.read_text())
+        recorded = meta["output_sha256"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise CorruptOutputError(
+            f"{output}: its provenance sidecar {side.name} is unreadable ({type(exc).__name__}: {exc}); "
+            f"delete both and rerun snakemake to rebuild them.") from None
     actual = sha256_file(output)
-    if actual != meta.get("output_sha256"):
+    if actual != recorded:
         raise CorruptOutputError(
             f"{output}: checksum {actual[:12]}… differs from the sidecar's "
-            f"{str(meta.get('output_sha256'))[:12]}…; the file was truncated or edited. "
-            f"Delete it and rerun snakemake to rebuild it."
+            f"{str(recorded)[:12]}…; the file was truncated or edited. "
+            f"Delete it and rerun snakemake to rebuild it (or `python -m netrepro verify --remove-corrupt`)."
         )
     return meta
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The state of one file checked by :func:`verify_tree`."""
+
+    path: Path
+    status: str  # "ok", "corrupt", "missing", "no-sidecar", "partial"
+    message: str
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+
+def _is_partial(path: Path) -> bool:
+    return path.name.startswith(".") and PARTIAL_MARK in path.name
+
+
+def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
+    """Check files and directory trees against their provenance sidecars.
+
+    Parameters
+    ----------
+    paths : sequence of path
+        Files or directories (searched recursively).
+    inputs_only : bool
+        Check only files that have a sidecar (the mode of a rule's inputs,
+        which include source files and notebooks); otherwise a result file
+        without a sidecar is reported as ``no-sidecar``.
+
+    Returns
+    -------
+    list of :class:`Verdict`
+        One per result file, sidecar without its file (``missing``), or
+        leftover temporary file of an interrupted write (``partial``).
+    """
+    verdicts = []
+    files = []
+    for root in map(Path, paths):
+        if root.is_dir():
+            files.extend(sorted(p for p in root.rglob("*") if p.is_file()))
+        else:
+            files.append(root)
+    seen = set()
+    for path in files:
+        if path in seen:
+            continue
+        seen.add(path)
+        if _is_partial(path):
+            verdicts.append(Verdict(path, "partial", f"{path}: leftover temporary file of an interrupted write "
+                                    "(never read by the pipeline; safe to delete)"))
+            continue
+        if path.name.endswith(".meta.json"):
+            output = path.with_name(path.name[: -len(".meta.json")])
+            if not output.exists():
+                verdicts.append(Verdict(output, "missing", f"{output}: missing, but its sidecar {path.name} exists; "
+                                        "rebuild it with snakemake"))
+            continue
+        if not sidecar_path(path).is_file():
+            if inputs_only:
+                continue
+            if not path.exists():
+                verdicts.append(Verdict(path, "missing", f"{path}: does not exist"))
+            else:
+                verdicts.append(Verdict(path, "no-sidecar", f"{path}: no provenance sidecar "
+                                        f"{sidecar_path(path).name}; it was not written by the pipeline (or its "
+                                        "writer was interrupted): delete it and rerun snakemake"))
+            continue
+        try:
+            verify_output(path)
+        except CorruptOutputError as exc:
+            verdicts.append(Verdict(path, "corrupt", str(exc)))
+        else:
+            verdicts.append(Verdict(path, "ok", f"{path}: ok"))
+    return verdicts

@@ -1,6 +1,9 @@
-"""The one entry point that Snakemake rules call.
+"""The one entry point that Snakemake rules call, and the checker of cached results.
 
 ``python -m netrepro run --rule RULE --func module:function --params JSON --io JSON``
+runs one step; ``python -m netrepro verify [PATH ...]`` checks every result
+under ``results/`` and ``figures/`` (or the given files and directories)
+against the checksums in their provenance sidecars.
 
 The step function has the signature ``fn(params, inputs, outputs)`` where
 ``inputs`` and ``outputs`` map names to :class:`pathlib.Path`. It returns a
@@ -9,11 +12,17 @@ written (atomically) by the runner; a ``"provenance"`` entry adds to the
 sidecar. Files the function writes itself (figures) must be written through
 :func:`netrepro.io.atomic_path`. Every output then gets a provenance sidecar.
 Inputs that carry a sidecar are checked against their checksum first.
+
+Before the step runs, stale sidecars of its outputs and temporary files left
+by an interrupted earlier attempt are removed, so a sidecar always describes
+the file written after it was (re)started: an interrupted job leaves either
+no output, or an output without a sidecar, never one that verifies.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import inspect
 import json
@@ -22,12 +31,13 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from .io import write_table
-from .provenance import StepRecord, sidecar_path, verify_output, write_sidecar
+from .provenance import PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, verify_output, verify_tree, write_sidecar
 
-__all__ = ["resolve", "run_step", "main"]
+__all__ = ["resolve", "run_step", "verify_main", "main"]
 
 log = logging.getLogger("netrepro")
 
@@ -60,9 +70,45 @@ def _flatten(named: dict) -> dict:
 
 
 def _check_inputs(inputs: dict) -> None:
+    """Verify every input that has a sidecar; inputs under ``results/`` must have one.
+
+    Everything under ``results/`` is written by a step, with its sidecar; a
+    result without one was written by something else, or by a step that was
+    killed between writing it and writing its sidecar: never use it silently.
+    """
     for path in _flatten(inputs).values():
+        path = Path(path)
         if sidecar_path(path).is_file():
             verify_output(path)
+        elif path.parts[:1] == ("results",) and path.is_file():
+            raise CorruptOutputError(
+                f"{path}: no provenance sidecar {sidecar_path(path).name}, so its checksum cannot be verified "
+                "(written outside the pipeline, or by an interrupted job). Delete it and rerun snakemake.")
+
+
+def _clear_stale(outputs: dict) -> None:
+    """Remove old sidecars of ``outputs`` and temporary files of interrupted writes to them."""
+    for path in outputs.values():
+        with contextlib.suppress(FileNotFoundError):
+            sidecar_path(path).unlink()
+        if path.parent.is_dir():
+            for part in path.parent.glob(f".{path.name}.*{PARTIAL_MARK}*"):
+                with contextlib.suppress(FileNotFoundError):
+                    part.unlink()
+
+
+def _nonfinite(frame: pd.DataFrame) -> dict:
+    """``{column: {"nan": n, "inf": m}}`` for numeric columns holding NaN or inf (a flag in the sidecar)."""
+    counts = {}
+    for col in frame.columns:
+        values = frame[col]
+        if not pd.api.types.is_numeric_dtype(values) or pd.api.types.is_bool_dtype(values):
+            continue
+        arr = values.to_numpy(dtype=float)
+        n_nan, n_inf = int(np.isnan(arr).sum()), int(np.isinf(arr).sum())
+        if n_nan or n_inf:
+            counts[str(col)] = {"nan": n_nan, "inf": n_inf}
+    return counts
 
 
 def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dict) -> None:
@@ -71,18 +117,26 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     inputs = {k: _as_paths(v) for k, v in inputs.items()}
     outputs = {k: Path(v) for k, v in outputs.items()}
     _check_inputs(inputs)
+    _clear_stale(outputs)
     for path in outputs.values():
         path.parent.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     result = func(params, inputs, outputs) or {}
     elapsed = time.perf_counter() - start
-    extra = result.pop("provenance", {}) if isinstance(result, dict) else {}
+    extra = dict(result.pop("provenance", {}) if isinstance(result, dict) else {})
+    nonfinite = {}
     for name, value in result.items():
         if name not in outputs:
             raise KeyError(f"{func_spec} returned table {name!r}, which is not an output of rule {rule}")
         if not isinstance(value, pd.DataFrame):
             raise TypeError(f"{func_spec} returned {type(value).__name__} for {name!r}; expected a DataFrame")
+        counts = _nonfinite(value)
+        if counts:
+            nonfinite[name] = counts
+            log.info("rule %s: table %r holds non-finite values %s", rule, name, counts)
         write_table(value, outputs[name])
+    if nonfinite:
+        extra.setdefault("nonfinite", nonfinite)
     source_file = inspect.getsourcefile(func) or "?"
     try:
         source_file = str(Path(source_file).resolve().relative_to(Path.cwd().resolve()))
@@ -106,6 +160,40 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     log.info("rule %s: %s done in %.2f s", rule, func_spec, elapsed)
 
 
+def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, stream=None) -> int:
+    """``python -m netrepro verify``: report every result that does not match its sidecar.
+
+    Returns 0 when every checked file verifies (leftover temporary files are
+    reported but harmless), 1 otherwise. With ``remove_corrupt``, corrupt
+    files and their sidecars (and leftover temporary files) are deleted, so
+    the next ``snakemake`` run rebuilds them.
+    """
+    stream = stream or sys.stdout
+    if not paths:
+        paths = [p for p in ("results", "figures") if Path(p).is_dir()]
+    verdicts = verify_tree(paths, inputs_only=inputs_only)
+    counts = {}
+    for v in verdicts:
+        counts[v.status] = counts.get(v.status, 0) + 1
+        if not v.ok:
+            print(f"{v.status.upper()}: {v.message}", file=stream)
+        elif not quiet:
+            print(f"OK: {v.path}", file=stream)
+        if remove_corrupt and v.status in ("corrupt", "no-sidecar", "partial"):
+            for path in (v.path, sidecar_path(v.path)):
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+            if v.status != "partial":
+                print(f"REMOVED: {v.path} (rerun snakemake to rebuild it)", file=stream)
+    bad = sum(n for status, n in counts.items() if status not in ("ok", "partial"))
+    summary = ", ".join(f"{n} {status}" for status, n in sorted(counts.items())) or "nothing to check"
+    print(f"verify: {len(verdicts)} files checked in {', '.join(map(str, paths))}: {summary}", file=stream)
+    if bad and not remove_corrupt:
+        print("verify: FAILED. Rebuild with `python -m netrepro verify --remove-corrupt` then `snakemake`.",
+              file=stream)
+    return 1 if bad and not remove_corrupt else 0
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -115,7 +203,17 @@ def main(argv=None) -> int:
     run.add_argument("--params", default="{}", help="JSON object of parameters")
     run.add_argument("--io", default="{}", help='JSON {"inputs": {...}, "outputs": {...}}')
     run.add_argument("--log", default=None)
+    ver = sub.add_parser("verify", help="check results against the checksums of their provenance sidecars")
+    ver.add_argument("paths", nargs="*", help="files or directories (default: results/ and figures/)")
+    ver.add_argument("--inputs", action="store_true",
+                     help="check only the given files that have a sidecar (a rule's inputs)")
+    ver.add_argument("--remove-corrupt", action="store_true",
+                     help="delete corrupt or unverifiable results so that snakemake rebuilds them")
+    ver.add_argument("-q", "--quiet", action="store_true", help="print only problems and the summary")
     args = parser.parse_args(argv)
+    if args.command == "verify":
+        return verify_main(args.paths, inputs_only=args.inputs, remove_corrupt=args.remove_corrupt,
+                           quiet=args.quiet)
 
     handlers = [logging.StreamHandler(sys.stderr)]
     if args.log:

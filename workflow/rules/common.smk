@@ -1,15 +1,26 @@
-# Shared helpers for all rules. The configuration is validated here, before any job runs.
+# Shared helpers for all rules. Before any job runs, the Python environment is checked (every
+# required package importable and recent enough) and the configuration is validated.
 import json
 import shlex
 import sys
+from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from netrepro.config import ConfigError, validate_config
+try:
+    from netrepro.config import ConfigError, DependencyError, check_dependencies, validate_config
+except ImportError as exc:
+    raise WorkflowError(
+        f"cannot import the netrepro package with {sys.executable}: {exc}. "
+        "Fix: run `make` (creates .venv/ with everything) and use .venv/bin/snakemake, "
+        "or `pip install -e .` in this environment."
+    ) from None
 
 try:
-    validate_config(config)
-except ConfigError as exc:
+    check_dependencies()
+    # the schemas of this workflow copy (not of the installed package's checkout)
+    validate_config(config, schema_dir=Path(workflow.basedir) / "workflow" / "schemas")
+except (ConfigError, DependencyError) as exc:
     raise WorkflowError(str(exc)) from None
 
 PYTHON = sys.executable
@@ -43,30 +54,43 @@ def src(*modules):
 
 
 def finalize_rules(workflow):
-    """Write each rule's own name into its runner command (the `--rule` of the provenance)."""
+    """Write each rule's own name into its recorded command (the `--rule` of the provenance).
+
+    The command a job executes gets the name from Snakemake's `{rule}` placeholder; the
+    recorded command (`rule.shellcmd`, which Snakemake compares to decide code-triggered
+    reruns) carries the name literally, as the executed command does.
+    """
     for each in workflow.rules:
-        if each.shellcmd and RULE_PLACEHOLDER in each.shellcmd:
-            each.shellcmd = each.shellcmd.replace(RULE_PLACEHOLDER, each.name)
+        if each.shellcmd:
+            for placeholder in (RULE_PLACEHOLDER, RULE_FIELD):
+                each.shellcmd = each.shellcmd.replace(placeholder, each.name if placeholder == RULE_PLACEHOLDER
+                                                      else f"--rule {each.name} ")
 
 
 RULE_PLACEHOLDER = "@RULE@"
+RULE_FIELD = "--rule {rule} "
 # Software of every rule, for --use-conda (the default route is the .venv/ that `make` builds).
 CONDA_ENV = "../envs/netrepro.yaml"
 
 
 def step(func):
-    """Shell command of a pipeline step: one call into the package."""
+    """Shell command of a pipeline step: one call into the package (`{rule}` is the job's rule name)."""
     return (
-        f"{PYTHON} -m netrepro run --rule {RULE_PLACEHOLDER} --func {func} "
+        f"{PYTHON} -m netrepro run --rule {{rule}} --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )
 
 
 def notebook(slug):
-    """Shell command executing the paper's papermill notebook into report/<slug>.html."""
+    """Shell command executing the paper's papermill notebook into report/<slug>.html.
+
+    The notebook reads tables directly, so their checksums are verified first (a truncated or
+    edited table stops the rule with a message naming it, instead of being shown silently).
+    """
     return (
+        f"{PYTHON} -m netrepro verify --inputs {{input}} > {{log}} 2>&1 && "
         f"{PYTHON} -m netrepro.reportgen notebook --slug {slug} "
-        "--notebook {input.notebook} --html {output.html} > {log} 2>&1"
+        "--notebook {input.notebook} --html {output.html} >> {log} 2>&1"
     )
 
 
