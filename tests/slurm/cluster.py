@@ -50,6 +50,7 @@ SLURM_CONF = Path("/etc/slurm/slurm.conf")
 MARKER = "# netrepro test cluster: written by tests/slurm/cluster.py, removed when it stops"
 PARTITION = "netrepro"
 LOCK_FILE = Path("/run/lock/netrepro-slurm-test.lock")
+PID_FILE = Path("/run/lock/netrepro-slurm-test.pids")  # daemons of a cluster whose owner was killed
 DAEMONS = ("munged", "slurmctld", "slurmd")
 CLIENTS = ("sbatch", "srun", "squeue", "scontrol", "scancel", "sinfo", "munge", "unmunge")
 PACKAGES = "munge slurmctld slurmd slurm-client"
@@ -158,6 +159,31 @@ def _terminate(pids, grace=15.0):
                 pass
 
 
+def _cmdline(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return ""
+
+
+def _stop_stale_daemons():
+    """Stop the daemons a killed test session left behind (PIDs recorded in PID_FILE, names checked)."""
+    if not PID_FILE.exists():
+        return
+    stale, dirs = [], []
+    for line in PID_FILE.read_text().splitlines():
+        name, _, pid = line.partition(" ")
+        if name == "dir" and pid.startswith("/tmp/netrepro-slurm-"):
+            dirs.append(Path(pid))
+        elif name in DAEMONS and pid.isdigit() and _alive(int(pid)) and name in _cmdline(int(pid)):
+            stale.append(int(pid))
+            stale.extend(_children(int(pid)))
+    _terminate(stale)
+    for path in dirs:
+        shutil.rmtree(path, ignore_errors=True)
+    PID_FILE.unlink()
+
+
 class LocalSlurm:
     """A single-node Slurm cluster (controller and compute node on this host).
 
@@ -231,6 +257,8 @@ class LocalSlurm:
         self.procs[name] = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
                                             start_new_session=True, env=self.client_env(), **kwargs)
         log.close()
+        with open(PID_FILE, "a") as pids:
+            pids.write(f"{name} {self.procs[name].pid}\n")
 
     def _check_running(self, name):
         proc = self.procs[name]
@@ -317,8 +345,10 @@ PartitionName={PARTITION} Nodes={self.host} Default=YES MaxTime=INFINITE State=U
             raise SlurmUnavailable(reason)
         self._acquire_lock()
         try:
+            _stop_stale_daemons()
             self.dir = Path(tempfile.mkdtemp(prefix="netrepro-slurm-", dir="/tmp"))
             os.chmod(self.dir, 0o755)
+            PID_FILE.write_text(f"dir {self.dir}\n")
             for sub in ("state", "spool", "log"):
                 (self.dir / sub).mkdir()
             self._start_munge()
@@ -377,6 +407,7 @@ PartitionName={PARTITION} Nodes={self.host} Default=YES MaxTime=INFINITE State=U
                     pass
                 _terminate(helpers, grace=5)
             self.procs.clear()
+            PID_FILE.unlink(missing_ok=True)
         finally:
             if self._wrote_conf and SLURM_CONF.exists() and MARKER in SLURM_CONF.read_text(errors="replace"):
                 SLURM_CONF.unlink()
