@@ -90,6 +90,7 @@ rule gainsched_errata:
         gains="results/gainsched/gains.csv",
         summary="results/gainsched/error_summary.csv",
         theorem1="results/gainsched/theorem1.csv",
+        solutions="results/gainsched/lmi_solutions.csv",
     output:
         table="results/errata/gainsched.csv",
     params:

@@ -25,13 +25,16 @@ with (25): :math:`\\bar Q^i = \\bar Q_0 + p_i \\bar Q_p`, :math:`\\Theta^{jr} = 
 
 .. math::
 
-    \\Gamma_3^{ijr} = \\Theta^{jr}\\begin{bmatrix} 0 \\\\ \\bar H^i C\\end{bmatrix} N,\\;
+    \\Gamma_3^{ijr} = \\Theta^{jr}\\begin{bmatrix} \\bar H^i C \\\\ \\bar H^i C\\end{bmatrix} N,\\;
     \\Gamma_4 = \\sigma^2 \\begin{bmatrix} S_{11}^T D \\\\ R_1^T D\\end{bmatrix} N,\\;
     \\hat B = \\begin{bmatrix} S_{11}^T B \\\\ R_1^T B \\end{bmatrix}.
 
-The transposes in Γ1, Λ and B̂ are our reading of the garbled print: they are
-the ones the congruence T = diag(I, S22^{-1} S21) of S = [S_ij] produces
-(checked in the tests by rebuilding (12) from a recovered S).
+The transposes in Γ1, Λ and B̂, and the two equal rows of Γ3, are our reading
+of the garbled print: they are what the congruence T = diag(I, S22^{-1} S21)
+of S = [S_ij] produces, since T^T S^T C̄ N T = [[S21^T H C, 0], [S21^T H C, 0]]
+(checked in the tests by rebuilding (12) from a recovered S). Reading Γ3 like
+C̄ of (11), [0; H̄C]N, breaks that identity (``gamma3_top="zero"`` keeps this
+reading for the errata demonstration).
 """
 
 from __future__ import annotations
@@ -45,7 +48,8 @@ import numpy as np
 from ..engines.lmi import SOLVER
 from .gainsched_model import Gains, GainschedError, System
 
-__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "REALISATIONS"]
+__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "congruence_residual",
+           "REALISATIONS"]
 
 REALISATIONS = ("identity_T", "S21_identity")
 
@@ -90,10 +94,16 @@ class Theorem3:
     margin_cap : float
         Feasibility problems maximise the margin t (vertices <= -t I) subject to
         t <= margin_cap; uncapped, Clarabel ends ``optimal_inaccurate``.
+    gamma3_top : {"HC", "zero"}
+        Upper row of Γ3: H̄^i C (what the congruence gives) or 0 (the misreading).
     """
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
-                 eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1):
+                 eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
+                 gamma3_top: str = "HC"):
+        if gamma3_top not in ("HC", "zero"):
+            raise GainschedError(f"gamma3_top must be 'HC' or 'zero', got {gamma3_top!r}")
+        self.gamma3_top = gamma3_top
         self.sys = sys
         self.scheduled = scheduled
         self.performance = performance
@@ -177,11 +187,13 @@ class Theorem3:
         return cp.bmat([[v["S11"].T @ AF + HC, self.Gbar(pi)], [v["R1"].T @ AF + HC, self.Gbar(pi)]])
 
     def Gamma3(self, pi, pj, pr):
-        """Γ3^{ijr} = Θ^{jr} [0; H̄^i C] N, Θ^{jr} = p_j (1 - p_r) (25)."""
+        """Γ3^{ijr} = Θ^{jr} [H̄^i C; H̄^i C] N, Θ^{jr} = p_j (1 - p_r) (25) (= T^T Θ S^T C̄ N T)."""
         s = self.sys
         theta = pj * (1.0 - pr)
         n = s.n
-        return theta * cp.bmat([[np.zeros((n, n)), np.zeros((n, n))], [self.Hbar(pi) @ s.C, np.zeros((n, n))]])
+        HC = self.Hbar(pi) @ s.C
+        top = HC if self.gamma3_top == "HC" else np.zeros((n, n))
+        return theta * cp.bmat([[top, np.zeros((n, n))], [HC, np.zeros((n, n))]])
 
     def Gamma4(self):
         """Γ4 = σ² [S11^T D; R1^T D] N (22)."""
@@ -290,3 +302,38 @@ def certificate_from_solution(values: dict, realisation: str = "identity_T") -> 
     _, extra = recover_gains(values, realisation)
     Tinv = np.linalg.inv(extra["T"])
     return {"Q0": Tinv.T @ values["Q0"] @ Tinv, "Qp": Tinv.T @ values["Qp"] @ Tinv, "S": extra["S"]}
+
+
+def congruence_residual(sys: System, values: dict, p: float, pn: float, realisation: str = "identity_T",
+                        gamma3_top: str = "HC") -> float:
+    """Max-abs residual of Theorem 2's equivalence at (p(k), p(k+1)) = (p, pn).
+
+    Compares the polytopic combination (28)-(33) of the vertices (24),
+    :math:`\\sum \\alpha_i\\alpha_j\\alpha_r\\beta_l M^{ijrl}`, with the congruence
+    diag(T, I, T, T, T)^T (12) diag(T, I, T, T, T) of the Theorem 1 matrix built
+    from the gains (26), the slack S of (23) and Q = T^{-T} Q̄ T^{-1}. Zero (to
+    rounding) when every block of (24)-(25) is read correctly.
+    """
+    from .gainsched_model import theorem1_matrix
+
+    prob = Theorem3(sys, gamma3_top=gamma3_top)
+    for name, var in prob.vars.items():
+        var.value = values[name]
+    gains, extra = recover_gains(values, realisation)
+    cert = certificate_from_solution(values, realisation)
+    T = extra["T"]
+    ps = (sys.p1, sys.p2)
+    span = sys.p2 - sys.p1
+    a = ((sys.p2 - p) / span, (p - sys.p1) / span)  # (28)
+    b = ((sys.p2 - pn) / span, (pn - sys.p1) / span)  # (30)
+    combo = sum(a[i] * a[j] * a[r] * b[l] * prob.vertex(ps[i], ps[j], ps[r], ps[l]).value
+                for i in range(2) for j in range(2) for r in range(2) for l in range(2))
+    M = theorem1_matrix(sys, gains, cert["Q0"] + p * cert["Qp"], cert["Q0"] + pn * cert["Qp"], cert["S"], p)
+    nn, nz = 2 * sys.n, sys.nz
+    big = np.zeros((4 * nn + nz, 4 * nn + nz))
+    big[:nn, :nn] = T
+    big[nn:nn + nz, nn:nn + nz] = np.eye(nz)
+    for k in range(3):
+        o = nn + nz + nn * k
+        big[o:o + nn, o:o + nn] = T
+    return float(np.max(np.abs(big.T @ M @ big - combo)))

@@ -350,7 +350,7 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
 
 
 def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, performance: bool = False):
-    """Largest eigenvalue of (12) and smallest of Q(p) over an ``n_fine`` x ``n_fine`` grid of (p(k), p(k+1)).
+    r"""Largest eigenvalue of (12) and smallest of Q(p) over an ``n_fine`` x ``n_fine`` grid of (p(k), p(k+1)).
 
     An independent numerical check (no solver) of a Theorem 1 certificate.
     With ``performance`` the (1,1) block carries :math:`+L^TL`, :math:`L = [I\; -I]`
