@@ -527,7 +527,8 @@ RECON = [
     ("evader.step_scale", "evader step length = step_scale * sqrt(tr W), the RMS step of the random walk with the same W.", None),
     ("evader.n_iter", "iterations of the mirror-descent minimisation over lambda in (24) (smallest over-bounding ellipse).", None),
     ("layouts.ten", "ten agents on an arc of radius 40 about the target's start, 20 deg apart: neighbours 13.9 apart, "
-     "next-neighbours 27.4 > r = 20, so the graph is a path (at most two neighbours, connected) as in Figs 2-3.", None),
+     "next-neighbours 27.4 > r = 20, so the graph is a path (at most two neighbours, connected) as in Figs 2-3. The target "
+     "starts at the origin in every scenario; the agents start 40 from it (2.6 a1), so that motion has something to gain.", None),
     ("layouts.four", "four agents on an arc of radius 30, 30 deg apart (a connected path) for Fig 6.", None),
     ("scenarios.*.horizon", "number of time steps (not stated).", None),
     ("scenarios.*.runs", "Monte Carlo runs (the paper shows single runs).", None),
