@@ -4,6 +4,14 @@ Pipeline steps (called by ``workflow/rules/hinf.smk``), figures, claims,
 errata and reconstructions. The mathematics lives in
 :mod:`netrepro.papers.hinf_core` (re-exported here).
 
+Scenarios (``config['hinf']['scenarios']``; the ``scenario`` column of the tables)
+--------------------------------------------------------------------------------
+``fig2`` / ``fig3``: ten stationary agents, random-walk target, W = 0.01 I / 0.001 I (Figs 2-3);
+``static_fixed`` / ``static_mobile``: stationary target, stationary / mobile agents (Figs 4-5);
+``evasive_hinf`` / ``evasive_kalman``: four mobile agents, evasive target, agents driven by decentralized
+H-infinity / Kalman filters (Fig 6 and the comparison beyond the paper). Filters: ``local``,
+``decentralized``, ``centralized`` and their ``kalman_*`` counterparts (gamma = infinity).
+
 Tables (all under ``results/hinf/``)
 ------------------------------------
 ``noise_model.csv``  (Fig 1)
@@ -848,6 +856,7 @@ def figure_sensitivity(params, inputs, outputs):
         ax.legend(fontsize=7)
     axes[0][0].set_ylabel("decentralized / local error")
     axes[0][0].legend(fontsize=7)
+    fig.subplots_adjust(wspace=0.5)
     fig.suptitle("Sensitivity of the Fig 2-3 comparison (x: no result)")
     save_figure(fig, outputs["figure"])
     return {}
