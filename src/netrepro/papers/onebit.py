@@ -1304,7 +1304,8 @@ def claims_step(params, inputs, outputs):
         sub = lim if eps is None else r5
         d = (sub["rho_sl_db"] - sub["rho_f_db"]).abs()
         C(f"same_loss_{'limit' if eps is None else 'alpha5'}",
-          f"'The quantization loss of 1-bit smoothing is the same as for filtering' ({label}): max |rho_SL - rho_F| in dB",
+          f"'The quantization loss of 1-bit smoothing is the same as for filtering' (Sec. 5), read strictly as equal "
+          f"curves rho_SL = rho_F ({label}): max |rho_SL - rho_F| over the SNR grid in dB",
           0.0, round(float(d.max()), 4), 0.01, "a difference under 0.01 dB is invisible on a dB plot",
           note=(f"largest at SNR = {_idxmax(d):g} dB; max over SNR >= -20 dB: {d.loc[-20:].max():.3f} dB. Exact (0) only "
                 "in the alpha -> 1 limit; at finite alpha it holds approximately (the prior information "
