@@ -234,3 +234,36 @@ def test_check_config_rejects_bad_shapes():
         M.check_config({"examples": {"I": dict(good, R=[[-1.0]])}})
     with pytest.raises(ConfigError, match="observable"):
         M.check_config({"examples": {"I": dict(good, A=[[1.2, 0.0], [0.0, 1.2]], C=[[1.0, 0.0]])}})
+
+
+def test_long_horizon_refinement_trusts_only_narrow_intervals():
+    """Example I near its boundary is resolved; Example II's parity tail is flagged as untrusted."""
+    opts = dict(M.REFINE_DEFAULTS, n_paths=200, horizon=160)
+    rng = np.random.default_rng(6)
+    rate, rel, verdict = M.refine_long_horizon(EX1, np.eye(2), np.array([0.5, 0.5]), np.array([0.36, 0.5]), opts, rng)
+    assert list(verdict) == ["unbounded", "bounded"]
+    assert rate[0] == pytest.approx(np.log(1.69 * 0.64), abs=0.01)  # trailing loss-run growth |lambda|^2 (1-q)
+    _, _, verdict2 = M.refine_long_horizon(EX2, np.eye(3), np.array([0.99]), np.array([0.5]), opts, rng)
+    assert verdict2[0] == "undecided"
+
+
+def test_rb_trace_grid_matches_single_point_estimator():
+    rng = np.random.default_rng(8)
+    m, h = mm.rb_trace_grid(EX1, np.eye(2), [0.5], [0.5], 400, 40, rng, n_batches=10)
+    arr = mm.gilbert_elliott_arrivals(np.random.default_rng(9), 4000, 40, 0.5, 0.5, initial=1)
+    m2, lo, hi = mm.rb_mean_trace(EX1, np.eye(2), 0.5, 0.5, arr)
+    assert abs(m[0, -1] - m2[-1]) < 3 * (h[0, -1] + (hi[-1] - lo[-1]) / 2)
+
+
+@pytest.mark.parametrize("system", [EX1, EX2])
+def test_linear_trace_estimator_is_unbiased(system):
+    """rb_mean_trace (linear form) equals the per-path trace estimator, which is unbiased by enumeration."""
+    T = 9
+    arr = _all_paths(T)
+    p, q = 0.6, 0.35
+    w = _path_probs(arr, p, q)
+    per_path = mm.rb_mean_norm(system, np.eye(system.n), p, q, arr, which="trace")
+    exact = mm.exact_moments(system, np.eye(system.n), T).mean(p, q, "trace")
+    assert np.allclose(w @ per_path, exact, rtol=1e-10)
+    mean, _, _ = mm.rb_mean_trace(system, np.eye(system.n), p, q, arr, n_batches=len(arr))
+    assert np.allclose(mean, per_path.mean(axis=0), rtol=1e-10)

@@ -54,7 +54,7 @@ def bisect_monotone(*args, **kwargs):
 __all__ = [
     "LinearSystem", "observability_index", "stacked_output", "spectral_abs", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "GilbertElliottLMI", "LMIResult", "thm5_lower_bound",
-    "rebuild_solve", "riccati_g", "riccati_h", "covariance_paths_ge", "exact_moments", "ExactMoments", "rb_mean_norm", "rb_mean_trace", "plain_mc",
+    "rebuild_solve", "riccati_g", "riccati_h", "covariance_paths_ge", "exact_moments", "ExactMoments", "rb_mean_norm", "rb_mean_trace", "rb_trace_grid", "plain_mc",
     "sym_norm", "sinopoli_lmi_threshold", "gilbert_elliott_stationary_loss", "parity_bound_example2", "norm_relaxation_bound",
 ]
 
@@ -614,6 +614,56 @@ def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int = 20):
     mean = vals.mean(axis=0)
     half = 1.96 * vals.std(axis=0, ddof=1) / np.sqrt(len(batches))
     return mean, mean - half, mean + half
+
+
+def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_batches: int = 10):
+    """:func:`rb_mean_trace` for many ``(p, q)`` points at once (all paths of all points in one batch).
+
+    Memory is ``O(points x paths)``: the batch sums of ``1{gamma_i = 1} P_{i+1}`` are accumulated
+    during the time loop, the covariances themselves are not stored.
+
+    Returns
+    -------
+    (mean, half): arrays ``(n_points, horizon + 1)``, the estimate of ``E tr P_k`` and the 95%
+    batch-means half-width.
+    """
+    ps, qs = np.atleast_1d(np.asarray(ps, float)), np.atleast_1d(np.asarray(qs, float))
+    npts, B, T = len(ps), n_batches, horizon
+    per = -(-n_paths // B)  # paths per batch
+    A, C, Q, R = system.A, system.C, system.Q, system.R
+    n = A.shape[0]
+    arr = np.concatenate([gilbert_elliott_arrivals(rng, B * per, T, p, q, initial=1) for p, q in zip(ps, qs)])
+    starts = np.arange(0, npts * B * per, per)  # contiguous (point, batch) groups
+    P = np.broadcast_to(np.asarray(Sigma0, float), (len(arr), n, n)).copy()
+    S = np.empty((npts * B, T, n, n))
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(T):
+            P = np.where(arr[:, k, None, None], riccati_g(P, A, C, Q, R), riccati_h(P, A, Q))
+            S[:, k] = np.add.reduceat(np.where(arr[:, k, None, None], P, 0.0), starts, axis=0) / per
+    f = np.add.reduceat(arr.astype(float), starts, axis=0) / per  # (npts*B, T)
+    W, c = [np.eye(n)], [0.0]
+    Aj, Qsum = np.eye(n), np.zeros_like(A)
+    for _ in range(T):
+        Qsum = A @ Qsum @ A.T + Q
+        Aj = A @ Aj
+        W.append(Aj.T @ Aj)
+        c.append(float(np.trace(Qsum)))
+    W, c = np.array(W), np.array(c)
+    vals = np.empty((npts * B, T + 1))
+    vals[:, 0] = np.trace(np.asarray(Sigma0, float))
+    pr = np.repeat(ps, B)[:, None]
+    qr = np.repeat(qs, B)[:, None]
+    with np.errstate(over="ignore", invalid="ignore"):
+        inner = np.einsum("bixy,jxy->bij", S, W)
+        for k in range(2, T + 2):
+            i = np.arange(1, k)
+            j = k - 1 - i
+            w = np.where(i < k - 1, pr * (1.0 - qr) ** np.maximum(k - 2 - i, 0), 1.0)
+            vals[:, k - 1] = np.sum(w * (inner[:, i - 1, j] + c[j] * f[:, i - 1]), axis=1)
+    vals = vals.reshape(npts, B, T + 1)
+    mean = vals.mean(axis=1)
+    half = 1.96 * vals.std(axis=1, ddof=1) / np.sqrt(B)
+    return mean, half
 
 
 # ----------------------------------------------------------------------------- i.i.d. line, analytic helpers
