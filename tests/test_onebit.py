@@ -369,3 +369,16 @@ def test_innovation_snr_definition_does_not_reproduce_the_asymptotes(cfg, tmp_pa
     ob.run_estimator(c).to_csv(paths["estimator"], index=False)
     v = ob.claims_step(c, paths, {})["table"].set_index("claim_id")["verdict"]
     assert v["rho_sl_low_snr_fig1"] == "differs" and v["rho_s_positive"] == "differs"
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "test.yaml"])
+def test_config_sections_validate(name):
+    import jsonschema
+
+    from netrepro.config import load_schemas
+
+    section = yaml.safe_load((ROOT / "config" / name).read_text())["onebit"]
+    _, registry = load_schemas()
+    schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents
+    jsonschema.Draft202012Validator(schema).validate(section)
+    ob.check_config(section)
