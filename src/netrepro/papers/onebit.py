@@ -71,7 +71,6 @@ import math
 
 import numpy as np
 import pandas as pd
-from scipy import integrate, interpolate, optimize
 from scipy.special import log_ndtr, ndtr
 
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
@@ -227,6 +226,8 @@ def expected_fisher_1bit_quad(var_theta: float, sigma_eta: float = 1.0, mean_the
 
     Returns ``(value, error_estimate)``; scalar arguments only.
     """
+    from scipy import integrate
+
     s = math.sqrt(var_theta)
     lo = max(mean_theta - 40.0 * s, -60.0 * sigma_eta)
     hi = min(mean_theta + 40.0 * s, 60.0 * sigma_eta)
@@ -250,6 +251,8 @@ def expected_fisher_interpolator(log10_v_min: float = -12.0, log10_v_max: float 
     callable
         ``f(var_ratio) -> efq`` (dimensionless).
     """
+    from scipy import interpolate
+
     grid = np.linspace(log10_v_min, log10_v_max, n)
     spline = interpolate.CubicSpline(grid, np.log(expected_fisher_1bit(10.0**grid)))
 
@@ -1344,6 +1347,8 @@ def _idxmax(series):
 
 def _crossing_snr(lim):
     """SNR (dB) where the alpha -> 1 rho_S crosses 0 dB: sigma_eta^2 E[F_q] = 1/4."""
+    from scipy import optimize
+
     return float(optimize.brentq(lambda d: float(expected_fisher_1bit(10 ** (d / 10))) - 0.25, -10.0, 40.0, xtol=1e-10))
 
 
