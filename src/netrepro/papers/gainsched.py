@@ -601,9 +601,12 @@ def reconstructions_step(params, inputs, outputs):
          "Changes the sector gain of z2 by 0.2 %."),
         ("system.F1_diag / F2_diag", f"{s['F1_diag']} / {s['F2_diag']}", "'Fy = diag{0.46 0.37}, F; = diag{2.81 2.95}' "
          "read as F1, F2 (F = F2 - F1 > 0 as (3) requires).", "—"),
-        ("transposes (22)-(25)", "S11^T A, R1^T A, S11^T B, R1^T B, Λ = [[S11+S11^T, R1+R2^T],[R1^T+R2, R2+R2^T]]",
-         "Garbled superscripts; taken as produced by the congruence T = diag(I, S22^{-1}S21) (errata E3).",
+        ("transposes (22)-(25)", "S11^T A, R1^T A, S11^T B, R1^T B, Λ = [[S11+S11^T, R1+R2^T],[R1^T+R2, R2+R2^T]], "
+         "R2 = S21^T S22^{-T} S21", "Garbled superscripts; taken as produced by the congruence "
+         "T = diag(I, S22^{-1}S21) (errata E3).",
          "Tests rebuild (12) from the recovered S and Q: the identity holds to rounding."),
+        ("Γ3 of (22), (25)", "Θ[H̄C; H̄C]N", "Only one row is legible; the congruence gives H̄C in both rows "
+         "(errata E4).", "Reading [0; H̄C]N breaks the equivalence of Theorems 2-3 with Theorem 1 (residual in E4)."),
         ("lmi.realisation", "identity_T (S21 = S22 = R2)", "Algorithm 1 says 'choose appropriate S21, S22'; with "
          "T = I the error bound of the performance design applies to the recovered x_f.",
          f"S21 = I instead changes sum E||e||^2 from {summary.get(('theorem3', 'gaussian'), np.nan):.3g} to "
