@@ -640,7 +640,7 @@ def figure_plane(params, inputs, outputs):
         for verdict, color in _COLORS.items():
             sub = s[s.verdict == verdict]
             ax.scatter(sub.q, sub.p, s=7, marker="s", color=color, alpha=0.55, linewidths=0,
-                       label=f"exact E||P_k||: {verdict}")
+                       label=f"map: E||P_k|| {verdict}")
         c = curves[curves.example == name]
         ax.plot(c.q, c.p_thm5, color="k", lw=2, label="Theorem 5 lower bound p(q)")
         ax.plot(c.q, c.p_prop1, color="tab:blue", lw=1.5, ls="--", label="Proposition 1 (eq. 8)")
