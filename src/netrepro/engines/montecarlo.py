@@ -58,15 +58,20 @@ class MonteCarloSums:
         return _ordered_sum(self.sums[key]) / self.n
 
     def std(self, key):
+        """Sample standard deviation; inf where a path diverged (never inf - inf = NaN)."""
         m = self.mean(key)
-        var = _ordered_sum(self.sumsq[key]) / self.n - m * m
-        return np.sqrt(np.maximum(var, 0.0) * self.n / max(self.n - 1, 1))
+        with np.errstate(invalid="ignore", over="ignore"):
+            var = _ordered_sum(self.sumsq[key]) / self.n - m * m
+            std = np.sqrt(np.maximum(var, 0.0) * self.n / max(self.n - 1, 1))
+        return np.where(np.isinf(m), np.inf, std)
 
     def ci(self, key, level: float = 0.95):
         """Normal-approximation confidence interval of the mean: ``(mean, lo, hi)``."""
         m = self.mean(key)
         half = stats.norm.ppf(0.5 + level / 2) * self.std(key) / np.sqrt(self.n)
-        return m, m - half, m + half
+        with np.errstate(invalid="ignore"):
+            lo = np.where(np.isinf(m), m, m - half)
+        return m, lo, m + half
 
     def maximum(self, key):
         return np.max(self.maxima[key], axis=0)

@@ -28,7 +28,7 @@ plain_hi, plain_max, n_paths``.
 ``results/intermittent/scalar_bounds.csv``: ``lam, k, s, r, report_estimate, mean, mean_lo, mean_hi,
 mean_method`` plus ``lam_label, report_estimate_printed, plain_mean, plain_lo, plain_hi``.
 ``results/intermittent/two_sensor_region.csv``: ``lambda1, lambda2c_lower, lambda2c_upper`` plus
-``bracket_lower, n_solves, status_at_threshold, certified_radius``.
+``bracket_lower, n_solves, status_at_threshold, certified_radius, statuses_seen``.
 ``results/intermittent/two_sensor_simulation.csv``: ``lambda1, lambda2, side, k, mean, mean_lo, mean_hi,
 predicted_growth``.
 """
@@ -85,8 +85,9 @@ def lower_bound_sequence(s0, a, R1, lam, n_steps) -> np.ndarray:
     """Eq. (10): s_{k+1} = (1 - lambda) a^2 s_k + R1, for k = 0..n_steps."""
     s = np.empty(n_steps + 1)
     s[0] = s0
-    for k in range(n_steps):
-        s[k + 1] = (1.0 - lam) * a * a * s[k] + R1
+    with np.errstate(over="ignore"):
+        for k in range(n_steps):
+            s[k + 1] = (1.0 - lam) * a * a * s[k] + R1
     return s
 
 
@@ -94,8 +95,10 @@ def upper_bound_sequence(r0, a, R1, R2, lam, n_steps) -> np.ndarray:
     """Eq. (9): r_{k+1} = a^2 r_k + R1 - lambda a^2 r_k^2 / (r_k + R2) (the modified Riccati iteration)."""
     r = np.empty(n_steps + 1)
     r[0] = r0
-    for k in range(n_steps):
-        r[k + 1] = a * a * r[k] + R1 - lam * a * a * r[k] ** 2 / (r[k] + R2)
+    with np.errstate(over="ignore"):
+        for k in range(n_steps):
+            # a diverged bound stays inf (inf/inf would give NaN)
+            r[k + 1] = np.inf if np.isinf(r[k]) else a * a * r[k] + R1 - lam * a * a * r[k] ** 2 / (r[k] + R2)
     return r
 
 
@@ -211,13 +214,18 @@ def conditional_mean_paths(p_paths, p0, a, R1, sensor_vars, probs):
             mixed += weight * (a * a * post + R1)
     W = conditional_mean_weights(T, a, pi0)  # (T, T+1)
     ks = np.arange(T + 1)
-    # the R1 part of L^m over all m, weighted; deterministic
-    prob_any = 1.0 - pi0
-    m = ks[None, :] - 1 - np.arange(T)[:, None]
-    growth = np.where(m >= 0, loss_propagation(0.0, np.maximum(m, 0), a, R1), 0.0)
-    const = (np.where(m >= 0, pi0 ** np.maximum(m, 0), 0.0) * prob_any * growth).sum(axis=0)
-    const = const + pi0**ks * loss_propagation(p0, ks, a, R1)
-    return mixed @ W + const[None, :]
+    # deterministic part: the R1 terms of L^m weighted by pi0^m, and the no-arrival-at-all path.
+    # Written with (pi0 a^2)^m and pi0^m separately so that no 0 * inf can occur.
+    with np.errstate(over="ignore", invalid="ignore"):
+        grow = (pi0 * a * a) ** ks.astype(float)  # (pi0 a^2)^k
+        shrink = pi0 ** ks.astype(float)  # pi0^k
+        if np.isclose(a * a, 1.0):
+            r1_terms = R1 * ks * shrink
+        else:
+            r1_terms = R1 * (grow - shrink) / (a * a - 1.0)  # pi0^m R1 (a^{2m} - 1)/(a^2 - 1)
+        cumulative = np.concatenate([[0.0], np.cumsum(r1_terms[:-1])])  # sum over m = 0..k-1
+        const = (1.0 - pi0) * cumulative + p0 * grow + r1_terms
+        return mixed @ W + const[None, :]
 
 
 # ----------------------------------------------------------------------------- two sensors
@@ -244,7 +252,7 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
     homogeneous in X), so the bound depends on a and the C_i only.
 
     Returns a DataFrame with ``lambda1, lambda2c_upper, bracket_lower, n_solves,
-    status_at_threshold, certified_radius``.
+    status_at_threshold, certified_radius, statuses_seen`` (every solver status met in the bisection).
     """
     lmi = MareStabilizabilityLMI([[a]], two_sensor_modes())
     rows = []
@@ -260,13 +268,20 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
         before = lmi.n_solves
         res = bisect_monotone(feasible, 0.0, 1.0, tol=tol)
         at = outcomes.get(res.threshold)
+        seen = pd.Series([o.status for o in outcomes.values()]).value_counts()
+        if at is None:  # nothing certified: say what the solver said at the feasible end of the bracket
+            end = outcomes.get(1.0)
+            status = f"not certified at lambda2 = 1 ({end.status if end else 'not solved'})"
+        else:
+            status = at.status
         rows.append({
             "lambda1": lam1,
             "lambda2c_upper": res.threshold,
             "bracket_lower": res.lower,
             "n_solves": lmi.n_solves - before,
-            "status_at_threshold": at.status if at else "none",
+            "status_at_threshold": status,
             "certified_radius": at.certificate_value if at else np.nan,
+            "statuses_seen": "; ".join(f"{k}: {v}" for k, v in seen.items()),
         })
     return pd.DataFrame(rows)
 
