@@ -6,7 +6,9 @@ munged as the ``munge`` user, slurmctld and slurmd as root, no slurmdbd), runs t
 repository with ``snakemake --profile workflow/profiles/slurm`` (every job an sbatch
 job, job states from squeue), and checks that
 
-* every planned job went through Slurm and the run ends with no job left in the queue;
+* every planned job went through Slurm, in the partition the profile takes from
+  ``NETREPRO_SLURM_PARTITION`` (the cluster has no default partition, so a job without it
+  would be refused), and the run ends with no job left in the queue;
 * the tables equal those of a local run of ``config/test.yaml`` in another scratch copy
   (``netrepro.regression.compare_tables``), although the Slurm run splits the Monte Carlo
   and the LMI sweep into a different number of shards (``n_shards`` + 1) when the
@@ -15,8 +17,9 @@ job, job states from squeue), and checks that
 Needs root and the Debian packages munge, slurmctld, slurmd and slurm-client (CI installs
 them with ``.ci/setup.d/20-slurm.sh``) and ``snakemake-executor-plugin-slurm`` (the ``test``
 and ``slurm`` extras); skips with the reason otherwise. ``NETREPRO_SKIP_SLURM=1`` skips it.
-Every wait is bounded: a run that outlives its timeout is killed (its process group, then
-the cluster's jobs are cancelled and the daemons stopped by PID).
+Every wait is bounded: a run that outlives its timeout is interrupted (SIGINT: Snakemake cancels
+its jobs), then killed (SIGKILL to its process group); the fixture then cancels what is left and
+stops the daemons by PID.
 """
 
 from __future__ import annotations
@@ -75,14 +78,19 @@ def _env(workdir: Path, cluster: LocalSlurm) -> dict:
     return env
 
 
-def _run(cmd, cwd, env, timeout):
-    """Run a command in its own process group; on timeout SIGTERM the group, then SIGKILL it."""
-    proc = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+def _start(cmd, cwd, env):
+    return subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             stdin=subprocess.DEVNULL, start_new_session=True)
+
+
+def _run(cmd, cwd, env, timeout, proc=None):
+    """Run a command (or finish the started ``proc``) in its own process group; on timeout SIGINT
+    the group (Snakemake then scancels its jobs; SIGTERM would wait for them), then SIGKILL it."""
+    proc = proc or _start(cmd, cwd, env)
     try:
         out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGTERM)  # snakemake cancels its Slurm jobs on SIGTERM
+        os.killpg(proc.pid, signal.SIGINT)
         try:
             out, _ = proc.communicate(timeout=60)
         except subprocess.TimeoutExpired:
@@ -112,7 +120,7 @@ def cluster():
         pytest.skip(f"no local Slurm cluster: {reason}")
     if importlib.util.find_spec("snakemake_executor_plugin_slurm") is None:
         pytest.skip("snakemake-executor-plugin-slurm is not installed (pip install -e '.[slurm]')")
-    local = LocalSlurm()
+    local = LocalSlurm(default_partition=False)
     try:
         local.start()
     except SlurmUnavailable as exc:
@@ -141,15 +149,21 @@ def runs(cluster, tmp_path_factory):
             resharded.append(f"intermittent.{section}.n_shards={part['n_shards']}")
     (on_slurm / "config/slurm_test.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
 
-    _run(_snakemake(reference, "config/test.yaml", "-j2", "--profile", "workflow/profiles/default"),
-         reference, _env(reference, cluster), LOCAL_TIMEOUT)
-
-    profile = ["--profile", "workflow/profiles/slurm"]
-    planned = _planned_jobs(_run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile, "-n"), on_slurm,
-                                 _env(on_slurm, cluster), 300))
-    log = _run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile,
-                          "--slurm-init-seconds-before-status-checks", str(STATUS_INTERVAL)),
-               on_slurm, _env(on_slurm, cluster), SLURM_TIMEOUT)
+    # the local reference run goes on while the Slurm run waits for its jobs
+    local_cmd = _snakemake(reference, "config/test.yaml", "-j2", "--profile", "workflow/profiles/default")
+    local_run = _start(local_cmd, reference, _env(reference, cluster))
+    try:
+        profile = ["--profile", "workflow/profiles/slurm"]
+        planned = _planned_jobs(_run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile, "-n"), on_slurm,
+                                     _env(on_slurm, cluster), 300))
+        log = _run(_snakemake(on_slurm, "config/slurm_test.yaml", *profile,
+                              "--slurm-init-seconds-before-status-checks", str(STATUS_INTERVAL)),
+                   on_slurm, _env(on_slurm, cluster), SLURM_TIMEOUT)
+    except BaseException:
+        os.killpg(local_run.pid, signal.SIGKILL)
+        local_run.communicate(timeout=30)
+        raise
+    _run(local_cmd, reference, None, LOCAL_TIMEOUT, proc=local_run)
     return dict(reference=reference, on_slurm=on_slurm, planned=planned, log=log, resharded=resharded)
 
 
@@ -157,8 +171,8 @@ def test_every_job_ran_as_a_slurm_job(runs, cluster):
     submitted = re.findall(r"has been submitted with SLURM jobid (\d+)", runs["log"])
     assert runs["planned"] >= len(TABLES)
     assert len(submitted) == runs["planned"], runs["log"][-4000:]
-    known = {job_id: state for job_id, _, state in cluster.jobs()}
-    assert {known.get(job_id) for job_id in submitted} == {"COMPLETED"}, known
+    known = {job_id: (partition, state) for job_id, partition, state in cluster.jobs(fields="%i|%P|%T")}
+    assert {known.get(job_id) for job_id in submitted} == {(PARTITION, "COMPLETED")}, known
     assert not cluster.jobs("PENDING,RUNNING,COMPLETING,CONFIGURING,SUSPENDED")
 
 

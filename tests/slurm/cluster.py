@@ -196,14 +196,18 @@ class LocalSlurm:
         Seconds to wait for each daemon to come up.
     lock_timeout
         Seconds to wait for another local cluster (another test session) to finish.
+    default_partition
+        Whether the partition ``netrepro`` is the default one. When it is not, a job
+        is accepted only if it names the partition (``sbatch -p netrepro``).
     """
 
     def __init__(self, cpus: int | None = None, memory_mb: int | None = None, start_timeout: float = 60,
-                 lock_timeout: float = 900):
+                 lock_timeout: float = 900, default_partition: bool = True):
         self.cpus = cpus or max(os.cpu_count() or 1, 4)
         self.memory_mb = memory_mb or 16000
         self.start_timeout = start_timeout
         self.lock_timeout = lock_timeout
+        self.default_partition = default_partition
         self.host = socket.gethostname().split(".")[0]
         self.dir: Path | None = None
         self.procs: dict[str, subprocess.Popen] = {}
@@ -299,7 +303,7 @@ SelectTypeParameters=CR_Core_Memory
 ReturnToService=2
 SlurmdParameters=config_overrides
 NodeName={self.host} NodeAddr=127.0.0.1 CPUs={self.cpus} RealMemory={self.memory_mb} State=UNKNOWN
-PartitionName={PARTITION} Nodes={self.host} Default=YES MaxTime=INFINITE State=UP
+PartitionName={PARTITION} Nodes={self.host} Default={"YES" if self.default_partition else "NO"} MaxTime=INFINITE State=UP
 """
         SLURM_CONF.parent.mkdir(parents=True, exist_ok=True)
         tmp = SLURM_CONF.with_name(SLURM_CONF.name + ".netrepro-tmp")
@@ -379,10 +383,11 @@ PartitionName={PARTITION} Nodes={self.host} Default=YES MaxTime=INFINITE State=U
         return self
 
     # ---- use ---------------------------------------------------------------------------------
-    def jobs(self, states: str = "all") -> list[tuple[str, str, str]]:
-        """``(job id, job name, state)`` of the jobs the controller knows (finished ones for MinJobAge)."""
-        out = _run(["squeue", "-h", "-t", states, "-o", "%i|%j|%T"], env=self.client_env(), timeout=20, check=True)
-        return [tuple(line.split("|", 2)) for line in out.stdout.splitlines() if line.strip()]
+    def jobs(self, states: str = "all", fields: str = "%i|%j|%T") -> list[tuple[str, ...]]:
+        """The jobs the controller knows (finished ones for MinJobAge), by default as
+        ``(job id, job name, state)``; ``fields`` is a ``squeue -o`` format joined by ``|``."""
+        out = _run(["squeue", "-h", "-t", states, "-o", fields], env=self.client_env(), timeout=20, check=True)
+        return [tuple(line.split("|")) for line in out.stdout.splitlines() if line.strip()]
 
     # ---- stop --------------------------------------------------------------------------------
     def stop(self):
