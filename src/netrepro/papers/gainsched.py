@@ -725,7 +725,7 @@ def figure_mse(params, inputs, outputs):
     """Fig S1: E||e(k)||^2 per design (log scale) and sum_k E||e||^2 for fixed and Gaussian initial states."""
     errors = read_table(inputs["errors"])
     summary = read_table(inputs["summary"])
-    fig, (ax1, ax2) = new_figure(1, 2, figsize=(11, 4))
+    fig, (ax1, ax2) = new_figure(1, 2, figsize=(12, 4.2), layout="constrained")
     for d, er in errors.groupby("design", sort=False):
         ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(d), label=d, lw=1.2)
     ax1.set(xlabel="k", ylabel=r"$E\|e(k)\|^2$ (fixed $x_0$)")
@@ -751,10 +751,11 @@ def figure_sensitivity(params, inputs, outputs):
         g = sens[(sens["variant"] == variant) & (sens["kind"] == "grid")]
         ax.plot(g["sigma2"], g["margin"], mk, label=f"Theorem 3, {variant}")
     lim = sens[sens["kind"] == "sigma2_max"].set_index("variant")["sigma2"]
-    for variant, ls in (("scheduled", ":"), ("fixed", "-."), ("plant_ms_limit", "-")):
+    for variant, ls, col in (("scheduled", ":", "C0"), ("fixed", "-.", "C1"), ("plant_ms_limit", "-", "0.3")):
         if variant in lim:
-            ax.axvline(lim[variant], ls=ls, color="0.4", lw=1)
-            ax.text(lim[variant], 0.0, f" {variant}\n {lim[variant]:.3g}", fontsize=7, va="bottom")
+            ax.axvline(lim[variant], ls=ls, color=col, lw=1.2,
+                       label=f"largest feasible $\\sigma^2$, {variant}: {lim[variant]:.3g}" if variant != "plant_ms_limit"
+                       else f"plant MS-stability limit: {lim[variant]:.3g}")
     ax.axhline(0, color="k", lw=0.8)
     ax.axvline(params["sigma2"], color="C3", lw=1, label=r"reconstructed $\sigma^2$")
     ax.set(xlabel=r"$\sigma^2$", ylabel="LMI margin t (capped)")
