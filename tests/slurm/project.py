@@ -1,0 +1,142 @@
+"""Projected wall time of the workflow on N cluster nodes, from measured per-job times.
+
+Reads the jobs and their dependencies from a dry run (``snakemake -n ... report`` output:
+each job's rule, wildcards, inputs and outputs), takes each job's time from one of
+
+* ``--squeue FILE``: ``squeue -h -t all -o '%i|%k|%T|%M'`` of a run under Slurm
+  (the comment ``%k`` names rule and wildcards; ``%M`` is the job's run time, so it includes
+  the per-job start-up: Snakemake in the job, ``srun``, Python imports), or
+* ``--results DIR``: the provenance sidecars (``<output>.meta.json``, ``wall_time_s``) of a
+  run, plus ``--overhead`` seconds per job for the start-up a sidecar does not see,
+
+and list-schedules the DAG (longest remaining path first) on N nodes with ``--cores`` job
+slots each. Prints the job count, the summed job time, the critical path and the makespan
+per N. Jobs without a measured time get ``--default`` seconds (plus the overhead).
+
+    python tests/slurm/project.py --dry-run dry.log --results results --overhead 20 --nodes 1 2 4 8 16
+"""
+
+from __future__ import annotations
+
+import argparse
+import heapq
+import json
+import re
+import sys
+from pathlib import Path
+
+__all__ = ["parse_dry_run", "schedule", "main"]
+
+
+def parse_dry_run(text: str) -> list[dict]:
+    """Jobs of a dry run: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists)."""
+    jobs, job = [], None
+    for line in text.splitlines():
+        head = re.match(r"^(?:local)?rule (\w+):\s*$", line)
+        if head:
+            job = {"rule": head.group(1), "input": [], "output": [], "wildcards": {}}
+            jobs.append(job)
+            continue
+        field = re.match(r"^\s+(input|output|jobid|wildcards): (.*)$", line)
+        if job is None or not field:
+            continue
+        key, value = field.groups()
+        if key == "jobid":
+            job["jobid"] = int(value)
+        elif key == "wildcards":
+            job["wildcards"] = dict(part.split("=", 1) for part in value.split(", ") if "=" in part)
+        else:
+            job[key] = [v.strip() for v in value.split(", ") if v.strip()]
+    return [j for j in jobs if "jobid" in j]
+
+
+def _slurm_key(rule, wildcards):
+    key = f"rule_{rule}"
+    if wildcards:
+        key += "_wildcards_" + "_".join(str(v) for v in wildcards.values())
+    return key
+
+
+def schedule(durations: dict, parents: dict, slots: int) -> float:
+    """Makespan of a list schedule: a job starts when its parents are done and a slot is free."""
+    children = {j: [] for j in durations}
+    for j, ps in parents.items():
+        for p in ps:
+            children[p].append(j)
+    rank = {}
+
+    def remaining(j):  # longest path from the start of j to the end of the workflow
+        if j not in rank:
+            rank[j] = durations[j] + max((remaining(c) for c in children[j]), default=0.0)
+        return rank[j]
+
+    sys.setrecursionlimit(max(10000, 4 * len(durations)))
+    waiting = {j: len(parents.get(j, ())) for j in durations}
+    ready = [(-remaining(j), j) for j, n in waiting.items() if n == 0]
+    heapq.heapify(ready)
+    running, now, free = [], 0.0, slots
+    while ready or running:
+        while ready and free:
+            _, j = heapq.heappop(ready)
+            heapq.heappush(running, (now + durations[j], j))
+            free -= 1
+        now, done = heapq.heappop(running)
+        free += 1
+        for c in children[done]:
+            waiting[c] -= 1
+            if waiting[c] == 0:
+                heapq.heappush(ready, (-remaining(c), c))
+    return now
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dry-run", required=True, type=Path, help="output of `snakemake -n ... report`")
+    parser.add_argument("--squeue", type=Path, help="squeue -h -t all -o '%%i|%%k|%%T|%%M' of a Slurm run")
+    parser.add_argument("--results", type=Path, help="root of a run's outputs (sidecars <output>.meta.json)")
+    parser.add_argument("--overhead", type=float, default=0.0, help="seconds added to each sidecar time")
+    parser.add_argument("--default", type=float, default=10.0, help="seconds for a job without a measured time")
+    parser.add_argument("--nodes", type=int, nargs="+", default=[1, 2, 4, 8, 16])
+    parser.add_argument("--cores", type=int, default=1, help="jobs at once per node")
+    args = parser.parse_args(argv)
+
+    jobs = parse_dry_run(args.dry_run.read_text())
+    measured = {}
+    if args.squeue:
+        for line in args.squeue.read_text().splitlines():
+            parts = line.split("|")
+            if len(parts) >= 4 and parts[2] == "COMPLETED":
+                clock = [int(x) for x in re.split(r"[-:]", parts[3])]
+                seconds = sum(v * m for v, m in zip(reversed(clock), (1, 60, 3600, 86400)))
+                measured[parts[1]] = seconds
+    durations, parents, unmeasured = {}, {}, []
+    producer = {out: j["jobid"] for j in jobs for out in j["output"]}
+    for j in jobs:
+        jid = j["jobid"]
+        t = measured.get(_slurm_key(j["rule"], j["wildcards"]))
+        if t is None and args.results:
+            for out in j["output"]:
+                sidecar = args.results / (out + ".meta.json")
+                if sidecar.is_file():
+                    t = json.loads(sidecar.read_text()).get("wall_time_s")
+                    if t is not None:
+                        t += args.overhead
+                        break
+        if t is None:
+            unmeasured.append(j["rule"])
+            t = args.default + args.overhead
+        durations[jid] = float(t)
+        parents[jid] = sorted({producer[i] for i in j["input"] if i in producer and producer[i] != jid})
+    total = sum(durations.values())
+    critical = schedule(durations, parents, slots=len(durations))
+    print(f"jobs: {len(jobs)}  summed job time: {total:.0f} s  critical path: {critical:.0f} s")
+    if unmeasured:
+        print(f"no measured time ({args.default:.0f} s assumed): {', '.join(sorted(set(unmeasured)))}")
+    print("nodes  slots  projected wall time")
+    for n in args.nodes:
+        print(f"{n:5d}  {n * args.cores:5d}  {schedule(durations, parents, n * args.cores):8.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
