@@ -14,8 +14,14 @@ rule gainsched_design:
         designs="results/gainsched/designs.csv",
         solutions="results/gainsched/lmi_solutions.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "paper_gains", "lmi", "performance", "tuning", "simulation")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
     log:
         "logs/gainsched/design.log",
     shell:
@@ -31,8 +37,14 @@ rule gainsched_stability:
         stability="results/gainsched/stability.csv",
         theorem1="results/gainsched/theorem1.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "lmi", "stability", "simulation")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
     log:
         "logs/gainsched/stability.log",
     shell:
@@ -48,8 +60,14 @@ rule gainsched_simulation:
         error_summary="results/gainsched/error_summary.csv",
         paths="results/gainsched/sample_paths.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "simulation", "performance")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=2,
     log:
         "logs/gainsched/simulation.log",
     shell:
@@ -62,8 +80,14 @@ rule gainsched_sensitivity:
     output:
         table="results/gainsched/sensitivity.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "lmi", "sensitivity")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
     log:
         "logs/gainsched/sensitivity.log",
     shell:
@@ -76,8 +100,14 @@ rule gainsched_timing:
     output:
         table="results/gainsched/timing.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "lmi", "timing")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=4000,
+        runtime=10,
     log:
         "logs/gainsched/timing.log",
     shell:
@@ -94,8 +124,14 @@ rule gainsched_errata:
     output:
         table="results/errata/gainsched.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "lmi", "simulation")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=2,
     log:
         "logs/gainsched/errata.log",
     shell:
@@ -110,8 +146,14 @@ rule gainsched_reconstructions:
     output:
         table="results/reconstructions/gainsched.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "lmi", "simulation")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=1,
     log:
         "logs/gainsched/reconstructions.log",
     shell:
@@ -131,8 +173,14 @@ rule gainsched_claims:
     output:
         table="results/claims/gainsched.csv",
     params:
-        cfg=as_json(GCFG),
+        cfg=as_json(pick(GCFG, "system", "sensitivity")),
         io=io_json,
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=1,
     log:
         "logs/gainsched/claims.log",
     shell:
@@ -150,6 +198,8 @@ rule gainsched_fig1:
         cfg=as_json({"component": 1, "designs": GCFG.get("simulation", {}).get("fig_designs"),
                      "band": GCFG.get("simulation", {}).get("band")}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/gainsched/fig1.log",
     shell:
@@ -167,6 +217,8 @@ rule gainsched_fig2:
         cfg=as_json({"component": 2, "designs": GCFG.get("simulation", {}).get("fig_designs"),
                      "band": GCFG.get("simulation", {}).get("band")}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/gainsched/fig2.log",
     shell:
@@ -183,6 +235,8 @@ rule gainsched_figS1:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/gainsched/figS1.log",
     shell:
@@ -198,6 +252,8 @@ rule gainsched_figS2:
     params:
         cfg=as_json({"sigma2": GCFG.get("system", {}).get("sigma2")}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/gainsched/figS2.log",
     shell:
@@ -230,6 +286,8 @@ rule gainsched_notebook:
         reconstructions="results/reconstructions/gainsched.csv",
     output:
         html="report/gainsched.html",
+    conda:
+        CONDA_ENV
     log:
         "logs/gainsched/notebook.log",
     shell:
