@@ -482,9 +482,7 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
             counts[np.arange(len(idx)), idx] += 1
             state = new_state
         key = ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
-        uniq, inv = np.unique(key, return_inverse=True)
-        first = np.zeros(len(uniq), dtype=np.int64)
-        first[inv[::-1]] = np.arange(len(inv))[::-1]
+        uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
         s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(uniq))
         s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(uniq))
         coef.append(np.column_stack([counts[first].astype(float), s_norm, s_tr]))
