@@ -18,6 +18,8 @@ rule hinf_noise_model:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/noise_model.log",
     shell:
@@ -32,6 +34,8 @@ rule hinf_consensus_check:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/consensus_check.log",
     shell:
@@ -47,6 +51,8 @@ rule hinf_attenuation:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/attenuation.log",
     shell:
@@ -67,6 +73,8 @@ rule hinf_simulate:
         io=io_json,
     wildcard_constraints:
         scenario="|".join(HINF_SCENARIOS),
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/simulate_{scenario}.log",
     shell:
@@ -86,6 +94,8 @@ rule hinf_tables:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/tables.log",
     shell:
@@ -100,6 +110,8 @@ rule hinf_sensitivity:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/sensitivity.log",
     shell:
@@ -114,6 +126,8 @@ rule hinf_sensitivity_evasive:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/sensitivity_evasive.log",
     shell:
@@ -128,6 +142,8 @@ rule hinf_errata:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/errata.log",
     shell:
@@ -144,6 +160,8 @@ rule hinf_reconstructions:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/reconstructions.log",
     shell:
@@ -164,6 +182,8 @@ rule hinf_claims:
     params:
         cfg=as_json(HCFG),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/claims.log",
     shell:
@@ -179,6 +199,8 @@ rule hinf_fig1:
     params:
         cfg=as_json({"scale": 3.0}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig1.log",
     shell:
@@ -196,6 +218,8 @@ rule hinf_fig2:
         cfg=as_json({"series": [["fig2", "local", "local"], ["fig2", "decentralized", "decentralized"]],
                      "title": "Fig 2: local vs decentralized H-inf filter, W = 0.01 I"}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig2.log",
     shell:
@@ -213,6 +237,8 @@ rule hinf_fig3:
         cfg=as_json({"series": [["fig3", "local", "local"], ["fig3", "decentralized", "decentralized"]],
                      "title": "Fig 3: local vs decentralized H-inf filter, W = 0.001 I"}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig3.log",
     shell:
@@ -231,6 +257,8 @@ rule hinf_fig4:
                                 ["static_mobile", "decentralized", "mobile, decentralized"]],
                      "title": "Fig 4: stationary target", "log": True}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig4.log",
     shell:
@@ -249,6 +277,8 @@ rule hinf_fig5:
                                 ["static_mobile", "decentralized", "mobile, decentralized"]],
                      "title": "Fig 5: stationary target", "log": True}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig5.log",
     shell:
@@ -264,6 +294,8 @@ rule hinf_fig6:
     params:
         cfg=as_json({"scenario": "evasive_hinf", "run": 0, "title": "Fig 6: four agents and an evasive target"}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/fig6.log",
     shell:
@@ -279,6 +311,8 @@ rule hinf_figS1:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/figS1.log",
     shell:
@@ -295,6 +329,8 @@ rule hinf_figS2:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/figS2.log",
     shell:
@@ -310,6 +346,8 @@ rule hinf_figS3:
     params:
         cfg=as_json({}),
         io=io_json,
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/figS3.log",
     shell:
@@ -344,6 +382,8 @@ rule hinf_notebook:
         reconstructions="results/reconstructions/hinf.csv",
     output:
         html="report/hinf.html",
+    conda:
+        CONDA_ENV
     log:
         "logs/hinf/notebook.log",
     shell:
