@@ -28,14 +28,10 @@ import time
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize
 
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from ..config import ConfigError
-from ..engines.lmi import bisect_monotone
 from ..io import read_table
-from ..plotting import new_figure, save_figure
-from .gainsched_design import Theorem3, certificate_from_solution, congruence_residual, recover_gains
 from .gainsched_model import (
     Gains,
     GainschedError,
@@ -174,6 +170,8 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
         e = simulate(sys, unpack(v), p_seq, x0, np.random.default_rng(seed + 1), nonlinearity)
         return float((e ** 2).sum(-1).mean(0).sum())
 
+    from scipy.optimize import minimize
+
     dim = (n * n + n * m) * (2 if scheduled else 1)
     v0 = np.zeros(dim)
     if start is not None:
@@ -192,6 +190,8 @@ def design_step(params, inputs, outputs):
     Writes ``gains`` (design, matrix, row, col, value) and ``designs`` (one row
     per design: solver status, margin, objective, solve time, realisation).
     """
+    from .gainsched_design import Theorem3, recover_gains
+
     sys = _sys(params)
     lmi = params["lmi"]
     tables, rows = [], []
@@ -295,6 +295,8 @@ def stability_step(params, inputs, outputs):
     check of the Theorem 3 certificate itself (rebuilt Q, S of (23), (27)),
     and the growth rate of E||z||^2 along the scheduled p(k).
     """
+    from .gainsched_design import certificate_from_solution, recover_gains
+
     sys = _sys(params)
     table = read_table(inputs["gains"])
     designs = list(dict.fromkeys(table["design"]))
@@ -376,6 +378,10 @@ def sensitivity_step(params, inputs, outputs):
     Also the true mean-square stability limit of the plant (linear sector
     vertices): the criterion can never certify beyond it.
     """
+    from ..engines.lmi import bisect_monotone
+
+    from .gainsched_design import Theorem3
+
     base = _sys(params)
     lmi = params["lmi"]
     sens = params["sensitivity"]
@@ -414,6 +420,8 @@ def timing_step(params, inputs, outputs):
     and a power-law fit of solver time against the number of scalar variables
     (columns ``fit_exponent``, ``extrapolated_1000_s``, identical on every row).
     """
+    from .gainsched_design import Theorem3
+
     base = _sys(params)
     cfg = params["timing"]
     rng = np.random.default_rng(int(cfg["seed"]))
@@ -470,6 +478,8 @@ def errata_step(params, inputs, outputs):
 
     Reads ``gains`` and ``error_summary``; recomputes what it needs.
     """
+    from .gainsched_design import certificate_from_solution, congruence_residual
+
     sys = _sys(params)
     table = read_table(inputs["gains"])
     summary = read_table(inputs["summary"])
@@ -702,6 +712,8 @@ _COLORS = {"paper": "C3", "theorem3": "C0", "theorem3_S21I": "C9", "fixed_gain":
 
 def figure_errors(params, inputs, outputs):
     """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper) and the Monte Carlo mean with a band."""
+    from ..plotting import new_figure, save_figure
+
     comp = int(params["component"])
     errors = read_table(inputs["errors"])
     paths = read_table(inputs["paths"])
@@ -723,6 +735,8 @@ def figure_errors(params, inputs, outputs):
 
 def figure_mse(params, inputs, outputs):
     """Fig S1: E||e(k)||^2 per design (log scale) and sum_k E||e||^2 for fixed and Gaussian initial states."""
+    from ..plotting import new_figure, save_figure
+
     errors = read_table(inputs["errors"])
     summary = read_table(inputs["summary"])
     fig, (ax1, ax2) = new_figure(1, 2, figsize=(12, 4.2), layout="constrained")
@@ -745,6 +759,8 @@ def figure_mse(params, inputs, outputs):
 
 def figure_sensitivity(params, inputs, outputs):
     """Fig S2: Theorem 3 margin against sigma^2, scheduled and fixed gains, with the plant's MS-stability limit."""
+    from ..plotting import new_figure, save_figure
+
     sens = read_table(inputs["sensitivity"])
     fig, ax = new_figure(figsize=(6.4, 4))
     for variant, mk in (("scheduled", "o-"), ("fixed", "x--")):
@@ -765,4 +781,4 @@ def figure_sensitivity(params, inputs, outputs):
 
 
 # keep the model helpers importable from the paper module
-__all__ += ["tune_gains", "theorem1_matrix"]
+__all__ += ["tune_gains", "load_solutions", "theorem1_matrix"]

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cvxpy as cp
 import numpy as np
 
-from ..engines.lmi import SOLVER, second_moment_radius
+# cvxpy (and the engine that imports it) are imported where needed: steps that only
+# simulate or plot do not pay for the import.
 
 __all__ = [
     "GainschedError",
@@ -277,7 +277,7 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
     theta = p * (1.0 - p)
     s2 = sys.sigma2
     nn, nz = 2 * sys.n, sys.nz
-    use_cp = any(isinstance(x, cp.Expression) for x in (Q_now, Q_next, S))
+    use_cp = any(type(x).__module__.startswith("cvxpy") for x in (Q_now, Q_next, S))
     T = (lambda X: X.T)
     Lam = -Q_next + S + T(S)
     Om1 = T(S) @ (aug["A"] + aug["B"] @ sys.F1 @ sys.Z @ N)
@@ -294,6 +294,8 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
         [SD, O((nn, nz)), O((nn, nn)), O((nn, nn)), -s2 * Lam],
     ]
     if use_cp:
+        import cvxpy as cp
+
         return cp.bmat(rows)
     return np.block(rows)
 
@@ -323,6 +325,10 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     ``bound`` (scale fixing; an uncapped margin drives the solver to
     ``optimal_inaccurate``).
     """
+    import cvxpy as cp
+
+    from ..engines.lmi import SOLVER
+
     nn = 2 * sys.n
     Q0 = cp.Variable((nn, nn), symmetric=True, name="Q0")
     Qp = cp.Variable((nn, nn), symmetric=True, name="Qp")
@@ -396,6 +402,8 @@ def second_moment_operator(sys: System, gains: Gains, p: float, F):
 
 def frozen_radius(sys: System, gains: Gains, p: float, F) -> float:
     """Spectral radius of the second-moment operator at frozen p and linear f = F z (< 1: MS stable)."""
+    from ..engines.lmi import second_moment_radius
+
     loops, weights = second_moment_operator(sys, gains, p, F)
     return second_moment_radius(loops, weights)
 
