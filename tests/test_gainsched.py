@@ -247,3 +247,12 @@ def test_performance_design_bound_holds(sys, cfg):
     x0 = np.random.default_rng(6).standard_normal((4000, 2))
     e = simulate(sys, g, p_schedule(np.arange(40), sys.p1, sys.p2, 1.0), x0, np.random.default_rng(7))
     assert (e ** 2).sum(-1).mean(0).sum() <= sol.objective
+
+
+def test_noise_free_case_needs_the_last_row_removed(sys):
+    """At σ² = 0 the printed (24) has a zero diagonal block: strictly infeasible; without it, feasible."""
+    from netrepro.papers.gainsched_model import System
+
+    s0 = System(sys.A, sys.B, sys.C, sys.D, sys.Z, sys.F1, sys.F2, 0.0, sys.p1, sys.p2)
+    assert not Theorem3(s0, bound=100.0).solve().solver_feasible
+    assert Theorem3(s0, bound=100.0, noise_row=False).solve().solver_feasible

@@ -478,7 +478,7 @@ def errata_step(params, inputs, outputs):
 
     Reads ``gains`` and ``error_summary``; recomputes what it needs.
     """
-    from .gainsched_design import certificate_from_solution, congruence_residual
+    from .gainsched_design import Theorem3, certificate_from_solution, congruence_residual
 
     sys = _sys(params)
     table = read_table(inputs["gains"])
@@ -552,6 +552,21 @@ def errata_step(params, inputs, outputs):
                                       "the congruence of (12) rebuilt from the recovered gains, S and Q, at three "
                                       "(p, p+) pairs, with the Theorem 3 solution",
                      "residual_printed": res["zero"], "residual_corrected": res["HC"]})
+    # D4: sigma = 0
+    lmi = params["lmi"]
+    margins = {}
+    for keep in (True, False):
+        sys0 = System(sys.A, sys.B, sys.C, sys.D, sys.Z, sys.F1, sys.F2, 0.0, sys.p1, sys.p2)
+        sol0 = Theorem3(sys0, eps=float(lmi["eps"]), bound=float(lmi["bound"]), margin_cap=float(lmi["margin_cap"]),
+                        noise_row=keep).solve()
+        margins[keep] = sol0.margin
+    rows.append({"paper": PAPER, "erratum_id": "D4_noise_free_case", "location": "(12), (24): last block row",
+                 "printed": "σ²S^T D̄N and -σ²Λ(k) kept for every σ",
+                 "corrected": "for σ = 0 the last block row/column must be deleted; as printed the strict LMI is "
+                              "then infeasible (a zero diagonal block)",
+                 "demonstration": "largest margin t (vertices <= -tI) of Theorem 3 at σ² = 0 with the row (printed "
+                                  "column, must be > 0 for feasibility) and without it (corrected column)",
+                 "residual_printed": margins[True], "residual_corrected": margins[False]})
     # D1: stability of (10) does not involve the estimate; zero gains pass
     sm = summary.set_index(["design", "initial_state"])["sum_mse"]
     st = stab.set_index("design")

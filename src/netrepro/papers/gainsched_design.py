@@ -96,11 +96,16 @@ class Theorem3:
         t <= margin_cap; uncapped, Clarabel ends ``optimal_inaccurate``.
     gamma3_top : {"HC", "zero"}
         Upper row of Γ3: H̄^i C (what the congruence gives) or 0 (the misreading).
+    noise_row : bool
+        Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
+        block, so the strict LMI as printed is infeasible; ``False`` drops it
+        (the correct noise-free condition).
     """
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
-                 gamma3_top: str = "HC"):
+                 gamma3_top: str = "HC", noise_row: bool = True):
+        self.noise_row = noise_row
         if gamma3_top not in ("HC", "zero"):
             raise GainschedError(f"gamma3_top must be 'HC' or 'zero', got {gamma3_top!r}")
         self.gamma3_top = gamma3_top
@@ -214,6 +219,13 @@ class Theorem3:
         FZN = s.F @ s.Z @ s.N
         G1, G3, G4, Bh, Lam = self.Gamma1(pi, pj), self.Gamma3(pi, pj, pr), self.Gamma4(), self.Bhat(), self.Lambda(pl)
         O = np.zeros
+        if not self.noise_row:
+            return cp.bmat([
+                [-self.Qbar(pi), FZN.T, G1.T, G3.T],
+                [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn))],
+                [G1, Bh, -Lam, O((nn, nn))],
+                [G3, O((nn, nz)), O((nn, nn)), -theta * Lam],
+            ])
         return cp.bmat([
             [-self.Qbar(pi), FZN.T, G1.T, G3.T, G4.T],
             [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn)), O((nz, nn))],
