@@ -165,8 +165,8 @@ def test_theorem3_vertices_are_congruent_to_theorem1(sys, realisation):
 
 
 def test_congruence_residual_flags_gamma3_misreading(sys, t3):
-    assert congruence_residual(sys, t3.values, 0.5, 0.7) < 1e-9
-    assert congruence_residual(sys, t3.values, 0.5, 0.7, gamma3_top="zero") > 1e-4
+    assert congruence_residual(sys, t3.values, [(0.5, 0.7), (0.8, 0.4)]) < 1e-9
+    assert congruence_residual(sys, t3.values, [(0.5, 0.7)], gamma3_top="zero") > 1e-4
 
 
 def test_realisations_have_same_stability(sys, t3):

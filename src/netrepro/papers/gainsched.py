@@ -542,9 +542,8 @@ def errata_step(params, inputs, outputs):
                      "residual_printed": resid["printed"], "residual_corrected": resid["corrected"]})
     # E4: the rows of Γ3
     if v is not None:
-        res = {top: max(congruence_residual(sys, v, p, pn, "identity_T", top)
-                        for p, pn in ((0.5, 0.7), (sys.p1, sys.p2), (0.75, 0.45)))
-               for top in ("zero", "HC")}
+        pairs = ((0.5, 0.7), (sys.p1, sys.p2), (0.75, 0.45))
+        res = {top: congruence_residual(sys, v, pairs, "identity_T", top) for top in ("zero", "HC")}
         rows.append({"paper": PAPER, "erratum_id": "E4_gamma3_rows", "location": "(22), (25): Γ3",
                      "printed": "Θ(k)[· ; H̄(p(k))C]N, one row legible; read like C̄ of (11) it is Θ[0; H̄C]N",
                      "corrected": "Θ[H̄C; H̄C]N, since T^T S^T C̄ N T = [[S21^T H C, 0], [S21^T H C, 0]]",

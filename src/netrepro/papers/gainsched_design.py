@@ -316,9 +316,9 @@ def certificate_from_solution(values: dict, realisation: str = "identity_T") -> 
     return {"Q0": Tinv.T @ values["Q0"] @ Tinv, "Qp": Tinv.T @ values["Qp"] @ Tinv, "S": extra["S"]}
 
 
-def congruence_residual(sys: System, values: dict, p: float, pn: float, realisation: str = "identity_T",
+def congruence_residual(sys: System, values: dict, pairs, realisation: str = "identity_T",
                         gamma3_top: str = "HC") -> float:
-    """Max-abs residual of Theorem 2's equivalence at (p(k), p(k+1)) = (p, pn).
+    """Max-abs residual of Theorem 2's equivalence over the (p(k), p(k+1)) pairs ``pairs``.
 
     Compares the polytopic combination (28)-(33) of the vertices (24),
     :math:`\\sum \\alpha_i\\alpha_j\\alpha_r\\beta_l M^{ijrl}`, with the congruence
@@ -336,11 +336,6 @@ def congruence_residual(sys: System, values: dict, p: float, pn: float, realisat
     T = extra["T"]
     ps = (sys.p1, sys.p2)
     span = sys.p2 - sys.p1
-    a = ((sys.p2 - p) / span, (p - sys.p1) / span)  # (28)
-    b = ((sys.p2 - pn) / span, (pn - sys.p1) / span)  # (30)
-    combo = sum(a[i] * a[j] * a[r] * b[l] * prob.vertex(ps[i], ps[j], ps[r], ps[l]).value
-                for i in range(2) for j in range(2) for r in range(2) for l in range(2))
-    M = theorem1_matrix(sys, gains, cert["Q0"] + p * cert["Qp"], cert["Q0"] + pn * cert["Qp"], cert["S"], p)
     nn, nz = 2 * sys.n, sys.nz
     big = np.zeros((4 * nn + nz, 4 * nn + nz))
     big[:nn, :nn] = T
@@ -348,4 +343,13 @@ def congruence_residual(sys: System, values: dict, p: float, pn: float, realisat
     for k in range(3):
         o = nn + nz + nn * k
         big[o:o + nn, o:o + nn] = T
-    return float(np.max(np.abs(big.T @ M @ big - combo)))
+    vertices = {(i, j, r, l): prob.vertex(ps[i], ps[j], ps[r], ps[l]).value
+                for i in range(2) for j in range(2) for r in range(2) for l in range(2)}
+    worst = 0.0
+    for p, pn in pairs:
+        a = ((sys.p2 - p) / span, (p - sys.p1) / span)  # (28)
+        b = ((sys.p2 - pn) / span, (pn - sys.p1) / span)  # (30)
+        combo = sum(a[i] * a[j] * a[r] * b[l] * V for (i, j, r, l), V in vertices.items())
+        M = theorem1_matrix(sys, gains, cert["Q0"] + p * cert["Qp"], cert["Q0"] + pn * cert["Qp"], cert["S"], p)
+        worst = max(worst, float(np.max(np.abs(big.T @ M @ big - combo))))
+    return worst
