@@ -21,6 +21,14 @@ fi
 
 export DEBIAN_FRONTEND=noninteractive
 apt_opts=(-o DPkg::Lock::Timeout=600 -o Acquire::Retries=3)
+# The packages' maintainer scripts start munge, slurmctld and slurmd through invoke-rc.d and fail
+# when that fails (slurmd has no configuration yet). Deny service starts during the install, as
+# container images do, unless a policy is already in place.
+if [ ! -e /usr/sbin/policy-rc.d ]; then
+    printf '#!/bin/sh\nexit 101\n' > /usr/sbin/policy-rc.d
+    chmod +x /usr/sbin/policy-rc.d
+    trap 'rm -f /usr/sbin/policy-rc.d' EXIT
+fi
 for attempt in 1 2 3; do
     if apt-get "${apt_opts[@]}" update -qq \
         && apt-get "${apt_opts[@]}" install -y -qq --no-install-recommends "${missing[@]}"; then
@@ -29,6 +37,4 @@ for attempt in 1 2 3; do
     [ "$attempt" -lt 3 ] || { echo "slurm: apt-get install ${missing[*]} failed"; exit 1; }
     sleep $((attempt * 10))
 done
-# The packages' init scripts must not have started a system munged or Slurm daemons that could
-# clash with the test's own; nothing is started here (no systemd), and nothing is configured.
 echo "slurm: installed ${missing[*]} ($(dpkg-query -W -f='${Version}' slurmd))"
