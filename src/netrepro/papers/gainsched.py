@@ -82,9 +82,10 @@ def check_config(section: dict) -> None:
         gains_from_dict(section["paper_gains"], sys)
     except (GainschedError, KeyError, ValueError) as exc:
         raise ConfigError(f"config key 'gainsched.system' / 'gainsched.paper_gains' is invalid: {exc}") from None
-    x0 = np.asarray(section["simulation"]["x0"], dtype=float)
-    if x0.shape != (sys.n,):
-        raise ConfigError(f"config key 'gainsched.simulation.x0' = {x0.tolist()} must have {sys.n} entries")
+    for key in ("x0", "xf0"):
+        vec = np.asarray(section["simulation"].get(key, np.zeros(sys.n)), dtype=float)
+        if vec.shape != (sys.n,):
+            raise ConfigError(f"config key 'gainsched.simulation.{key}' = {vec.tolist()} must have {sys.n} entries")
     cov = np.asarray(section["performance"]["initial_cov"], dtype=float)
     if cov.shape != (sys.n, sys.n) or not np.allclose(cov, cov.T) or np.linalg.eigvalsh(cov).min() < 0:
         raise ConfigError(f"config key 'gainsched.performance.initial_cov' must be a symmetric PSD {sys.n}x{sys.n} "
@@ -140,8 +141,8 @@ def _p_seq(params, sys, horizon=None):
     return p_schedule(np.arange(K), sys.p1, sys.p2, float(sim["sine_omega"]))
 
 
-def _mc_errors(sys, gains, p_seq, x0, seed, nonlinearity):
-    return simulate(sys, gains, p_seq, x0, np.random.default_rng(seed), nonlinearity)
+def _mc_errors(sys, gains, p_seq, x0, seed, nonlinearity, xf0=None):
+    return simulate(sys, gains, p_seq, x0, np.random.default_rng(seed), nonlinearity, xf0=xf0)
 
 
 def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, scheduled: bool, maxiter: int,
@@ -202,7 +203,7 @@ def design_step(params, inputs, outputs):
                  "realisation": "unknown"})
     X0 = _x0_cov_aug(params, sys.n)
     common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
-                  margin_cap=float(lmi["margin_cap"]))
+                  margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
     problems = {
         "theorem3": dict(scheduled=True, performance=False),
         "fixed_gain": dict(scheduled=False, performance=False),
@@ -352,7 +353,7 @@ def simulation_step(params, inputs, outputs):
     ks = np.arange(len(p_seq) + 1)
     for d in designs:
         gains = gains_from_table(table, d, sys)
-        e = _mc_errors(sys, gains, p_seq, x0_fixed, int(sim["seed"]), sim["nonlinearity"])
+        e = _mc_errors(sys, gains, p_seq, x0_fixed, int(sim["seed"]), sim["nonlinearity"], sim.get("xf0"))
         mean = e.mean(0)
         lo, hi = np.percentile(e, q_lo, axis=0), np.percentile(e, q_hi, axis=0)
         mse = (e ** 2).sum(-1).mean(0)
@@ -389,7 +390,8 @@ def sensitivity_step(params, inputs, outputs):
     rows = []
     for variant, sched in (("scheduled", True), ("fixed", False)):
         prob = Theorem3(base, scheduled=sched, eps=float(lmi["eps"]), bound=float(lmi["bound"]),
-                        qp_positive=bool(lmi["qp_positive"]), margin_cap=float(lmi["margin_cap"]))
+                        qp_positive=bool(lmi["qp_positive"]), margin_cap=float(lmi["margin_cap"]),
+                        gamma3_top=lmi.get("gamma3_top", "HC"))
         for s2 in grid:
             sol = prob.solve(float(s2))
             rows.append({"variant": variant, "sigma2": float(s2), "status": sol.status, "margin": sol.margin,
@@ -614,8 +616,8 @@ def reconstructions_step(params, inputs, outputs):
          "read as k (omega = 1).", "Stability results hold for any p(k) in [p1, p2]; only Figs 1-2 change."),
         ("simulation.x0", sim["x0"], "Algorithm 1 needs an initial state; the paper gives none.",
          "The system is not linear (sector f) but nearly homogeneous; error_summary.csv also reports x0 ~ N(0, I)."),
-        ("simulation.xf0", [0.0, 0.0], "Initial filter state not given; x_f(0) = 0 is the natural choice.",
-         "Enters like x0 through e(0)."),
+        ("simulation.xf0", sim.get("xf0"), "Initial filter state not given; x_f(0) = 0 is the natural choice "
+         "(and the one the performance bound assumes).", "Enters like x0 through e(0) (fixed-x0 runs only)."),
         ("simulation.horizon", sim["horizon"], "Figure axes lost; N chosen so the errors have decayed.",
          "None on the conclusions (errors decay within ~15 steps)."),
         ("simulation.nonlinearity", sim["nonlinearity"], "The example gives only the sector [F1, F2]; we use "
@@ -629,7 +631,7 @@ def reconstructions_step(params, inputs, outputs):
          "R2 = S21^T S22^{-T} S21", "Garbled superscripts; taken as produced by the congruence "
          "T = diag(I, S22^{-1}S21) (errata E3).",
          "Tests rebuild (12) from the recovered S and Q: the identity holds to rounding."),
-        ("Γ3 of (22), (25)", "Θ[H̄C; H̄C]N", "Only one row is legible; the congruence gives H̄C in both rows "
+        ("lmi.gamma3_top (Γ3 of (22), (25))", f"{params['lmi'].get('gamma3_top', 'HC')}: Θ[H̄C; H̄C]N", "Only one row is legible; the congruence gives H̄C in both rows "
          "(errata E4).", "Reading [0; H̄C]N breaks the equivalence of Theorems 2-3 with Theorem 1 (residual in E4)."),
         ("lmi.realisation", "identity_T (S21 = S22 = R2)", "Algorithm 1 says 'choose appropriate S21, S22'; with "
          "T = I the error bound of the performance design applies to the recovered x_f.",

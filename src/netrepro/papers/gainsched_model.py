@@ -429,7 +429,8 @@ def scheduled_growth_rate(sys: System, gains: Gains, p_seq, F) -> float:
 
 
 # ----------------------------------------------------------------------------- simulation
-def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generator, nonlinearity: str = "sine_mid"):
+def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generator, nonlinearity: str = "sine_mid",
+             xf0=None):
     """Monte Carlo of plant (1), (6) and filter (8) under Algorithm 1, vectorised over runs.
 
     Each step draws xi(k) ~ Bernoulli(p(k)) (7) and w(k) ~ N(0, sigma^2), then
@@ -446,7 +447,9 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
     p_seq : ndarray (K,)
         p(0..K-1); the result has K+1 time points.
     x0 : ndarray (runs, n)
-        Initial states (x_f(0) = 0).
+        Initial states.
+    xf0 : ndarray (n,) or None
+        Initial filter state (default 0); ignored for the trivial estimate.
 
     Returns
     -------
@@ -459,6 +462,8 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
     runs = x.shape[0]
     p_seq = np.asarray(p_seq, dtype=float)
     xf = np.zeros_like(x)
+    if xf0 is not None and gains is not None:
+        xf = xf + np.asarray(xf0, dtype=float)
     errs = np.empty((runs, len(p_seq) + 1, sys.n))
     errs[:, 0] = x - xf
     sd = np.sqrt(sys.sigma2)
