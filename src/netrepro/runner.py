@@ -13,6 +13,9 @@ sidecar. Files the function writes itself (figures) must be written through
 :func:`netrepro.io.atomic_path`. Every output then gets a provenance sidecar.
 Inputs that carry a sidecar are checked against their checksum first.
 
+Warnings the step raises are logged once per distinct warning, with a
+count, and listed in the sidecar (no flood of repeated warnings in the logs).
+
 Before the step runs, stale sidecars of its outputs and temporary files left
 by an interrupted earlier attempt are removed, so a sidecar always describes
 the file written after it was (re)started: an interrupted job leaves either
@@ -29,6 +32,7 @@ import json
 import logging
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -111,6 +115,18 @@ def _nonfinite(frame: pd.DataFrame) -> dict:
     return counts
 
 
+def _summarize_warnings(caught) -> list[dict]:
+    """Warnings raised by a step, one entry per distinct (category, message, place) with its count.
+
+    A recursion that warns at every step logs one line, not thousands.
+    """
+    counts = {}
+    for w in caught:
+        key = (w.category.__name__, str(w.message), f"{Path(w.filename).name}:{w.lineno}")
+        counts[key] = counts.get(key, 0) + 1
+    return [{"category": c, "message": m, "where": where, "count": n} for (c, m, where), n in counts.items()]
+
+
 def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dict) -> None:
     """Run one step and write its outputs and their provenance sidecars."""
     func = resolve(func_spec)
@@ -121,9 +137,17 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     for path in outputs.values():
         path.parent.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    result = func(params, inputs, outputs) or {}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = func(params, inputs, outputs) or {}
     elapsed = time.perf_counter() - start
     extra = dict(result.pop("provenance", {}) if isinstance(result, dict) else {})
+    summary = _summarize_warnings(caught)
+    for item in summary:
+        log.warning("rule %s: %s: %s (at %s, %d times)", rule, item["category"], item["message"], item["where"],
+                    item["count"])
+    if summary:
+        extra.setdefault("warnings", summary)
     nonfinite = {}
     for name, value in result.items():
         if name not in outputs:
