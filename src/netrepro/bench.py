@@ -534,12 +534,14 @@ def _job_times(work: Path) -> pd.DataFrame:
         records.append(dict(rule=rec.get("rule"), output=output, start=rec["starttime"], end=rec["endtime"],
                             step_s=step))
     if not records:
-        return pd.DataFrame(columns=["rule", "job_s", "step_s", "n_outputs"])
+        return pd.DataFrame(columns=["rule", "output", "job_s", "step_s", "n_outputs", "start", "end"])
     df = pd.DataFrame(records)
-    jobs = df.groupby("rule").agg(start=("start", "min"), end=("end", "max"), step_s=("step_s", "max"),
-                                  n_outputs=("output", "count")).reset_index()
+    # one job = one rule run: its outputs share the start time (a rule with several jobs has several starts)
+    df["start_key"] = df["start"].round(3)
+    jobs = df.groupby(["rule", "start_key"]).agg(start=("start", "min"), end=("end", "max"), step_s=("step_s", "max"),
+                                                 n_outputs=("output", "count"), output=("output", "min")).reset_index()
     jobs["job_s"] = jobs["end"] - jobs["start"]
-    return jobs.sort_values("job_s", ascending=False)[["rule", "job_s", "step_s", "n_outputs"]]
+    return jobs.sort_values("job_s", ascending=False)[["rule", "output", "job_s", "step_s", "n_outputs", "start", "end"]]
 
 
 def _set_config_value(config_file: Path, dotted: str, factor: float) -> tuple[float, float]:
