@@ -307,6 +307,22 @@ rule intermittent_figS1:
         step("netrepro.papers.intermittent:figure_estimators")
 
 
+# light steps run in the main Snakemake process, never as cluster jobs
+localrules:
+    intermittent_monte_carlo,
+    intermittent_two_sensor_region,
+    intermittent_scalar_bounds,
+    intermittent_errata,
+    intermittent_reconstructions,
+    intermittent_claims,
+    intermittent_fig1,
+    intermittent_fig2,
+    intermittent_fig4,
+    intermittent_fig5,
+    intermittent_figS1,
+    intermittent_notebook,
+
+
 INTERMITTENT_FIGURES = [f"figures/intermittent/{f}.png" for f in ("fig1", "fig2", "fig4", "fig5", "figS1")]
 INTERMITTENT_TABLES = [
     "results/intermittent/scalar_bounds.csv",
