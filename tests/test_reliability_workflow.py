@@ -10,7 +10,9 @@
   tables (part 4);
 * the tables the figures read hold no NaN and the logs hold no flood of warnings (part 6).
 
-Only the `intermittent` paper is built (its own section of config/test.yaml, with more Monte Carlo
+Every snakemake run uses the scratch copy's own src/ (a snapshot of the package taken once), so that
+edits made meanwhile in the live checkout cannot mix into a comparison. Only the `intermittent` paper
+is built (its own section of config/test.yaml, with more Monte Carlo
 paths so that the step lasts long enough to be interrupted).
 """
 
@@ -50,9 +52,17 @@ TIMEOUT = 900
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("reliability")]
 
 
+def isolated_env(workdir, env=None):
+    """Run the scratch copy's own package code (a snapshot), not the live checkout's editable install."""
+    env = dict(env or os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(workdir) / "src"), env.get("PYTHONPATH")) if p)
+    return env
+
+
 def snakemake(workdir, *args, config="config/rel.yaml", check=True, env=None, timeout=TIMEOUT):
     cmd = [sys.executable, "-m", "snakemake", "--configfile", config, *args]
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout,
+                          env=isolated_env(workdir, env))
     if check and proc.returncode != 0:
         raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
     return proc
@@ -75,10 +85,11 @@ def fresh_copy(tmp_path_factory, name):
     return work
 
 
-def clone(src, tmp_path_factory, name):
-    """A copy of a built scratch repository, with its results and Snakemake metadata."""
+def clone(src, tmp_path_factory, name, results=True):
+    """A copy of a built scratch repository (same code), with or without its results and metadata."""
     work = tmp_path_factory.mktemp(name) / "repo"
-    shutil.copytree(src, work, symlinks=True)
+    ignore = None if results else shutil.ignore_patterns("results", "logs", ".snakemake", "figures", "report")
+    shutil.copytree(src, work, symlinks=True, ignore=ignore)
     return work
 
 
@@ -99,7 +110,7 @@ def snapshot(workdir):
 
 def verify(workdir, *args):
     return subprocess.run([sys.executable, "-m", "netrepro", "verify", "-q", *args], cwd=workdir,
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, env=isolated_env(workdir))
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +174,7 @@ sys.meta_path.insert(0, _Block())
 
 def test_missing_package_stops_snakemake_with_a_clear_message(built, tmp_path):
     (tmp_path / "sitecustomize.py").write_text(BLOCKER)
-    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))  # the scratch copy's src/ is prepended by snakemake()
     before = snapshot(built)
     proc = snakemake(built, "-j2", "--forceall", *TARGETS, check=False, env=env)
     out = proc.stdout + proc.stderr
@@ -178,7 +189,8 @@ def interrupt(work, how):
     """Start the Monte Carlo targets, kill as ``how`` while the Monte Carlo step runs; return the log."""
     out = open(work / "interrupted.txt", "w")
     cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/rel.yaml", "-j2", *MC_TARGETS]
-    proc = subprocess.Popen(cmd, cwd=work, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+    proc = subprocess.Popen(cmd, cwd=work, stdout=out, stderr=subprocess.STDOUT, start_new_session=True,
+                            env=isolated_env(work))
     try:
         deadline = time.monotonic() + 600
         while not list((work / "logs/intermittent").glob("monte_carlo*.log")):
@@ -208,8 +220,8 @@ def job_processes(work):
 
 
 @pytest.mark.parametrize("how", ["TERM", "TERM-group", "KILL-group"])
-def test_interrupted_monte_carlo_reruns_to_identical_tables(how, reference, tmp_path_factory):
-    work = fresh_copy(tmp_path_factory, f"rel_{how.lower()}")
+def test_interrupted_monte_carlo_reruns_to_identical_tables(how, built, reference, tmp_path_factory):
+    work = clone(built, tmp_path_factory, f"rel_{how.lower()}", results=False)
     interrupt(work, how)
     time.sleep(0.5)
     # nothing that looks complete unless it is: a graceful stop (SIGTERM to snakemake) lets the
