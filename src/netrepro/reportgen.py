@@ -17,7 +17,10 @@ import base64
 import datetime as _dt
 import html
 import json
+import os
+import platform
 import re
+import shlex
 import sys
 from pathlib import Path
 
@@ -28,7 +31,7 @@ from .papers import PAPERS
 from .provenance import git_state, package_versions, params_hash, sidecar_path
 
 __all__ = ["make_notebook", "execute_notebook", "strip_external_scripts", "build_index", "provenance_chain",
-           "scorecard", "main"]
+           "scorecard", "rule_for", "config_keys", "main"]
 
 SCORE_VERDICTS = ("reproduced", "differs", "erratum")
 
@@ -114,11 +117,22 @@ def show_table(path, max_rows=None):
 
 _EXTERNAL = re.compile(r"<script[^>]*\bsrc=\"https?://[^\"]*\"[^>]*>\s*</script>|<link[^>]*\bhref=\"https?://[^\"]*\"[^>]*>",
                        re.I)
+NO_FAVICON = '<link rel="icon" href="data:,">'
+_INLINE_SCRIPT = re.compile(r"<script\b[^>]*>(.*?)</script>", re.I | re.S)
+_REMOTE_IMPORT = re.compile(r"""import\s*\(?\s*["']https?://|\bfrom\s*["']https?://|=\s*["']https?://[^"']*\.m?js["']""")
 
 
 def strip_external_scripts(text: str) -> str:
-    """Remove ``<script src=http...>`` and ``<link href=http...>`` tags (offline report)."""
-    return _EXTERNAL.sub("", text)
+    """Remove scripts and style sheets fetched from the network (offline report).
+
+    Drops ``<script src=http...>``, ``<link href=http...>`` and inline scripts that
+    import modules from a URL (nbconvert's mermaid loader), so the page makes no
+    network request and logs no console error when opened offline.
+    """
+    text = _EXTERNAL.sub("", text)
+    if 'rel="icon"' not in text:  # no favicon request: a static page makes no request it cannot satisfy
+        text = re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
+    return _INLINE_SCRIPT.sub(lambda m: "" if _REMOTE_IMPORT.search(m.group(1)) else m.group(0), text)
 
 
 def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root: str | Path = ".") -> Path:
@@ -136,6 +150,7 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
     with atomic_path(html_out) as tmp:
         tmp.write_text(strip_external_scripts(body))
+    os.chmod(html_out, 0o644)
     return html_out
 
 
@@ -156,135 +171,530 @@ def provenance_chain(path: str | Path, seen=None) -> list[dict]:
 
 
 def scorecard(claims: dict[str, pd.DataFrame]) -> pd.DataFrame:
-    """Counts of verdicts per paper (and a total row)."""
+    """Counts of verdicts per paper (and a total row).
+
+    Verdicts outside :data:`SCORE_VERDICTS` are counted in an ``other`` column, so
+    the columns always add up to ``claims``.
+    """
     rows = []
     for slug, frame in claims.items():
-        counts = frame["verdict"].value_counts()
-        rows.append({"paper": slug, "claims": len(frame), **{v: int(counts.get(v, 0)) for v in SCORE_VERDICTS}})
-    table = pd.DataFrame(rows, columns=["paper", "claims", *SCORE_VERDICTS])
+        verdicts = frame["verdict"].astype(str).str.strip() if "verdict" in frame else pd.Series(dtype=str)
+        counts = verdicts.value_counts()
+        row = {"paper": slug, "claims": len(frame), **{v: int(counts.get(v, 0)) for v in SCORE_VERDICTS}}
+        row["other"] = len(frame) - sum(row[v] for v in SCORE_VERDICTS)
+        rows.append(row)
+    table = pd.DataFrame(rows, columns=["paper", "claims", *SCORE_VERDICTS, "other"])
     total = {"paper": "total", **{c: int(table[c].sum()) for c in table.columns[1:]}}
     return pd.concat([table, pd.DataFrame([total])], ignore_index=True)
 
 
+def rule_for(path: str | Path, producers: dict | None) -> str | None:
+    """Name of the Snakemake rule producing ``path``, from the workflow's own rule table.
+
+    ``producers`` is ``{"files": {path: rule}, "patterns": [[regex, rule], ...]}``
+    as built by ``workflow/rules/report.smk`` from ``workflow.rules``.
+    """
+    if not producers:
+        return None
+    path = str(path)
+    if path in producers.get("files", {}):
+        return producers["files"][path]
+    for pattern, name in producers.get("patterns", []):
+        if re.fullmatch(pattern, path):
+            return name
+    return None
+
+
+def _rule_name(meta: dict, producers: dict | None) -> str:
+    """The rule that made a sidecar's output: the workflow's rule table first, then the sidecar."""
+    name = rule_for(meta.get("output", ""), producers)
+    recorded = str(meta.get("rule", ""))
+    if name:
+        return name
+    return recorded if recorded and "@" not in recorded else "?"
+
+
+def _repo_relative(source_file: str) -> str:
+    """``src/netrepro/...`` form of a source path recorded as absolute (editable installs)."""
+    source_file = str(source_file)
+    marker = "src/netrepro/"
+    if marker in source_file and not source_file.startswith(marker):
+        return source_file[source_file.index(marker):]
+    return source_file
+
+
+def _flatten(obj, prefix="") -> dict:
+    """Nested dict -> ``{"a.b.c": leaf}`` (lists are leaves)."""
+    if isinstance(obj, dict) and obj:
+        flat = {}
+        for key, value in obj.items():
+            flat.update(_flatten(value, f"{prefix}.{key}" if prefix else str(key)))
+        return flat
+    return {prefix: obj} if prefix else {}
+
+
+def config_keys(params: dict, config_section: dict, slug: str) -> list[tuple[str, object, bool]]:
+    """Each leaf of a step's params with the configuration key it came from.
+
+    Returns ``(key, value, from_config)``: ``key`` is the dotted configuration path
+    (``slug.section.name``) when exactly one configuration entry ends with the
+    param's name and holds the same value, otherwise the param's own name
+    (a constant fixed in the rule, ``from_config`` False).
+    """
+    flat_cfg = _flatten(config_section or {})
+    out = []
+    for key, value in _flatten(params or {}).items():
+        leaf = key.split(".")[-1]
+        hits = [k for k, v in flat_cfg.items() if (k == key or k.endswith("." + key) or k.split(".")[-1] == leaf)
+                and v == value]
+        exact = [k for k in hits if k == key or k.endswith("." + key)]
+        hits = exact or hits
+        if len(hits) == 1:
+            out.append((f"{slug}.{hits[0]}", value, True))
+        else:
+            out.append((key, value, False))
+    return out
+
+
 def _img(path: Path) -> str:
     data = base64.b64encode(Path(path).read_bytes()).decode()
-    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(path.stem)}">'
+    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(path.stem)}" loading="eager">'
 
 
-def _table_html(frame: pd.DataFrame, css="data") -> str:
-    return frame.to_html(index=False, escape=True, na_rep="", classes=css, border=0)
+def _esc(value) -> str:
+    if value is None or (isinstance(value, float) and pd.isna(value)):
+        return ""
+    return html.escape(str(value))
 
 
-def _provenance_panel(fig: Path, root: Path) -> str:
+def _fmt_value(value) -> str:
+    if isinstance(value, (list, dict)):
+        text = json.dumps(value)
+        return text if len(text) <= 120 else text[:117] + "..."
+    return str(value)
+
+
+def _rst_html(text: str) -> str:
+    """Render a caption written in reStructuredText (fallback: escaped paragraphs)."""
+    text = text.strip()
+    if not text:
+        return ""
+    try:
+        from docutils.core import publish_parts
+
+        body = publish_parts(text, writer_name="html5",
+                             settings_overrides={"report_level": 5, "halt_level": 5, "syntax_highlight": "none",
+                                                 "embed_stylesheet": False, "math_output": "HTML"})["body"]
+        return body
+    except Exception:  # noqa: BLE001 - any docutils failure falls back to plain text
+        return "".join(f"<p>{html.escape(p)}</p>" for p in re.split(r"\n\s*\n", text))
+
+
+def _table_html(frame: pd.DataFrame, css="data", table_id=None) -> str:
+    head = "".join(f"<th>{_esc(c)}</th>" for c in frame.columns)
+    body = "".join("<tr>" + "".join(f"<td>{_esc(v)}</td>" for v in row) + "</tr>"
+                   for row in frame.itertuples(index=False))
+    tid = f' id="{table_id}"' if table_id else ""
+    return f'<div class="scroll"><table class="{css}"{tid}><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table></div>'
+
+
+def _read_csv(path) -> pd.DataFrame | None:
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        return pd.read_csv(path)
+    except pd.errors.EmptyDataError:
+        return pd.DataFrame()
+
+
+class _Site:
+    """Files the index links to, copied under ``report/files/`` so the report is self-contained."""
+
+    def __init__(self, root: Path, out_dir: Path | None):
+        self.root = root
+        self.out_dir = out_dir
+        self.sources: set[str] = set()
+        self.tables: set[str] = set()
+
+    def source_link(self, source_file: str, line=None) -> str:
+        rel = _repo_relative(source_file)
+        if self.out_dir is None or not (self.root / rel).is_file():
+            return f"../{rel}"
+        self.sources.add(rel)
+        return f"files/source/{rel}.html" + (f"#L-{int(line)}" if line else "")
+
+    def table_link(self, path: str) -> str:
+        if self.out_dir is None or not (self.root / path).is_file():
+            return f"../{path}"
+        self.tables.add(str(path))
+        return f"files/data/{path}"
+
+    def write(self) -> None:
+        if self.out_dir is None:
+            return
+        import shutil
+
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        for rel in sorted(self.tables):
+            target = self.out_dir / "data" / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(self.root / rel, target)
+            side = sidecar_path(self.root / rel)
+            if side.is_file():
+                shutil.copyfile(side, sidecar_path(target))
+        for rel in sorted(self.sources):
+            target = self.out_dir / "source" / f"{rel}.html"
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_text(_source_page(rel, (self.root / rel).read_text()))
+
+
+def _source_page(rel: str, code: str) -> str:
+    """A static, offline page of one source file; line N has the anchor ``#L-N``."""
+    try:
+        from pygments import highlight
+        from pygments.formatters import HtmlFormatter
+        from pygments.lexers import PythonLexer
+
+        formatter = HtmlFormatter(linenos="inline", linespans="L", anchorlinenos=True, lineanchors="N",
+                                  cssclass="code")
+        body = highlight(code, PythonLexer(), formatter)
+        style = formatter.get_style_defs(".code")
+        body = re.sub(r'<span id="L-(\d+)">', r'<span id="L-\1" class="line">', body)
+    except ImportError:
+        style = ""
+        body = "<pre class=\"code\">" + "".join(
+            f'<span id="L-{n}" class="line">{n:5d}  {html.escape(line)}\n</span>'
+            for n, line in enumerate(code.splitlines(), 1)) + "</pre>"
+    return (f"<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">{NO_FAVICON}<title>{html.escape(rel)}</title>"
+            f"<style>{style}\nbody{{font-family:system-ui,sans-serif;margin:1em}} pre{{font-size:13px;line-height:1.35}}"
+            f" .line:target{{background:#fff3a8;display:inline-block;width:100%}}</style></head><body>"
+            f"<p><a href=\"{'../' * (rel.count('/') + 2)}index.html\">&larr; report</a> &middot; <code>{html.escape(rel)}</code>"
+            f" (as built)</p>{body}</body></html>")
+
+
+def _short(sha) -> str:
+    return str(sha or "")[:12]
+
+
+def _provenance_panel(fig: Path, slug: str, ctx: dict) -> str:
+    """Provenance of one figure: its rule, rebuild command, source functions, configuration keys,
+    upstream data tables with checksums, seeds, compute time."""
+    site: _Site = ctx["site"]
     chain = provenance_chain(fig)
     if not chain:
-        return '<div class="prov missing">no provenance sidecar</div>'
+        return '<div class="prov missing">no provenance sidecar: rebuild the figure with snakemake</div>'
+    producers = ctx["producers"]
     head = chain[0]
-    rule = head["rule"]
-    src = head["source_file"]
-    line = head["source_line"]
-    rows = []
+    rule = _rule_name(head, producers)
+    func = head.get("function", "?")
+    src = _repo_relative(head.get("source_file", "?"))
+    line = head.get("source_line")
+    configfile = "".join(f" --configfile {shlex.quote(c)}" for c in ctx.get("configfiles", []))
+    rebuild = f"snakemake -j2{configfile} --forcerun {rule} {rule}"
+    total = sum(float(m.get("wall_time_s", 0) or 0) for m in chain)
+    seeds = {}
     for meta in chain:
-        seeds = ", ".join(f"{k}={v}" for k, v in meta.get("seeds", {}).items()) or "none"
-        rows.append(
-            f"<tr><td><code>{html.escape(meta['rule'])}</code></td>"
-            f"<td><a class=\"src\" href=\"../{html.escape(meta['source_file'])}\">{html.escape(meta['source_file'])}:{meta['source_line']}</a>"
-            f"<br><code>{html.escape(meta['function'])}</code></td>"
-            f"<td><code>{html.escape(meta['output'])}</code><br><span class=\"sha\">sha256 {meta['output_sha256'][:16]}</span></td>"
-            f"<td><details><summary>params {meta['params_hash']}</summary><pre>{html.escape(json.dumps(meta['params'], indent=1, sort_keys=True))}</pre></details></td>"
-            f"<td>{html.escape(seeds)}</td><td>{meta['wall_time_s']:.2f} s</td></tr>"
-        )
-    git = head.get("git", {})
+        for key, value in (meta.get("seeds") or {}).items():
+            seeds[f"{_rule_name(meta, producers)}: {key}"] = value
+    git = head.get("git") or {}
+    stale = ""
+    run_commit = ctx.get("commit")
+    if git.get("commit") and run_commit and git.get("commit") != run_commit:
+        stale = f' <span class="warn">built at an earlier commit than this report ({_short(git.get("commit"))})</span>'
+
+    steps, tables, code = [], {}, {}
+    for meta in chain:
+        name = _rule_name(meta, producers)
+        msrc = _repo_relative(meta.get("source_file", "?"))
+        keys = config_keys(meta.get("params", {}), ctx["config"].get(slug, {}), slug)
+        cfg = "".join(
+            f'<li class="{"cfg" if from_cfg else "const"}"><code>{_esc(k)}</code> = <code>{_esc(_fmt_value(v))}</code>'
+            f'{"" if from_cfg else " <small>(fixed in the rule)</small>"}</li>' for k, v, from_cfg in keys)
+        steps.append(
+            f'<tr><td><code class="rule">{_esc(name)}</code></td>'
+            f'<td><a class="src" href="{_esc(site.source_link(msrc, meta.get("source_line")))}">{_esc(msrc)}:{_esc(meta.get("source_line"))}</a>'
+            f'<br><code class="func">{_esc(meta.get("function"))}</code></td>'
+            f'<td>{"<ul>" + cfg + "</ul>" if cfg else "<small>none</small>"}'
+            f'<small class="sha">params hash {_esc(meta.get("params_hash"))}</small></td>'
+            f'<td class="num">{float(meta.get("wall_time_s", 0) or 0):.2f}&nbsp;s</td></tr>')
+        for item_name, item in (meta.get("inputs") or {}).items():
+            target = code if item_name.startswith("code") or item["path"].endswith(".py") else tables
+            target.setdefault(item["path"], item.get("sha256"))
+    table_rows = "".join(
+        f'<tr><td><a class="data" href="{_esc(site.table_link(p))}">{_esc(p)}</a></td>'
+        f'<td><code class="sha" title="{_esc(s)}">sha256 {_esc(_short(s))}</code></td></tr>' for p, s in sorted(tables.items()))
+    code_list = ", ".join(
+        f'<a href="{_esc(site.source_link(p))}">{_esc(_repo_relative(p))}</a> <code class="sha" title="{_esc(s)}">{_esc(_short(s))}</code>'
+        for p, s in sorted(code.items()))
+    seed_text = ", ".join(f"<code>{_esc(k)} = {_esc(v)}</code>" for k, v in seeds.items()) or "none (deterministic)"
     return (
-        f'<div class="prov" data-rule="{html.escape(rule)}" data-source="{html.escape(src)}" '
-        f'data-function="{html.escape(head["function"])}">'
-        f"<p><b>Rule</b> <code>{html.escape(rule)}</code> &middot; <b>rebuild</b> "
-        f"<code>snakemake -j2 --forcerun {html.escape(rule)} {html.escape(rule)}</code> &middot; <b>source</b> "
-        f"<a href=\"../{html.escape(src)}\">{html.escape(src)}:{line}</a> &middot; <b>commit</b> "
-        f"<code>{html.escape(str(git.get('commit'))[:12])}</code>{' (dirty)' if git.get('dirty') else ''}</p>"
-        "<table class=\"chain\"><tr><th>rule</th><th>function</th><th>output</th><th>configuration</th>"
-        f"<th>seeds</th><th>time</th></tr>{''.join(rows)}</table></div>"
+        f'<div class="prov" data-rule="{_esc(rule)}" data-source="{_esc(src)}" data-function="{_esc(func)}" '
+        f'data-line="{_esc(line)}">'
+        f'<div class="prov-head"><span><b>rule</b> <code class="rule">{_esc(rule)}</code></span>'
+        f'<span><b>source</b> <a class="src" href="{_esc(site.source_link(src, line))}">{_esc(src)}:{_esc(line)}</a> '
+        f'<code class="func">{_esc(func.split(":")[-1])}</code></span>'
+        f'<span><b>compute</b> {float(head.get("wall_time_s", 0) or 0):.2f}&nbsp;s (with upstream steps {total:.1f}&nbsp;s)</span>'
+        f'<span><b>commit</b> <code>{_esc(_short(git.get("commit")) or "n/a")}</code>{" (dirty)" if git.get("dirty") else ""}{stale}</span></div>'
+        f'<div class="rebuild"><b>rebuild just this figure</b> <code class="cmd">{_esc(rebuild)}</code></div>'
+        f'<div><b>seeds</b> {seed_text} &middot; <b>figure</b> <code>{_esc(fig)}</code> '
+        f'<code class="sha" title="{_esc(head.get("output_sha256"))}">sha256 {_esc(_short(head.get("output_sha256")))}</code></div>'
+        f'<details><summary>steps ({len(chain)}), configuration, data tables ({len(tables)}) and code</summary>'
+        '<table class="chain"><thead><tr><th>rule</th><th>source function</th><th>configuration used</th><th>time</th></tr></thead>'
+        f'<tbody>{"".join(steps)}</tbody></table>'
+        + (f'<table class="chain tables"><thead><tr><th>data table read</th><th>checksum</th></tr></thead><tbody>{table_rows}</tbody></table>'
+           if table_rows else "<p>data tables: none</p>")
+        + f'<p class="code-inputs"><b>code</b> {code_list}</p></details></div>'
     )
 
 
 CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
-h1{margin-bottom:.2em} h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
-table.data,table.chain,table.score{border-collapse:collapse;font-size:.85em;margin:.5em 0}
-table.data td,table.data th,table.chain td,table.chain th,table.score td,table.score th{border:1px solid #ddd;padding:3px 6px;vertical-align:top}
-tr.reproduced td.verdict{background:#e6f4ea} tr.differs td.verdict{background:#fde7e9} tr.erratum td.verdict{background:#fff4d6}
-.prov{background:#f7f7f9;border:1px solid #e2e2e8;padding:.5em;font-size:.85em}
-figure{margin:1.5em 0} figure img{max-width:100%;border:1px solid #eee} figcaption{font-style:italic;margin:.3em 0}
-pre{white-space:pre-wrap;max-width:420px;font-size:.8em} .sha{color:#777;font-size:.85em} nav a{margin-right:1em}
+:root{--ok:#1e7b34;--ok-bg:#e6f4ea;--bad:#b3261e;--bad-bg:#fde7e9;--err:#8a5a00;--err-bg:#fff1cc;--line:#dcdce3;--muted:#666}
+*{box-sizing:border-box}
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;max-width:1180px;margin:0 auto;padding:0 1.2em 4em;color:#1d1d22;line-height:1.45}
+header.top{padding:1.2em 0 .4em;border-bottom:3px solid #2b4c7e;margin-bottom:.8em}
+h1{margin:0;font-size:1.7em} .sub{color:var(--muted);margin:.2em 0 0}
+h2{border-bottom:2px solid var(--line);padding-bottom:.2em;margin-top:2.2em} h3{margin-top:1.6em} h4{margin:1.2em 0 .3em}
+nav.toc{position:sticky;top:0;background:#fff;border-bottom:1px solid var(--line);padding:.4em 0;z-index:5;font-size:.92em}
+nav.toc a{margin-right:1.1em;text-decoration:none}
+.cards{display:flex;gap:1em;flex-wrap:wrap;margin:.6em 0}
+.card{border:1px solid var(--line);border-radius:6px;padding:.5em .9em;min-width:8.5em}
+.card .n{font-size:1.8em;font-weight:650;display:block} .card.reproduced .n{color:var(--ok)} .card.differs .n{color:var(--bad)} .card.erratum .n{color:var(--err)}
+table{border-collapse:collapse;font-size:.86em;margin:.5em 0}
+td,th{border:1px solid var(--line);padding:3px 7px;vertical-align:top;text-align:left} thead th{background:#f3f4f7}
+td.num,th.num{text-align:right;font-variant-numeric:tabular-nums}
+table.score td.bar{min-width:180px} .bar span{display:inline-block;height:.9em;vertical-align:middle}
+.bar .reproduced{background:var(--ok)} .bar .differs{background:var(--bad)} .bar .erratum{background:#e0a800} .bar .other{background:#999}
+.verdict{font-weight:600;white-space:nowrap;border-radius:3px;padding:0 .35em}
+tr.v-reproduced td.verdict-cell{background:var(--ok-bg)} tr.v-differs td.verdict-cell{background:var(--bad-bg)} tr.v-erratum td.verdict-cell{background:var(--err-bg)}
+.scroll{overflow-x:auto}
+figure{margin:1.4em 0 2em;border-top:1px solid var(--line);padding-top:.8em} figure img{max-width:100%;height:auto;border:1px solid #eee;display:block;margin:.3em 0}
+figcaption .fig-id{font-weight:650} figcaption p{margin:.25em 0}
+.prov{background:#f6f7fa;border:1px solid #e0e2ea;border-radius:5px;padding:.5em .7em;font-size:.84em}
+.prov-head{display:flex;flex-wrap:wrap;gap:.4em 1.4em} .prov .rebuild{margin:.35em 0} code.cmd{background:#fff;border:1px solid var(--line);padding:1px 5px;user-select:all}
+.prov details{margin-top:.4em} .prov ul{margin:0;padding-left:1.1em} .prov li.const{color:var(--muted)}
+.sha{color:var(--muted);font-size:.9em} .warn{color:var(--bad)} .missing{color:var(--bad)}
+.beyond{border:2px dashed #7b5ea7;border-radius:8px;padding:.2em 1em 1em;margin-top:2em;background:#fbf9fe}
+.beyond>h3:first-child{color:#5b3f8a} .badge{display:inline-block;font-size:.75em;font-weight:700;padding:1px 6px;border-radius:3px;background:#7b5ea7;color:#fff;vertical-align:middle}
+dl.identity{display:grid;grid-template-columns:max-content 1fr;gap:.15em 1em;font-size:.9em} dl.identity dt{font-weight:600} dl.identity dd{margin:0}
+footer{margin-top:3em;color:var(--muted);font-size:.85em}
 """
 
 
-def _claims_html(frame: pd.DataFrame) -> str:
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in frame.columns)
-    body = []
+def _claims_html(frame: pd.DataFrame, slug: str) -> str:
+    """Claims table: statement, paper's value, ours, tolerance and why, verdict, note."""
+    def col(row, *names):
+        for n in names:
+            if n in row and not (isinstance(row[n], float) and pd.isna(row[n])):
+                return row[n]
+        return ""
+
+    rows = []
     for _, row in frame.iterrows():
-        cells = "".join(
-            f'<td class="{"verdict" if c == "verdict" else ""}">{html.escape("" if pd.isna(v) else str(v))}</td>'
-            for c, v in row.items()
-        )
-        body.append(f'<tr class="{html.escape(str(row["verdict"]))}">{cells}</tr>')
-    return f'<table class="data claims"><tr>{head}</tr>{"".join(body)}</table>'
+        verdict = str(col(row, "verdict")).strip()
+        why = col(row, "tolerance_reason", "tolerance_why")
+        rows.append(
+            f'<tr class="claim v-{_esc(verdict)}" data-verdict="{_esc(verdict)}">'
+            f'<td><code>{_esc(col(row, "claim_id"))}</code></td><td>{_esc(col(row, "statement"))}</td>'
+            f'<td class="num">{_esc(col(row, "paper_value"))}</td><td class="num">{_esc(col(row, "reproduced_value"))}</td>'
+            f'<td><span class="num">{_esc(col(row, "tolerance"))}</span>{("<br><small>" + _esc(why) + "</small>") if why != "" else ""}</td>'
+            f'<td class="verdict-cell"><span class="verdict">{_esc(verdict)}</span></td><td>{_esc(col(row, "note"))}</td></tr>')
+    return (f'<div class="scroll"><table class="data claims" id="{slug}-claims-table" data-paper="{slug}">'
+            "<thead><tr><th>id</th><th>statement</th><th>paper</th><th>ours</th><th>tolerance and why</th>"
+            f"<th>verdict</th><th>note</th></tr></thead><tbody>{''.join(rows)}</tbody></table></div>")
+
+
+def _figure_html(fig: Path, slug: str, captions: dict, ctx: dict) -> str:
+    ours = fig.stem.startswith("figS")
+    label = ("Figure " + fig.stem[3:]) if fig.stem.startswith("fig") else fig.stem
+    badge = ' <span class="badge">beyond the paper</span>' if ours else ""
+    caption = _rst_html(captions.get(fig.stem, "")) or "<p><em>no caption file</em></p>"
+    image = _img(fig) if fig.is_file() else f'<p class="missing">{_esc(fig)} not built</p>'
+    return (f'<figure id="{slug}-{fig.stem}" data-figure="{_esc(fig)}"><figcaption><span class="fig-id">{_esc(slug)} '
+            f"{_esc(label)}</span>{badge}{caption}</figcaption>{image}{_provenance_panel(fig, slug, ctx)}</figure>")
+
+
+def _tables_list(paths, ctx) -> str:
+    site: _Site = ctx["site"]
+    rows = []
+    for p in paths:
+        path = Path(p)
+        frame = _read_csv(path)
+        side = sidecar_path(path)
+        meta = json.loads(side.read_text()) if side.is_file() else {}
+        rows.append(
+            f'<tr><td><a class="data" href="{_esc(site.table_link(str(p)))}">{_esc(p)}</a></td>'
+            f'<td class="num">{"" if frame is None else len(frame)}</td>'
+            f'<td><code>{_esc(_rule_name(meta, ctx["producers"])) if meta else ""}</code></td>'
+            f'<td><code class="sha" title="{_esc(meta.get("output_sha256"))}">{_esc(_short(meta.get("output_sha256")))}</code></td></tr>')
+    return ("<table class=\"data\"><thead><tr><th>table</th><th>rows</th><th>rule</th><th>sha256</th></tr></thead>"
+            f"<tbody>{''.join(rows)}</tbody></table>")
+
+
+def _paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict) -> str:
+    meta = PAPERS.get(slug, {})
+    root = ctx["root"]
+    captions = figure_captions(root, slug)
+    figures = sorted((Path(f) for f in spec.get("figures", [])), key=_figure_sort_key)
+    paper_figs = [f for f in figures if not f.stem.startswith("figS")]
+    our_figs = [f for f in figures if f.stem.startswith("figS")]
+    notebook = spec.get("notebook")
+    out = [f'<section class="paper" id="{slug}"><h2>{_esc(meta.get("title", slug))} <small>(<code>{slug}</code>)</small></h2>',
+           f'<p class="sub">{_esc(meta.get("authors", ""))}'
+           + (f' &middot; source text <code>{_esc(meta["file"])}</code>' if meta.get("file") else "")
+           + (f' &middot; <a href="{_esc(Path(notebook).name)}">executed notebook</a>' if notebook else "")
+           + f' &middot; <a href="#{slug}-claims">claims</a> &middot; <a href="#{slug}-errata">errata</a>'
+           f' &middot; <a href="#{slug}-reconstructions">reconstructions</a> &middot; <a href="#{slug}-beyond">beyond the paper</a></p>']
+    out.append(f'<h3 id="{slug}-figures">Figures of the paper</h3>')
+    out.extend(_figure_html(f, slug, captions, ctx) for f in paper_figs)
+    if not paper_figs:
+        out.append("<p>The paper has no figure that we redraw.</p>")
+    out.append(f'<h3 id="{slug}-claims">Claims</h3>')
+    if frame is None:
+        out.append(f'<p class="missing">{_esc(spec.get("claims"))} not built</p>')
+    else:
+        counts = frame["verdict"].value_counts() if "verdict" in frame else {}
+        out.append("<p>" + ", ".join(f"{int(counts.get(v, 0))} {v}" for v in SCORE_VERDICTS)
+                   + f" of {len(frame)} stated numbers. Table: "
+                   f'<a class="data" href="{_esc(ctx["site"].table_link(spec["claims"]))}">{_esc(spec["claims"])}</a>.</p>')
+        out.append(_claims_html(frame, slug))
+    for title, key, intro in (
+            ("Errata", "errata", "Equations printed wrong: printed form, corrected form, numerical demonstration."),
+            ("Reconstructions", "reconstructions",
+             "Parameters the paper does not state or garbles: the value we chose, why, and where conclusions depend on it.")):
+        out.append(f'<h3 id="{slug}-{key}">{title}</h3><p class="sub">{intro}</p>')
+        table = _read_csv(spec[key]) if spec.get(key) else None
+        if table is None:
+            out.append(f'<p class="missing">{_esc(spec.get(key))} not built</p>')
+        elif not len(table):
+            out.append("<p>none</p>")
+        else:
+            out.append(_table_html(table.drop(columns=["paper"], errors="ignore"), table_id=f"{slug}-{key}-table"))
+    out.append(f'<div class="beyond" id="{slug}-beyond"><h3>Beyond the paper <span class="badge">ours</span></h3>'
+               "<p>Ground truths, comparisons and checks we add. Nothing here is claimed by the paper.</p>")
+    out.extend(_figure_html(f, slug, captions, ctx) for f in our_figs)
+    extra = spec.get("beyond_tables") or spec.get("extra_tables") or []
+    for table in extra:
+        frame_x = _read_csv(table)
+        if frame_x is not None:
+            out.append(f"<h4><code>{_esc(table)}</code></h4>" + _table_html(frame_x.head(50)))
+    tables = list(dict.fromkeys(spec.get("tables", [])))
+    if tables:
+        out.append("<h4>Result tables of this paper</h4>" + _tables_list(tables, ctx))
+    out.append("</div></section>")
+    return "\n".join(out)
+
+
+def _scorecard_html(score: pd.DataFrame, papers: dict, ctx: dict) -> str:
+    total = score.iloc[-1]
+    cards = "".join(f'<div class="card {v}"><span class="n" id="total-{v}">{int(total[v])}</span>{v}</div>'
+                    for v in SCORE_VERDICTS)
+    cards = f'<div class="card"><span class="n" id="total-claims">{int(total["claims"])}</span>claims checked</div>' + cards
+    show_other = int(total["other"]) > 0
+    head = ("<tr><th>paper</th><th class=\"num\">claims</th>" + "".join(f'<th class="num">{v}</th>' for v in SCORE_VERDICTS)
+            + ('<th class="num">other</th>' if show_other else "")
+            + "<th></th><th class=\"num\">errata</th><th class=\"num\">reconstructions</th><th class=\"num\">figures</th>"
+              "<th>claims table</th></tr>")
+    rows = []
+    for _, row in score.iterrows():
+        slug = row["paper"]
+        spec = papers.get(slug)
+        n = max(int(row["claims"]), 1)
+        bar = "".join(f'<span class="{v}" style="width:{160 * int(row[v]) / n:.1f}px" title="{int(row[v])} {v}"></span>'
+                      for v in (*SCORE_VERDICTS, "other") if int(row[v]))
+        if spec is not None:
+            name = f'<a href="#{slug}">{_esc(PAPERS.get(slug, {}).get("title", slug))}</a> <code>{_esc(slug)}</code>'
+            errata = _read_csv(spec.get("errata", "")) if spec.get("errata") else None
+            recon = _read_csv(spec.get("reconstructions", "")) if spec.get("reconstructions") else None
+            figs = spec.get("figures", [])
+            extra = (f'<td class="num n-errata">{"" if errata is None else len(errata)}</td>'
+                     f'<td class="num">{"" if recon is None else len(recon)}</td>'
+                     f'<td class="num">{sum(not Path(f).stem.startswith("figS") for f in figs)}'
+                     f' + {sum(Path(f).stem.startswith("figS") for f in figs)} ours</td>'
+                     f'<td><a class="claims-link" href="#{slug}-claims">claims of {_esc(slug)}</a></td>')
+        else:
+            name, extra = "<b>total</b>", "<td></td>" * 4
+        rows.append(f'<tr data-paper="{_esc(slug)}"><td>{name}</td><td class="num n-claims">{int(row["claims"])}</td>'
+                    + "".join(f'<td class="num n-{v}">{int(row[v])}</td>' for v in SCORE_VERDICTS)
+                    + (f'<td class="num n-other">{int(row["other"])}</td>' if show_other else "")
+                    + f'<td class="bar">{bar}</td>{extra}</tr>')
+    return (f'<div class="cards">{cards}</div><div class="scroll"><table class="score" id="scorecard-table"><thead>{head}</thead>'
+            f"<tbody>{''.join(rows)}</tbody></table></div>"
+            '<p class="sub"><b>reproduced</b>: our value is within the stated tolerance of the paper\'s; '
+            "<b>differs</b>: it is not, and the note says why; <b>erratum</b>: the paper's number follows from an equation "
+            "printed wrong (see the errata).</p>")
+
+
+def _identity_html(identity: dict, versions: dict) -> str:
+    items = "".join(f"<dt>{_esc(k)}</dt><dd id=\"id-{re.sub(r'[^a-z]+', '-', k.lower()).strip('-')}\">{v}</dd>"
+                    for k, v in identity.items())
+    pkgs = ", ".join(f"{_esc(k)} {_esc(v)}" for k, v in versions.items())
+    return f'<dl class="identity">{items}<dt>packages</dt><dd id="id-packages">{pkgs}</dd></dl>'
 
 
 def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     """Pipeline step: write ``report/index.html`` from claims, errata, figures and sidecars.
 
-    ``params["papers"]`` maps each slug to the outputs it registered in the
-    Snakefile (``PAPER_OUTPUTS``); ``params["config_hash"]`` identifies the run's configuration.
+    ``params``: ``papers`` maps each slug to the outputs it registered in the
+    Snakefile (``PAPER_OUTPUTS``); ``config_hash`` identifies the run's
+    configuration; optional ``config`` (the papers' configuration sections, to
+    name the configuration key of each parameter), ``producers`` (output file ->
+    rule, from the workflow), ``configfiles`` (given with ``--configfile``),
+    ``machine``, ``benchmarks`` (path of an optional benchmark table).
+    ``outputs``: ``html``, and optionally ``files``, a folder receiving the
+    linked source pages and tables so that the report is self-contained.
     """
     root = Path(".").resolve()
     papers = params["papers"]
-    claims = {slug: pd.read_csv(spec["claims"]) for slug, spec in papers.items()}
-    score = scorecard(claims)
+    files_dir = Path(outputs["files"]) if outputs.get("files") else None
+    site = _Site(root, files_dir)
+    claims = {slug: _read_csv(spec["claims"]) for slug, spec in papers.items()}
+    score = scorecard({s: (f if f is not None else pd.DataFrame({"verdict": []})) for s, f in claims.items()})
     git = git_state()
     versions = package_versions()
+    ctx = {"root": root, "site": site, "producers": params.get("producers"), "config": params.get("config", {}),
+           "configfiles": params.get("configfiles", []), "commit": git["commit"]}
+    commit = git["commit"]
     identity = {
-        "commit": git["commit"], "dirty": git["dirty"], "configuration hash": params["config_hash"],
-        "date (UTC)": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
-        "machine": params.get("machine", ""), **{f"{k}": v for k, v in versions.items()},
+        "commit": f"<code>{_esc(commit)}</code>" if commit else "not a git checkout",
+        "working tree": ("<span class=\"warn\">dirty (uncommitted changes)</span>" if git["dirty"] else "clean")
+        if git["dirty"] is not None else "unknown",
+        "configuration hash": f"<code>{_esc(params['config_hash'])}</code>"
+        + (f" &middot; {' '.join('<code>' + _esc(c) + '</code>' for c in ctx['configfiles'])}" if ctx["configfiles"] else ""),
+        "date (UTC)": _esc(_dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S")),
+        "machine": _esc(params.get("machine", "") or f"{platform.system()} {platform.machine()}")
+        + f" &middot; {_esc(platform.platform())}",
+        "papers": _esc(", ".join(papers)),
     }
-    parts = [f"<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>Reproduction report</title>"
-             f"<style>{CSS}</style></head><body>",
-             "<h1>Reproduction report: networked estimation and control</h1>",
-             "<nav>" + "".join(f'<a href="#{s}">{s}</a>' for s in papers) + "</nav>",
-             "<h2 id=\"scorecard\">Scorecard</h2>"]
-    score_html = ['<table class="score" id="scorecard-table"><tr><th>paper</th><th>claims</th>'
-                  + "".join(f"<th>{v}</th>" for v in SCORE_VERDICTS) + "<th>claims table</th></tr>"]
-    for _, row in score.iterrows():
-        slug = row["paper"]
-        link = (f'<a href="../{html.escape(papers[slug]["claims"])}">{html.escape(papers[slug]["claims"])}</a>'
-                if slug in papers else "")
-        score_html.append(
-            f'<tr data-paper="{html.escape(slug)}"><td>{html.escape(slug)}</td><td class="n-claims">{row["claims"]}</td>'
-            + "".join(f'<td class="n-{v}">{row[v]}</td>' for v in SCORE_VERDICTS) + f"<td>{link}</td></tr>")
-    parts.append("".join(score_html) + "</table>")
-    parts.append("<h3>Run identity</h3><table class=\"data\" id=\"identity\">"
-                 + "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>" for k, v in identity.items())
-                 + "</table>")
+    nav = "".join(f'<a href="#{s}">{_esc(s)}</a>' for s in papers)
+    bench_path = Path(params.get("benchmarks") or "results/benchmarks.csv")
+    bench = _read_csv(bench_path)
+    parts = [
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">" + NO_FAVICON +
+        "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+        f"<title>Reproduction report: networked estimation and control</title><style>{CSS}</style></head><body>",
+        '<header class="top"><h1>Reproduction report: networked estimation and control</h1>'
+        f'<p class="sub">{len(papers)} papers recomputed from their equations by one Snakemake workflow. Every figure '
+        "carries its provenance; every number the papers state is checked.</p></header>",
+        f'<nav class="toc"><a href="#scorecard">Scorecard</a><a href="#identity">Run</a>{nav}'
+        + ('<a href="#benchmarks">Benchmarks</a>' if bench is not None else "") + "</nav>",
+        '<h2 id="scorecard">Scorecard</h2>', _scorecard_html(score, papers, ctx),
+        '<h3 id="identity">Run identity</h3>', _identity_html(identity, versions),
+    ]
     for slug, spec in papers.items():
-        meta = PAPERS.get(slug, {})
-        parts.append(f'<h2 id="{slug}">{html.escape(meta.get("title", slug))}</h2>'
-                     f"<p>{html.escape(meta.get('authors', ''))} &middot; source text <code>{html.escape(meta.get('file', ''))}</code>"
-                     f' &middot; <a href="{html.escape(Path(spec["notebook"]).name)}">executed notebook</a></p>')
-        captions = figure_captions(root, slug)
-        for fig in sorted((Path(f) for f in spec["figures"]), key=_figure_sort_key):
-            ours = " <b>[beyond the paper]</b>" if fig.stem.startswith("figS") else ""
-            parts.append(f'<figure id="{slug}-{fig.stem}"><figcaption>{slug} {fig.stem}{ours}: '
-                         f"{html.escape(captions.get(fig.stem, ''))}</figcaption>{_img(fig)}"
-                         f"{_provenance_panel(fig, root)}</figure>")
-        parts.append(f"<h3>Claims</h3>{_claims_html(claims[slug])}")
-        for title, key in (("Errata", "errata"), ("Reconstructions", "reconstructions")):
-            path = Path(spec[key])
-            frame = pd.read_csv(path) if path.is_file() else pd.DataFrame()
-            parts.append(f"<h3>{title}</h3>" + (_table_html(frame) if len(frame) else "<p>none</p>"))
-    parts.append("</body></html>")
+        parts.append(_paper_section(slug, spec, claims[slug], ctx))
+    if bench is not None:
+        parts.append(f'<section id="benchmarks"><h2>Benchmarks</h2><p class="sub">From <code>{_esc(bench_path)}</code> '
+                     "(written by <code>make bench</code>; not a pipeline output, shown as found when the report was "
+                     f"built).</p>{_table_html(bench, table_id='benchmarks-table')}</section>")
+    parts.append("<footer>Built by the <code>report</code> rule (<code>netrepro.reportgen:build_index</code>). "
+                 "Figures are embedded; linked tables and source files are copies under <code>files/</code>, so the "
+                 "report works offline. Snakemake's own report: <code>snakemake --report report/snakemake_report.html</code>."
+                 "</footer></body></html>")
+    site.write()
     with atomic_path(outputs["html"]) as tmp:
         tmp.write_text("\n".join(parts))
+    os.chmod(outputs["html"], 0o644)
     return {"provenance": {"scorecard": score.to_dict(orient="records")}}
 
 

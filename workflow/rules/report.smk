@@ -1,8 +1,24 @@
-# The combined report: report/index.html from every paper's claims, errata, figures and sidecars.
+# The combined report: report/index.html from every paper's claims, errata, figures and sidecars,
+# plus report/files/ (copies of the linked tables and browsable source files), so that report/
+# works offline as static files. `snakemake --report` uses the description below.
 import platform
 
 from netrepro.provenance import params_hash
 
+
+report: "../report/workflow.rst"
+
+
+def report_producers():
+    """Output file -> name of the rule producing it (wildcard outputs as regexes), from the workflow."""
+    files, patterns = {}, []
+    for each in workflow.rules:
+        for out in each.output:
+            if out.contains_wildcard():
+                patterns.append([out.regex().pattern, each.name])
+            else:
+                files[str(out)] = each.name
+    return {"files": files, "patterns": patterns}
 
 
 rule report:
@@ -11,12 +27,17 @@ rule report:
         code=src("reportgen.py", "provenance.py"),
     output:
         html="report/index.html",
+        files=directory("report/files"),
     params:
         cfg=as_json(
             {
                 "papers": PAPER_OUTPUTS,
                 "config_hash": params_hash(config),
+                "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
+                "configfiles": [str(f) for f in workflow.overwrite_configfiles or []],
+                "producers": report_producers(),
                 "machine": f"{platform.system()} {platform.machine()}",
+                "benchmarks": "results/benchmarks.csv",
             }
         ),
         io=io_json,

@@ -1,0 +1,249 @@
+"""The combined report as a reader sees it: opened in a real headless Chromium.
+
+The report is built from a scratch copy of the repository with ``config/test.yaml``
+(never in the real ``results/``), then served as static files from ``report/`` alone
+by ``python -m http.server``'s handler, which also proves that the report needs
+nothing outside its folder. Checks: every image loads, every internal link
+resolves (files and anchors), no console errors and no network request leaves
+the report, the scorecard equals the claims tables, and a screenshot of the top
+is saved (path printed; ``REPORT_SCREENSHOT`` overrides it).
+
+Needs ``/usr/bin/chromium`` and ``chromedriver`` (Debian packages ``chromium``
+and ``chromium-driver``, installed in CI by ``.ci/setup.d/10-browser.sh``) and the
+``selenium`` package; skips with the reason when one is missing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import http.server
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import urllib.parse
+import urllib.request
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+TOP_LEVEL_IGNORE = {".venv", ".git", "results", "logs", ".snakemake", "report", "figures", ".pytest_cache",
+                    ".hypothesis", "build", "dist"}
+VERDICTS = ("reproduced", "differs", "erratum")
+CHROMIUM_FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
+                  "--window-size=1280,1600")
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
+
+
+def _find(*names):
+    for name in names:
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def _ignore(directory, names):
+    """Leave out the repository's build products (only at the top level: workflow/report/ is source)."""
+    if Path(directory).resolve() == ROOT:
+        return [n for n in names if n in TOP_LEVEL_IGNORE]
+    return [n for n in names if n in ("__pycache__",) or n.endswith(".egg-info")]
+
+
+def copy_repo(target: Path) -> Path:
+    shutil.copytree(ROOT, target, ignore=_ignore)
+    (target / "report").mkdir()
+    (target / "figures").mkdir()
+    return target
+
+
+def snakemake(workdir, *args, timeout=900):
+    cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", *args]
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout)
+    if proc.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    return proc
+
+
+@pytest.fixture(scope="module")
+def built_report(tmp_path_factory):
+    """A scratch repository with the full report built on the test configuration.
+
+    ``NETREPRO_BUILT_REPORT=/path/to/scratch/repo`` reuses an already built copy (when
+    working on the report itself).
+    """
+    if os.environ.get("NETREPRO_BUILT_REPORT"):
+        return Path(os.environ["NETREPRO_BUILT_REPORT"])
+    work = copy_repo(tmp_path_factory.mktemp("report") / "repo")
+    snakemake(work, f"-j{max(2, os.cpu_count() or 2)}", "report")
+    return work
+
+
+# ----------------------------------------------------------------------------- browser
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):  # keep pytest output clean
+        pass
+
+
+@contextlib.contextmanager
+def serve(directory: Path):
+    """Serve ``directory`` over HTTP on a free local port, as ``python -m http.server`` does."""
+    handler = functools.partial(_QuietHandler, directory=str(directory))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}/"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    chromium = _find("chromium", "chromium-browser", "google-chrome")
+    driver_bin = _find("chromedriver")
+    if chromium is None or driver_bin is None:
+        pytest.skip("no Chromium/chromedriver installed (apt-get install chromium chromium-driver, "
+                    "as .ci/setup.d/10-browser.sh does in CI)")
+    webdriver = pytest.importorskip("selenium.webdriver", reason="selenium not installed (pip install -e '.[test]')")
+    from selenium.webdriver.chrome.service import Service
+
+    profile = tempfile.mkdtemp(prefix="chromium-profile-")
+    options = webdriver.ChromeOptions()
+    options.binary_location = chromium
+    for flag in CHROMIUM_FLAGS:
+        options.add_argument(flag)
+    options.add_argument(f"--user-data-dir={profile}")
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(executable_path=driver_bin), options=options)
+    driver.set_page_load_timeout(60)
+    try:
+        yield driver
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def console_errors(driver) -> list[str]:
+    return [f"{e['level']}: {e['message']}" for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
+
+
+def page_state(driver) -> dict:
+    """Images, links, anchors and network requests of the loaded page."""
+    return driver.execute_script("""
+        const imgs = Array.from(document.images).map(i => ({
+            src: i.getAttribute('src').slice(0, 60), complete: i.complete, width: i.naturalWidth}));
+        const links = Array.from(document.querySelectorAll('a[href]')).map(a => ({
+            raw: a.getAttribute('href'), url: a.href}));
+        const ids = Array.from(document.querySelectorAll('[id]')).map(e => e.id);
+        const requests = performance.getEntriesByType('resource').map(r => r.name);
+        return {imgs, links, ids, requests, title: document.title};
+    """)
+
+
+def load(driver, url: str) -> dict:
+    driver.get_log("browser")  # drop earlier messages
+    driver.get(url)
+    driver.execute_script("return new Promise(r => document.readyState === 'complete' ? r() : "
+                          "window.addEventListener('load', () => r()));")
+    time.sleep(0.3)  # let late console messages arrive
+    return page_state(driver)
+
+
+def check_page(driver, url: str, base: str) -> tuple[dict, list[str]]:
+    """Load ``url``; return its state and the problems found on it."""
+    state = load(driver, url)
+    problems = [f"{url}: console {msg}" for msg in console_errors(driver)]
+    for img in state["imgs"]:
+        if not img["complete"] or img["width"] <= 0:
+            problems.append(f"{url}: image does not load: {img['src']}")
+    for req in state["requests"]:
+        if not (req.startswith(base) or req.startswith("data:")):
+            problems.append(f"{url}: network request outside the report: {req}")
+    return state, problems
+
+
+def internal_links(state: dict, base: str) -> list[str]:
+    return [link["url"] for link in state["links"]
+            if link["url"].startswith(base) or link["raw"].startswith("#")]
+
+
+def test_report_in_headless_chromium(built_report, browser, tmp_path_factory):
+    report = built_report / "report"
+    with serve(report) as base:
+        index_url = base + "index.html"
+        state, problems = check_page(browser, index_url, base)
+        assert state["imgs"], "the report shows no image"
+
+        # Screenshot of the top of the report (test artefact).
+        browser.execute_script("window.scrollTo(0, 0)")
+        shot = Path(os.environ.get("REPORT_SCREENSHOT") or tmp_path_factory.getbasetemp() / "report_top.png")
+        shot.parent.mkdir(parents=True, exist_ok=True)
+        assert browser.save_screenshot(str(shot)) and shot.stat().st_size > 10_000
+        print(f"screenshot of the report's top: {shot}")
+
+        # Every internal link: the file is served, and its #fragment exists on the target page.
+        targets: dict[str, set[str]] = {}
+        for url in internal_links(state, base):
+            page, _, fragment = url.partition("#")
+            targets.setdefault(page, set()).add(fragment)
+        assert len(targets) > 1, "the report links to no other page"
+        own_ids = set(state["ids"])
+        for page, fragments in sorted(targets.items()):
+            if page == index_url:
+                problems += [f"index.html: link to missing anchor #{f}" for f in fragments if f and f not in own_ids]
+                continue
+            try:
+                with urllib.request.urlopen(page, timeout=10) as resp:
+                    status = resp.status
+            except OSError as exc:
+                problems.append(f"broken link {page.removeprefix(base)}: {exc}")
+                continue
+            if status != 200:
+                problems.append(f"broken link {page.removeprefix(base)}: HTTP {status}")
+                continue
+            if page.endswith(".html"):
+                sub_state, sub_problems = check_page(browser, page, base)
+                problems += sub_problems
+                ids = set(sub_state["ids"])
+                problems += [f"{page.removeprefix(base)}: link to missing anchor #{f}"
+                             for f in fragments if f and f not in ids]
+        assert not problems, "\n".join(problems)
+
+        # The scorecard equals the claims tables (the CSVs and the tables shown on the page).
+        load(browser, index_url)
+        shown = browser.execute_script("""
+            const out = {};
+            for (const tr of document.querySelectorAll('#scorecard-table tr[data-paper]')) {
+                const row = {};
+                for (const td of tr.querySelectorAll('td[class*="n-"]')) {
+                    const cls = Array.from(td.classList).find(c => c.startsWith('n-'));
+                    row[cls.slice(2)] = parseInt(td.textContent, 10);
+                }
+                out[tr.dataset.paper] = row;
+            }
+            const tables = {};
+            for (const t of document.querySelectorAll('table.claims[data-paper]')) {
+                tables[t.dataset.paper] = Array.from(t.querySelectorAll('tr.claim')).map(r => r.dataset.verdict);
+            }
+            return {score: out, tables};
+        """)
+    claims = {p.stem: pd.read_csv(p) for p in sorted((built_report / "results" / "claims").glob("*.csv"))}
+    assert claims, "no claims table was built"
+    score, tables = shown["score"], shown["tables"]
+    assert set(score) == set(claims) | {"total"}
+    for slug, frame in claims.items():
+        expected = {"claims": len(frame), **{v: int((frame["verdict"] == v).sum()) for v in VERDICTS}}
+        assert {k: score[slug][k] for k in expected} == expected, slug
+        assert sorted(tables[slug]) == sorted(frame["verdict"].astype(str)), slug
+    for key in ("claims", *VERDICTS):
+        assert score["total"][key] == sum(score[s][key] for s in claims), key
