@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 
 report: $(STAMP)
 	$(BIN)/snakemake --profile workflow/profiles/default -j$(JOBS) report
-	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html
+	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html report
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
