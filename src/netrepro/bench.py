@@ -532,13 +532,12 @@ def _job_times(work: Path) -> pd.DataFrame:
             except ValueError:
                 pass
         records.append(dict(rule=rec.get("rule"), output=output, start=rec["starttime"], end=rec["endtime"],
-                            step_s=step))
+                            step_s=step, job=json.dumps(rec.get("log") or [output])))
     if not records:
         return pd.DataFrame(columns=["rule", "output", "job_s", "step_s", "n_outputs", "start", "end"])
     df = pd.DataFrame(records)
-    # one job = one rule run: its outputs share the start time (a rule with several jobs has several starts)
-    df["start_key"] = df["start"].round(3)
-    jobs = df.groupby(["rule", "start_key"]).agg(start=("start", "min"), end=("end", "max"), step_s=("step_s", "max"),
+    # one job = one rule run, identified by its log file(s); outputs without a log stand alone
+    jobs = df.groupby(["rule", "job"]).agg(start=("start", "min"), end=("end", "max"), step_s=("step_s", "max"),
                                                  n_outputs=("output", "count"), output=("output", "min")).reset_index()
     jobs["job_s"] = jobs["end"] - jobs["start"]
     return jobs.sort_values("job_s", ascending=False)[["rule", "output", "job_s", "step_s", "n_outputs", "start", "end"]]
