@@ -40,6 +40,9 @@ CHROMIUM_FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-
                   "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
                   "--window-size=1280,1600")
 
+# The small configuration of the workflow test (NETREPRO_REPORT_CONFIG overrides it, with NETREPRO_BUILT_REPORT).
+CONFIG = os.environ.get("NETREPRO_REPORT_CONFIG", "config/test.yaml")
+
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
 
 
@@ -66,7 +69,7 @@ def copy_repo(target: Path) -> Path:
 
 
 def snakemake(workdir, *args, timeout=900):
-    cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", *args]
+    cmd = [sys.executable, "-m", "snakemake", "--configfile", CONFIG, *args]
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout)
     if proc.returncode != 0:
         raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
@@ -91,6 +94,10 @@ def built_report(tmp_path_factory):
 class _QuietHandler(http.server.SimpleHTTPRequestHandler):
     def log_message(self, *args):  # keep pytest output clean
         pass
+
+    def handle(self):  # the browser may drop a connection it no longer needs
+        with contextlib.suppress(ConnectionError):
+            super().handle()
 
 
 @contextlib.contextmanager
@@ -247,3 +254,34 @@ def test_report_in_headless_chromium(built_report, browser, tmp_path_factory):
         assert sorted(tables[slug]) == sorted(frame["verdict"].astype(str)), slug
     for key in ("claims", *VERDICTS):
         assert score["total"][key] == sum(score[s][key] for s in claims), key
+
+
+# ----------------------------------------------------------------------------- provenance panels
+def test_every_figure_panel_names_an_existing_rule_and_function(built_report):
+    """Each figure's provenance panel names a rule of the workflow and an importable source function."""
+    import re
+
+    from netrepro.runner import resolve
+
+    rules = set(snakemake(built_report, "--list-rules").stdout.split())
+    text = (built_report / "report" / "index.html").read_text()
+    panels = re.findall(r'<figure id="([^"]+)" data-figure="([^"]+)">.*?<div class="prov" data-rule="([^"]*)" '
+                        r'data-source="([^"]*)" data-function="([^"]*)" data-line="([^"]*)"', text, re.S)
+    figures = re.findall(r'<figure id="', text)
+    assert panels and len(panels) == len(figures), "a figure has no provenance panel"
+    for fig_id, fig_path, rule, source, function, line in panels:
+        assert rule in rules, f"{fig_id}: rule {rule!r} is not a rule of the workflow"
+        func = resolve(function)
+        assert callable(func), f"{fig_id}: {function} is not a function"
+        assert (built_report / source).is_file(), f"{fig_id}: no file {source}"
+        assert source.endswith(func.__module__.replace(".", "/") + ".py"), f"{fig_id}: {function} not in {source}"
+        src_lines = (built_report / source).read_text().splitlines()
+        assert f"def {func.__name__}" in src_lines[int(line) - 1], f"{fig_id}: {source}:{line} is not def {func.__name__}"
+        assert f"--forcerun {rule} {rule}" in text
+
+
+def test_snakemake_report_view(built_report):
+    """Snakemake's own report (the second, standard view) builds with the figures' captions."""
+    out = built_report / "report" / "snakemake_report.html"
+    snakemake(built_report, "--report", str(out.relative_to(built_report)), "report")
+    assert out.stat().st_size > 50_000

@@ -1,6 +1,7 @@
 # The combined report: report/index.html from every paper's claims, errata, figures and sidecars,
 # plus report/files/ (copies of the linked tables and browsable source files), so that report/
 # works offline as static files. `snakemake --report` uses the description below.
+import os
 import platform
 
 from netrepro.provenance import params_hash
@@ -34,7 +35,7 @@ rule report:
                 "papers": PAPER_OUTPUTS,
                 "config_hash": params_hash(config),
                 "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
-                "configfiles": [str(f) for f in workflow.overwrite_configfiles or []],
+                "configfiles": [os.path.relpath(f) for f in workflow.overwrite_configfiles or []],
                 "producers": report_producers(),
                 "machine": f"{platform.system()} {platform.machine()}",
                 "benchmarks": "results/benchmarks.csv",
