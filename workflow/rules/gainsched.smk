@@ -303,3 +303,14 @@ if enabled("gainsched"):
         reconstructions="results/reconstructions/gainsched.csv",
         notebook="report/gainsched.html",
     )
+
+
+# light steps run in the main Snakemake process, never as cluster jobs
+localrules:
+    gainsched_reconstructions,
+    gainsched_claims,
+    gainsched_fig1,
+    gainsched_fig2,
+    gainsched_figS1,
+    gainsched_figS2,
+    gainsched_notebook,

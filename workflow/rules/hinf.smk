@@ -399,3 +399,20 @@ if enabled("hinf"):
         reconstructions="results/reconstructions/hinf.csv",
         notebook="report/hinf.html",
     )
+
+
+# light steps run in the main Snakemake process, never as cluster jobs
+localrules:
+    hinf_tables,
+    hinf_reconstructions,
+    hinf_claims,
+    hinf_fig1,
+    hinf_fig2,
+    hinf_fig3,
+    hinf_fig4,
+    hinf_fig5,
+    hinf_fig6,
+    hinf_figS1,
+    hinf_figS2,
+    hinf_figS3,
+    hinf_notebook,

@@ -323,3 +323,17 @@ if enabled("markov"):
         reconstructions="results/reconstructions/markov.csv",
         notebook="report/markov.html",
     )
+
+
+# light steps run in the main Snakemake process, never as cluster jobs
+localrules:
+    markov_reconstructions,
+    markov_claims,
+    markov_fig2,
+    markov_fig3,
+    markov_fig4,
+    markov_fig5,
+    markov_fig6,
+    markov_figS1,
+    markov_figS2,
+    markov_notebook,

@@ -362,3 +362,16 @@ if enabled("onebit"):
         reconstructions="results/reconstructions/onebit.csv",
         notebook="report/onebit.html",
     )
+
+
+# light steps run in the main Snakemake process, never as cluster jobs
+localrules:
+    onebit_estimator,
+    onebit_reconstructions,
+    onebit_claims,
+    onebit_fig1,
+    onebit_fig2,
+    onebit_figS1,
+    onebit_figS2,
+    onebit_figS3,
+    onebit_notebook,
