@@ -242,15 +242,29 @@ def config_keys(params: dict, config_section: dict, slug: str) -> list[tuple[str
     (a constant fixed in the rule, ``from_config`` False).
     """
     flat_cfg = _flatten(config_section or {})
-    out = []
+    matches = {}
     for key, value in _flatten(params or {}).items():
         leaf = key.split(".")[-1]
         hits = [k for k, v in flat_cfg.items() if (k == key or k.endswith("." + key) or k.split(".")[-1] == leaf)
                 and v == value]
         exact = [k for k in hits if k == key or k.endswith("." + key)]
-        hits = exact or hits
+        matches[key] = (value, exact or hits)
+    # A step reads one or a few sections: an ambiguous key comes from the section its unambiguous keys come from.
+    sections: dict[str, int] = {}
+    for _, hits in matches.values():
+        if len(hits) == 1:
+            parent = hits[0].rpartition(".")[0]
+            sections[parent] = sections.get(parent, 0) + 1
+    out = []
+    for key, (value, hits) in matches.items():
+        if len(hits) > 1 and sections:
+            best = max(sections.get(h.rpartition(".")[0], 0) for h in hits)
+            preferred = [h for h in hits if sections.get(h.rpartition(".")[0], 0) == best]
+            hits = preferred if best > 0 else hits
         if len(hits) == 1:
             out.append((f"{slug}.{hits[0]}", value, True))
+        elif hits:
+            out.append((" | ".join(f"{slug}.{h}" for h in hits), value, True))
         else:
             out.append((key, value, False))
     return out
@@ -481,6 +495,19 @@ footer{margin-top:3em;color:var(--muted);font-size:.85em}
 """
 
 
+def _num(value) -> str:
+    """A number as a reader wants it (7 significant digits; the exact value on hover)."""
+    text = _esc(value)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return text
+    if isinstance(value, bool) or not pd.notna(number) or number == int(number) and abs(number) < 1e15:
+        return text
+    short = f"{number:.7g}"
+    return text if short == str(value) else f'<span title="{text}">{short}</span>'
+
+
 def _claims_html(frame: pd.DataFrame, slug: str) -> str:
     """Claims table: statement, paper's value, ours, tolerance and why, verdict, note."""
     def col(row, *names):
@@ -496,7 +523,7 @@ def _claims_html(frame: pd.DataFrame, slug: str) -> str:
         rows.append(
             f'<tr class="claim v-{_esc(verdict)}" data-verdict="{_esc(verdict)}">'
             f'<td><code>{_esc(col(row, "claim_id"))}</code></td><td>{_esc(col(row, "statement"))}</td>'
-            f'<td class="num">{_esc(col(row, "paper_value"))}</td><td class="num">{_esc(col(row, "reproduced_value"))}</td>'
+            f'<td class="num">{_num(col(row, "paper_value"))}</td><td class="num">{_num(col(row, "reproduced_value"))}</td>'
             f'<td><span class="num">{_esc(col(row, "tolerance"))}</span>{("<br><small>" + _esc(why) + "</small>") if why != "" else ""}</td>'
             f'<td class="verdict-cell"><span class="verdict">{_esc(verdict)}</span></td><td>{_esc(col(row, "note"))}</td></tr>')
     return (f'<div class="scroll"><table class="data claims" id="{slug}-claims-table" data-paper="{slug}">'
