@@ -1,0 +1,44 @@
+"""Unit tests of the report generator's pure parts (no workflow run)."""
+
+import pandas as pd
+
+from netrepro.reportgen import config_keys, rule_for, scorecard, strip_external_scripts
+
+
+def test_scorecard_counts_and_total():
+    claims = {
+        "a": pd.DataFrame({"verdict": ["reproduced", "differs", "reproduced"]}),
+        "b": pd.DataFrame({"verdict": ["erratum", "reproduced", "pending"]}),
+    }
+    score = scorecard(claims).set_index("paper")
+    assert score.loc["a", ["claims", "reproduced", "differs", "erratum", "other"]].tolist() == [3, 2, 1, 0, 0]
+    assert score.loc["b", ["claims", "reproduced", "differs", "erratum", "other"]].tolist() == [3, 1, 0, 1, 1]
+    assert score.loc["total", ["claims", "reproduced", "differs", "erratum", "other"]].tolist() == [6, 3, 1, 1, 1]
+
+
+def test_rule_for_files_and_wildcard_patterns():
+    producers = {"files": {"figures/x/fig1.png": "x_fig1"},
+                 "patterns": [[r"results/x/shards/part_(?P<i>[^/]+)\.csv$", "x_shard"]]}
+    assert rule_for("figures/x/fig1.png", producers) == "x_fig1"
+    assert rule_for("results/x/shards/part_3.csv", producers) == "x_shard"
+    assert rule_for("results/y.csv", producers) is None
+    assert rule_for("figures/x/fig1.png", None) is None
+
+
+def test_config_keys_names_the_configuration_entry():
+    section = {"scalar": {"a": 1.5, "seed": 7, "n": 10}, "two": {"a": 1.5, "sigma": [0.2]}}
+    keys = {k: (v, c) for k, v, c in config_keys({"a": 1.5, "seed": 7, "n": 10, "which": "stable"}, section, "p")}
+    assert keys["p.scalar.seed"] == (7, True)
+    assert keys["p.scalar.a"] == (1.5, True)  # ambiguous alone; the step's other keys come from `scalar`
+    assert keys["which"] == ("stable", False)  # a constant fixed in the rule
+
+
+def test_strip_external_scripts_leaves_no_network_request():
+    page = ('<html><head><script src="https://cdn.example/x.js"></script>'
+            '<link rel="stylesheet" href="https://cdn.example/s.css"></head><body>'
+            '<script type="module">const m = await import("https://cdn.example/m.mjs");</script>'
+            "<script>var keep = 1;</script></body></html>")
+    out = strip_external_scripts(page)
+    assert "https://" not in out
+    assert "var keep = 1" in out
+    assert 'rel="icon" href="data:,"' in out
