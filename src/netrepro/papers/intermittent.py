@@ -42,7 +42,7 @@ from scipy import optimize
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from ..config import ConfigError
 from ..engines.channels import arrival_patterns, iid_arrivals
-from ..engines.lmi import MareStabilizabilityLMI, bisect_monotone
+from ..engines.lmi import MareStabilizabilityLMI, sweep_thresholds
 from ..engines.montecarlo import load_sums, merge_block_sums, run_blocks, run_monte_carlo, save_sums, shard_blocks
 from ..engines.riccati import Sensor, covariance_paths
 from ..io import read_table
@@ -247,7 +247,9 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
     Feasibility of eq. (16) is decided by the LMI of
     :class:`~netrepro.engines.lmi.MareStabilizabilityLMI` (one parametrised
     problem for the whole sweep) and certified by the spectral radius of the
-    closed-loop second-moment operator; lambda2 is found by bisection.
+    closed-loop second-moment operator; lambda2 is found by bisection, each
+    bracketed from the thresholds of the previous grid points
+    (:func:`~netrepro.engines.lmi.sweep_thresholds`).
     The noise terms of phi do not affect feasibility (the condition is
     homogeneous in X), so the bound depends on a and the C_i only.
 
@@ -255,22 +257,27 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
     status_at_threshold, certified_radius, statuses_seen`` (every solver status met in the bisection).
     """
     lmi = MareStabilizabilityLMI([[a]], two_sensor_modes())
-    rows = []
-    for lam1 in np.asarray(lambda1_grid, dtype=float):
-        outcomes = {}
+    grid = np.asarray(lambda1_grid, dtype=float)
+    outcomes = {float(lam1): {} for lam1 in grid}
 
-        def feasible(lam2, lam1=lam1, outcomes=outcomes):
+    def make_predicate(lam1):
+        def feasible(lam2):
             _, weights = arrival_patterns([lam1, lam2])
             out = lmi.solve(weights)
-            outcomes[lam2] = out
+            outcomes[float(lam1)][lam2] = out
             return out.certified
 
-        before = lmi.n_solves
-        res = bisect_monotone(feasible, 0.0, 1.0, tol=tol)
-        at = outcomes.get(res.threshold)
-        seen = pd.Series([o.status for o in outcomes.values()]).value_counts()
+        return feasible
+
+    # each bisection is bracketed from its neighbours' thresholds (fewer solves, same answers within tol)
+    results = sweep_thresholds(make_predicate, grid, 0.0, 1.0, tol=tol)
+    rows = []
+    for lam1, res in zip(grid, results):
+        seen_outcomes = outcomes[float(lam1)]
+        at = seen_outcomes.get(res.threshold)
+        seen = pd.Series([o.status for o in seen_outcomes.values()]).value_counts()
         if at is None:  # nothing certified: say what the solver said at the feasible end of the bracket
-            end = outcomes.get(1.0)
+            end = seen_outcomes.get(1.0)
             status = f"not certified at lambda2 = 1 ({end.status if end else 'not solved'})"
         else:
             status = at.status
@@ -278,7 +285,7 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
             "lambda1": lam1,
             "lambda2c_upper": res.threshold,
             "bracket_lower": res.lower,
-            "n_solves": lmi.n_solves - before,
+            "n_solves": res.n_evals,
             "status_at_threshold": status,
             "certified_radius": at.certificate_value if at else np.nan,
             "statuses_seen": "; ".join(f"{k}: {v}" for k, v in seen.items()),
