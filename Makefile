@@ -6,7 +6,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 JOBS ?= 2
 
-.PHONY: report test lint bench clean-results
+.PHONY: report test lint bench verify clean-results
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -21,6 +21,10 @@ report: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
+
+# Check every result table against the checksum in its provenance sidecar.
+verify: $(STAMP)
+	$(BIN)/python -m netrepro verify
 
 lint: $(STAMP)
 	$(BIN)/snakemake --lint

@@ -6,6 +6,7 @@ name and by file path, `--lint`, and that a bad configuration stops before
 any job runs.
 """
 
+import os
 import re
 import shutil
 import subprocess
@@ -25,7 +26,9 @@ pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
 
 def snakemake(workdir, *args, check=True):
     cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", *args]
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=900)
+    # the scratch copy runs its own src/ snapshot, not the live checkout behind the editable install
+    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=900, env=env)
     if check and proc.returncode != 0:
         raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
     return proc
@@ -124,7 +127,8 @@ def test_bad_config_stops_before_any_job(built):
     bad.write_text(yaml.safe_dump(cfg))
     before = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
     proc = subprocess.run([sys.executable, "-m", "snakemake", "--configfile", "config/bad.yaml", "-j2", "--forceall",
-                           "report"], cwd=built, capture_output=True, text=True, timeout=300)
+                           "report"], cwd=built, capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, PYTHONPATH=str(built / "src")))
     assert proc.returncode != 0
     assert "intermittent.scalar.R2" in proc.stdout + proc.stderr
     after = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}

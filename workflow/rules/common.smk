@@ -75,7 +75,9 @@ CONDA_ENV = "../envs/netrepro.yaml"
 
 def step(func):
     """Shell command of a pipeline step: one call into the package (`{rule}` is the job's rule name)."""
+    # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
+        "OPENBLAS_NUM_THREADS={threads} OMP_NUM_THREADS={threads} "
         f"{PYTHON} -m netrepro run --rule {{rule}} --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )

@@ -406,6 +406,10 @@ def two_sensor_region_merge_step(params, inputs, outputs):
     """Step: the Figs 4-5 table, concatenating the lambda1 shards."""
     table = pd.concat([read_table(p) for p in inputs["shards"]], ignore_index=True).sort_values("lambda1",
                                                                                                   kind="stable")
+    expected = np.linspace(0.0, 1.0, params["lambda1_grid"])
+    if len(table) != len(expected) or not np.allclose(table["lambda1"].to_numpy(), expected, rtol=0, atol=1e-12):
+        raise ValueError(f"the {len(inputs['shards'])} lambda1 shards do not cover the grid of {len(expected)} points "
+                         "exactly once; rebuild the shards (snakemake --forcerun intermittent_two_sensor_region_shard)")
     return {"table": table.reset_index(drop=True), "provenance": {"total_lmi_solves": int(table["n_solves"].sum())}}
 
 
