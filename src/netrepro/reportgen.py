@@ -665,14 +665,16 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     ``params``: ``papers`` maps each slug to the outputs it registered in the
     Snakefile (``PAPER_OUTPUTS``); ``config_hash`` identifies the run's
     configuration; optional ``config`` (the papers' configuration sections, to
-    name the configuration key of each parameter), ``producers`` (output file ->
+    name the configuration key of each parameter), ``order`` (the papers in the order
+    of the configuration; the JSON of ``papers`` has its keys sorted), ``producers`` (output file ->
     rule, from the workflow), ``configfiles`` (given with ``--configfile``),
     ``machine``, ``benchmarks`` (path of an optional benchmark table).
     ``outputs``: ``html``, and optionally ``files``, a folder receiving the
     linked source pages and tables so that the report is self-contained.
     """
     root = Path(".").resolve()
-    papers = params["papers"]
+    order = [s for s in params.get("order", []) if s in params["papers"]]
+    papers = {s: params["papers"][s] for s in order + sorted(set(params["papers"]) - set(order))}
     files_dir = Path(outputs["files"]) if outputs.get("files") else None
     site = _Site(root, files_dir)
     claims = {slug: _read_csv(spec["claims"]) for slug, spec in papers.items()}

@@ -33,6 +33,7 @@ rule report:
         cfg=as_json(
             {
                 "papers": PAPER_OUTPUTS,
+                "order": [slug for slug in config["papers"] if slug in PAPER_OUTPUTS],
                 "config_hash": params_hash(config),
                 "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
                 "configfiles": [os.path.relpath(f) for f in workflow.overwrite_configfiles or []],
