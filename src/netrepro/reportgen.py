@@ -31,7 +31,7 @@ from .papers import PAPERS
 from .provenance import git_state, package_versions, params_hash, sidecar_path
 
 __all__ = ["make_notebook", "execute_notebook", "strip_external_scripts", "build_index", "provenance_chain",
-           "scorecard", "rule_for", "config_keys", "main"]
+           "scorecard", "rule_for", "workflow_producers", "config_keys", "main"]
 
 SCORE_VERDICTS = ("reproduced", "differs", "erratum")
 
@@ -186,6 +186,22 @@ def scorecard(claims: dict[str, pd.DataFrame]) -> pd.DataFrame:
     table = pd.DataFrame(rows, columns=["paper", "claims", *SCORE_VERDICTS, "other"])
     total = {"paper": "total", **{c: int(table[c].sum()) for c in table.columns[1:]}}
     return pd.concat([table, pd.DataFrame([total])], ignore_index=True)
+
+
+def workflow_producers(rules) -> dict:
+    """Output file -> name of the rule producing it, from Snakemake's ``workflow.rules``.
+
+    Outputs with wildcards are given as regular expressions. The result is the
+    ``producers`` parameter of :func:`build_index` (see :func:`rule_for`).
+    """
+    files, patterns = {}, []
+    for each in rules:
+        for out in each.output:
+            if out.contains_wildcard():
+                patterns.append([out.regex().pattern, each.name])
+            else:
+                files[str(out)] = each.name
+    return {"files": files, "patterns": patterns}
 
 
 def rule_for(path: str | Path, producers: dict | None) -> str | None:

@@ -5,21 +5,10 @@ import os
 import platform
 
 from netrepro.provenance import params_hash
+from netrepro.reportgen import workflow_producers
 
 
 report: "../report/workflow.rst"
-
-
-def report_producers():
-    """Output file -> name of the rule producing it (wildcard outputs as regexes), from the workflow."""
-    files, patterns = {}, []
-    for each in workflow.rules:
-        for out in each.output:
-            if out.contains_wildcard():
-                patterns.append([out.regex().pattern, each.name])
-            else:
-                files[str(out)] = each.name
-    return {"files": files, "patterns": patterns}
 
 
 rule report:
@@ -37,7 +26,7 @@ rule report:
                 "config_hash": params_hash(config),
                 "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
                 "configfiles": [os.path.relpath(f) for f in workflow.overwrite_configfiles or []],
-                "producers": report_producers(),
+                "producers": workflow_producers(workflow.rules),
                 "machine": f"{platform.system()} {platform.machine()}",
                 "benchmarks": "results/benchmarks.csv",
             }
