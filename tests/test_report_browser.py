@@ -6,7 +6,7 @@ by ``python -m http.server``'s handler, which also proves that the report needs
 nothing outside its folder. Checks: every image loads, every internal link
 resolves (files and anchors), no console errors and no network request leaves
 the report, the scorecard equals the claims tables, and a screenshot of the top
-is saved (path printed; ``REPORT_SCREENSHOT`` overrides it).
+is saved as ``report/screenshot.png`` (git-ignored; ``REPORT_SCREENSHOT`` overrides the path).
 
 Needs ``/usr/bin/chromium`` and ``chromedriver`` (Debian packages ``chromium``
 and ``chromium-driver``, installed in CI by ``.ci/setup.d/10-browser.sh``) and the
@@ -184,7 +184,7 @@ def internal_links(state: dict, base: str) -> list[str]:
             if link["url"].startswith(base) or link["raw"].startswith("#")]
 
 
-def test_report_in_headless_chromium(built_report, browser, tmp_path_factory):
+def test_report_in_headless_chromium(built_report, browser):
     report = built_report / "report"
     with serve(report) as base:
         index_url = base + "index.html"
@@ -193,7 +193,7 @@ def test_report_in_headless_chromium(built_report, browser, tmp_path_factory):
 
         # Screenshot of the top of the report (test artefact).
         browser.execute_script("window.scrollTo(0, 0)")
-        shot = Path(os.environ.get("REPORT_SCREENSHOT") or tmp_path_factory.getbasetemp() / "report_top.png")
+        shot = Path(os.environ.get("REPORT_SCREENSHOT") or ROOT / "report" / "screenshot.png")  # git-ignored
         shot.parent.mkdir(parents=True, exist_ok=True)
         assert browser.save_screenshot(str(shot)) and shot.stat().st_size > 10_000
         print(f"screenshot of the report's top: {shot}")
