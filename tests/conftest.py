@@ -13,3 +13,53 @@ import pytest
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+# ----------------------------------------------------------------------------- one built workflow per session
+import shutil  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+TOP_LEVEL_IGNORE = {".venv", ".git", "results", "logs", ".snakemake", "report", "figures", ".pytest_cache",
+                    ".hypothesis", "build", "dist"}
+
+
+def _ignore(directory, names):
+    """Leave out the repository's build products (only at the top level: workflow/report/ is source)."""
+    if Path(directory).resolve() == ROOT:
+        return [n for n in names if n in TOP_LEVEL_IGNORE]
+    return [n for n in names if n == "__pycache__" or n.endswith(".egg-info")]
+
+
+def copy_repo(target: Path) -> Path:
+    """A scratch copy of the repository's sources (no results, figures or report)."""
+    shutil.copytree(ROOT, target, ignore=_ignore)
+    (target / "report").mkdir()
+    (target / "figures").mkdir()
+    return target
+
+
+def run_snakemake(workdir, *args, config="config/test.yaml", check=True, timeout=900):
+    """Snakemake in ``workdir``, running that copy's own ``src/`` (not the live checkout)."""
+    cmd = [sys.executable, "-m", "snakemake", "--configfile", config, *args]
+    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    return proc
+
+
+@pytest.fixture(scope="session")
+def built_repo(tmp_path_factory):
+    """A scratch repository with the whole report built on the small test configuration.
+
+    Shared by the workflow and report tests (both in xdist group "workflow", so one worker
+    builds it once). ``NETREPRO_BUILT_REPORT=/path`` reuses an already built copy.
+    """
+    if os.environ.get("NETREPRO_BUILT_REPORT"):
+        return Path(os.environ["NETREPRO_BUILT_REPORT"])
+    work = copy_repo(tmp_path_factory.mktemp("wf") / "repo")
+    run_snakemake(work, "-j2", "report")
+    return work

@@ -1,11 +1,9 @@
 import itertools
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from netrepro.engines.channels import iid_arrivals
 from netrepro.engines.montecarlo import run_monte_carlo
 from netrepro.engines.riccati import Sensor, covariance_paths, iterate_expected_riccati
 from netrepro.papers import intermittent as im

@@ -33,8 +33,6 @@ import pandas as pd
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-TOP_LEVEL_IGNORE = {".venv", ".git", "results", "logs", ".snakemake", "report", "figures", ".pytest_cache",
-                    ".hypothesis", "build", "dist"}
 VERDICTS = ("reproduced", "differs", "erratum")
 CHROMIUM_FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                   "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
@@ -54,40 +52,19 @@ def _find(*names):
     return None
 
 
-def _ignore(directory, names):
-    """Leave out the repository's build products (only at the top level: workflow/report/ is source)."""
-    if Path(directory).resolve() == ROOT:
-        return [n for n in names if n in TOP_LEVEL_IGNORE]
-    return [n for n in names if n in ("__pycache__",) or n.endswith(".egg-info")]
-
-
-def copy_repo(target: Path) -> Path:
-    shutil.copytree(ROOT, target, ignore=_ignore)
-    (target / "report").mkdir()
-    (target / "figures").mkdir()
-    return target
-
-
 def snakemake(workdir, *args, timeout=900):
     cmd = [sys.executable, "-m", "snakemake", "--configfile", CONFIG, *args]
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout)
+    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
+    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
     if proc.returncode != 0:
         raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
     return proc
 
 
 @pytest.fixture(scope="module")
-def built_report(tmp_path_factory):
-    """A scratch repository with the full report built on the test configuration.
-
-    ``NETREPRO_BUILT_REPORT=/path/to/scratch/repo`` reuses an already built copy (when
-    working on the report itself).
-    """
-    if os.environ.get("NETREPRO_BUILT_REPORT"):
-        return Path(os.environ["NETREPRO_BUILT_REPORT"])
-    work = copy_repo(tmp_path_factory.mktemp("report") / "repo")
-    snakemake(work, f"-j{max(2, os.cpu_count() or 2)}", "report")
-    return work
+def built_report(built_repo):
+    """The session's scratch repository with the full report built on the test configuration."""
+    return built_repo
 
 
 # ----------------------------------------------------------------------------- browser

@@ -8,30 +8,20 @@ any job runs.
 
 import os
 import re
-import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pandas as pd
 import pytest
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
-IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
-                                "*.egg-info", ".pytest_cache", ".hypothesis")
+from .conftest import run_snakemake
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
 
 
 def snakemake(workdir, *args, check=True):
-    cmd = [sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", *args]
-    # the scratch copy runs its own src/ snapshot, not the live checkout behind the editable install
-    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=900, env=env)
-    if check and proc.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
-    return proc
+    return run_snakemake(workdir, *args, check=check)
 
 
 def jobs_planned(workdir, *targets):
@@ -46,13 +36,8 @@ def jobs_planned(workdir, *targets):
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    work = tmp_path_factory.mktemp("wf") / "repo"
-    shutil.copytree(ROOT, work, ignore=IGNORE)
-    (work / "report").mkdir()
-    (work / "figures").mkdir()
-    snakemake(work, "-j2", "report")
-    return work
+def built(built_repo):
+    return built_repo
 
 
 def test_report_and_interface_tables(built):

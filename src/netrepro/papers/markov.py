@@ -49,7 +49,6 @@ Tables (``results/markov/``)
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
