@@ -49,6 +49,17 @@ class BisectionResult:
     bracketed: bool  # True when lo was infeasible and hi feasible
 
 
+def _halve(check, a, b, tol, history, max_evals) -> BisectionResult:
+    """Halve a bracket (a infeasible, b feasible) until it is at most ``tol`` wide."""
+    while b - a > tol and len(history) < max_evals:
+        mid = 0.5 * (a + b)
+        if check(mid):
+            b = mid
+        else:
+            a = mid
+    return BisectionResult(b, a, len(history), history, True)
+
+
 def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_evals: int = 60) -> BisectionResult:
     """Smallest x in [lo, hi] with ``is_feasible(x)`` for a monotone predicate (False ... False True ... True).
 
@@ -67,13 +78,7 @@ def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_ev
     if not check(hi):
         return BisectionResult(np.nan, hi, len(history), history, False)
     a, b = lo, hi
-    while b - a > tol and len(history) < max_evals:
-        mid = 0.5 * (a + b)
-        if check(mid):
-            b = mid
-        else:
-            a = mid
-    return BisectionResult(b, a, len(history), history, True)
+    return _halve(check, a, b, tol, history, max_evals)
 
 
 def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: float, tol: float = 1e-4,
@@ -119,13 +124,7 @@ def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: flo
                 return BisectionResult(lo, np.nan, len(history), history, False)
             step *= 2.0
             a = max(lo, a - step)
-    while b - a > tol and len(history) < max_evals:
-        mid = 0.5 * (a + b)
-        if check(mid):
-            b = mid
-        else:
-            a = mid
-    return BisectionResult(b, a, len(history), history, True)
+    return _halve(check, a, b, tol, history, max_evals)
 
 
 def sweep_thresholds(make_predicate, grid, lo: float, hi: float, tol: float = 1e-4, max_evals: int = 60,
