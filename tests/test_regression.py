@@ -18,3 +18,14 @@ def test_identical_tables_agree_and_changes_are_caught(tmp_path):
     assert "column 's' differs" in compare_tables(ref, got)[0]
     got.unlink()
     assert "missing" in compare_trees(tmp_path / "ref", tmp_path / "res")[1][0]
+
+
+def test_timing_columns_and_claim_notes_are_not_compared(tmp_path):
+    ref, got = tmp_path / "ref" / "claims" / "t.csv", tmp_path / "res" / "claims" / "t.csv"
+    for path in (ref, got):
+        path.parent.mkdir(parents=True)
+    pd.DataFrame({"x": [1.0], "solve_time_s": [0.5], "note": ["took 3 s"]}).to_csv(ref, index=False)
+    pd.DataFrame({"x": [1.0], "solve_time_s": [0.9], "note": ["took 4 s"]}).to_csv(got, index=False)
+    assert compare_tables(ref, got) == []
+    pd.DataFrame({"x": [1.5], "solve_time_s": [0.9], "note": ["took 4 s"]}).to_csv(got, index=False)
+    assert compare_tables(ref, got)
