@@ -107,3 +107,14 @@ def test_check_config_names_key():
         im.check_config({"scalar": dict(a=1.5, exact_horizon=30, horizon=10, lambda_offsets=[0.1])})
     with pytest.raises(ConfigError, match="lambda_offsets"):
         im.check_config({"scalar": dict(a=1.5, exact_horizon=3, horizon=10, lambda_offsets=[0.6])})
+
+
+def test_region_shards_give_identical_tables_whatever_the_split():
+    base = {"a": A, "lambda1_grid": 9, "bisection_tol": 1e-4}
+    tables = []
+    for n_shards in (1, 2, 4):
+        parts = [im.two_sensor_region_shard_step({**base, "n_shards": n_shards, "shard": s}, {}, {})["table"]
+                 for s in range(n_shards)]
+        tables.append(pd.concat(parts).sort_values("lambda1", kind="stable").reset_index(drop=True))
+    for other in tables[1:]:
+        pd.testing.assert_frame_equal(tables[0], other)
