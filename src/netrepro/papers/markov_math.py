@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..engines.channels import gilbert_elliott_arrivals, gilbert_elliott_stationary
+from ..engines.riccati import Sensor, covariance_paths
 
 # cvxpy (and the shared LMI engine, which imports it) are imported lazily: the simulation
 # steps do not need them, and importing cvxpy costs seconds per pipeline job.
@@ -492,26 +493,9 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
 # ----------------------------------------------------------------------------- Monte Carlo estimators
 def covariance_paths_ge(system, Sigma0, arrivals) -> np.ndarray:
     """``P_1..P_{T+1}`` along each path, shape ``(N, T+1, n, n)``: ``P_{k+1} = g(P_k)`` if ``gamma_k = 1``
-    else ``h(P_k)`` (eqs. 4-5), batched over paths, loop over time only.
-
-    Same recursion as :func:`netrepro.engines.riccati.covariance_paths` for one sensor (cross-checked
-    in the unit tests); kept here so that this paper's steps depend only on eqs. (4)-(5).
+    else ``h(P_k)`` (eqs. 4-5), batched over paths: the shared engine's recursion with one sensor (C, R).
     """
-    arrivals = np.asarray(arrivals, dtype=bool)
-    N, T = arrivals.shape
-    A, C, Q, R = system.A, system.C, system.Q, system.R
-    out = np.empty((N, T + 1) + A.shape)
-    P = np.broadcast_to(np.asarray(Sigma0, dtype=float), (N,) + A.shape).copy()
-    out[:, 0] = P
-    with np.errstate(over="ignore", invalid="ignore"):
-        for k in range(T):
-            P = np.where(arrivals[:, k, None, None], riccati_g(P, A, C, Q, R), riccati_h(P, A, Q))
-            out[:, k + 1] = P
-    return out
-
-
-def _paths(system, Sigma0, arrivals):
-    return covariance_paths_ge(system, Sigma0, arrivals)
+    return covariance_paths(Sigma0, system.A, system.Q, [Sensor(system.C, system.R)], arrivals, keep="all")
 
 
 def plain_mc(system, Sigma0, p, q, n_paths, horizon, rng):
@@ -520,7 +504,7 @@ def plain_mc(system, Sigma0, p, q, n_paths, horizon, rng):
     Returns ``(norms, arrivals)`` with ``norms`` of shape ``(N, horizon + 1)`` (``k = 1..horizon+1``).
     """
     arrivals = gilbert_elliott_arrivals(rng, n_paths, horizon, p, q, initial=1)
-    P = _paths(system, Sigma0, arrivals)
+    P = covariance_paths_ge(system, Sigma0, arrivals)
     return sym_norm(P), arrivals
 
 
@@ -550,7 +534,7 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
         raise ValueError("rb_mean_norm needs gamma_1 = 1 on every path")
     A, Q = system.A, system.Q
     if P is None:
-        P = _paths(system, Sigma0, arrivals)
+        P = covariance_paths_ge(system, Sigma0, arrivals)
     N, T = arrivals.shape
     normf = sym_norm if which == "norm" else (lambda M: np.trace(M, axis1=-2, axis2=-1))
     out = np.empty((N, T + 1))
