@@ -20,8 +20,6 @@ import functools
 import http.server
 import os
 import shutil
-import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -31,6 +29,8 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+
+from .conftest import run_snakemake
 
 ROOT = Path(__file__).resolve().parents[1]
 VERDICTS = ("reproduced", "differs", "erratum")
@@ -53,12 +53,7 @@ def _find(*names):
 
 
 def snakemake(workdir, *args, timeout=900):
-    cmd = [sys.executable, "-m", "snakemake", "--configfile", CONFIG, *args]
-    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
-    if proc.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
-    return proc
+    return run_snakemake(workdir, *args, config=CONFIG, timeout=timeout)
 
 
 @pytest.fixture(scope="module")
