@@ -35,44 +35,65 @@ def _system(rng, n):
 @pytest.mark.parametrize("keep", ["all", "last"])
 def test_scalar_kernel_is_bit_identical_to_original(rng, keep, monkeypatch):
     monkeypatch.setattr(ric, "SCALAR_CHUNK_PATHS", 37)  # several chunks, a ragged last one
-    arrivals = rng.random((200, 300, 2)) < 0.35  # a = 1.6 with these losses: some paths overflow
-    new = covariance_paths(5.0, [[1.6]], [[0.1]], [Sensor([[1.0]], [[0.5]]), Sensor([[2.0]], [[0.8]])], arrivals, keep)
-    old = _original_scalar(5.0, 1.6, 0.1, [0.5, 0.2], arrivals, keep)
+    arrivals = rng.random((200, 700, 2)) < 0.002  # a = 10, rare receptions: paths overflow, then recover
+    new = covariance_paths(5.0, [[10.0]], [[0.1]], [Sensor([[1.0]], [[0.5]]), Sensor([[2.0]], [[0.8]])], arrivals, keep,
+                           kernel="numpy")
+    old = _original_scalar(5.0, 10.0, 0.1, [0.5, 0.2], arrivals, keep)
     assert np.array_equal(new, old)
 
 
+@pytest.mark.parametrize("keep", ["all", "last"])
+def test_compiled_scalar_kernel_matches_original_with_overflow_and_recovery(rng, keep):
+    """One division per update instead of two: equal to rounding, and the same inf semantics
+    (a path that overflowed to inf recovers to r at its next reception)."""
+    # a = 10 with rare receptions: runs of ~300 losses overflow (10^308); 600 paths are three blocks
+    # of the compiled kernel, the last one ragged
+    arrivals = rng.random((600, 700, 2)) < 0.002
+    sensors = [Sensor([[1.0]], [[0.5]]), Sensor([[2.0]], [[0.8]])]
+    new = covariance_paths(5.0, [[10.0]], [[0.1]], sensors, arrivals, keep, kernel="compiled")
+    old = _original_scalar(5.0, 10.0, 0.1, [0.5, 0.2], arrivals, keep)
+    assert np.array_equal(np.isinf(new), np.isinf(old))
+    if keep == "all":
+        assert (np.isinf(old[:, :-1]) & np.isfinite(old[:, 1:])).any()  # overflow, then recovery, did happen
+    finite = np.isfinite(old)
+    assert np.allclose(new[finite], old[finite], rtol=1e-13, atol=0)
+
+
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
 @pytest.mark.parametrize("n", [2, 3])
 @pytest.mark.parametrize("keep", ["all", "last"])
-def test_small_state_kernel_matches_dense_form(rng, n, keep, monkeypatch):
+def test_small_state_kernel_matches_dense_form(rng, n, keep, kernel, monkeypatch):
     monkeypatch.setattr(ric, "CHUNK_PATHS", 23)
     A, Q, sensors = _system(rng, n)
     A = 0.8 * A / np.max(np.abs(np.linalg.eigvals(A)))
-    arrivals = rng.random((101, 40, 2)) < 0.5
-    fast = covariance_paths(np.eye(n), A, Q, sensors, arrivals, keep)
+    arrivals = rng.random((301, 40, 2)) < 0.5  # two blocks of the compiled kernel, the last one ragged
+    fast = covariance_paths(np.eye(n), A, Q, sensors, arrivals, keep, kernel=kernel)
     dense = ric._dense_paths(np.eye(n), A, Q, sensors, arrivals, keep)
     assert fast.shape == dense.shape
     assert np.allclose(fast, dense, rtol=1e-10, atol=1e-12)
 
 
-def test_small_state_kernel_handles_scalar_P0_like_dense(rng):
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+def test_small_state_kernel_handles_scalar_P0_like_dense(rng, kernel):
     A, Q, sensors = _system(rng, 2)
     arrivals = rng.random((7, 5, 2)) < 0.5
-    assert np.allclose(covariance_paths(2.0, 0.5 * A, Q, sensors, arrivals),
+    assert np.allclose(covariance_paths(2.0, 0.5 * A, Q, sensors, arrivals, kernel=kernel),
                        ric._dense_paths(2.0, 0.5 * A, Q, sensors, arrivals, "all"))
 
 
-def test_small_state_kernel_diverged_paths_stay_inf(rng):
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+def test_small_state_kernel_diverged_paths_stay_inf(rng, kernel):
     A = np.array([[3.0, 0.0], [0.0, 0.5]])  # the unstable mode is unobserved by sensor 2
     sensors = [Sensor([[0.0, 1.0]], [[1.0]])]
     arrivals = rng.random((6, 1500)) < 0.5
     arrivals[0] = False
-    out = covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="all")
+    out = covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="all", kernel=kernel)
     assert not np.isnan(out).any()
     dead_at = np.argmax(~np.isfinite(out).all(axis=(2, 3)), axis=1)
     assert np.all(dead_at > 0)
     for i, k in enumerate(dead_at):  # once non-finite, the whole matrix is inf for ever after
         assert np.isinf(out[i, k:]).all()
-    assert np.isinf(covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="last")).all()
+    assert np.isinf(covariance_paths(np.eye(2), A, np.eye(2), sensors, arrivals, keep="last", kernel=kernel)).all()
 
 
 def test_singular_noise_falls_back_to_dense_form(rng, monkeypatch):
@@ -95,9 +116,13 @@ def test_scalar_innovation_update_equals_solve(rng):
 
 
 def test_flop_count():
-    # n = 2, one row: u (12), s (4), w (1), t (2), update (6), prediction 2*9 = 18
-    assert packed_flops_per_step(2, 1) == 43
-    assert packed_flops_per_step(3, 2) == 2 * (36 + 6 + 1 + 3 + 12) + 72
+    # n = 2, one row, counted by hand: u = P c^T 4 mul + 2 add... as multiply-adds 4 (8 flops),
+    # s = c u + r 2 multiply-adds (4), w (1), t = w u (2), 3 entries updated (6), prediction
+    # 3 outputs x 3 multiply-adds (18): 39
+    assert packed_flops_per_step(2, 1) == 39
+    # n = 3: 9 (18) + 3 (6) + 1 + 3 + 6 (12) per row = 40, prediction 6 x 6 (72)
+    assert packed_flops_per_step(3, 2) == 2 * 40 + 72
+    assert packed_flops_per_step(1, 1) == 2 + 2 + 1 + 1 + 2 + 2
 
 
 # ----------------------------------------------------------------------------- bisection
@@ -147,13 +172,14 @@ def test_sweep_warm_start_matches_plain_and_needs_fewer_solves():
     assert sum(r.n_evals for r in warm) < 0.7 * sum(r.n_evals for r in plain)
 
 
-def test_small_state_kernel_is_exactly_symmetric_and_accurate():
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+def test_small_state_kernel_is_exactly_symmetric_and_accurate(kernel):
     """Over 200 steps of an unstable 3-state system: exact symmetry, and close to a long-double loop."""
     rng = np.random.default_rng(7)
     A = np.array([[1.1, 0.3, 0.0], [-0.2, 0.95, 0.1], [0.0, 0.2, 0.8]])
     c, r = np.ones(3) / np.sqrt(3), 0.5
     arrivals = rng.random((8, 200)) < 0.7
-    out = covariance_paths(np.eye(3), A, 0.1 * np.eye(3), [Sensor(c[None, :], [[r]])], arrivals)
+    out = covariance_paths(np.eye(3), A, 0.1 * np.eye(3), [Sensor(c[None, :], [[r]])], arrivals, kernel=kernel)
     assert np.array_equal(out, np.swapaxes(out, 2, 3))
     L = np.longdouble
     for i in range(8):

@@ -301,7 +301,7 @@ def run_blocked(tmp_path, blocked, code):
                           cwd=ROOT, timeout=120)
 
 
-@pytest.mark.parametrize("blocked", [["cvxpy"], ["clarabel"], ["papermill"], ["cvxpy", "nbconvert"]])
+@pytest.mark.parametrize("blocked", [["cvxpy"], ["clarabel"], ["papermill"], ["numba"], ["cvxpy", "nbconvert"]])
 def test_blocked_import_gives_clear_message(tmp_path, blocked):
     proc = run_blocked(tmp_path, blocked, """
         from netrepro.config import check_dependencies, DependencyError

@@ -318,13 +318,72 @@ def test_batched_scalar_recursion_diverges_to_inf_without_nan_or_warnings(rng):
     assert np.isinf(paths[1::2, -1]).all() and np.isfinite(paths[::2]).all()
 
 
-def test_batched_matrix_recursion_diverges_to_inf_without_nan_or_warnings(rng):
-    sensors = [Sensor([[1.0, 0.0]], [[0.5]]), Sensor([[0.0, 1.0]], [[0.5]])]
-    arrivals = iid_arrivals(rng, 40, 2500, [0.05, 0.05])
+UNSTABLE_2 = [[1.5, 0.2], [0.0, 1.2]]  # x1 (eigenvalue 1.5) is seen only by sensor 1
+SPLIT_SENSORS = [Sensor([[1.0, 0.0]], [[0.5]]), Sensor([[0.0, 1.0]], [[0.5]])]
+
+
+@pytest.mark.parametrize("kernel", ["compiled", "numpy", "dense"])
+def test_batched_matrix_recursion_overflows_to_inf_without_nan_or_warnings(rng, kernel):
+    arrivals = iid_arrivals(rng, 40, 2500, [0.5, 0.5])
+    arrivals[1::2, :, 0] = False  # odd paths never hear sensor 1: P_11 grows like 2.25^k, overflows near k = 875
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        paths = covariance_paths(np.eye(2), [[1.5, 0.2], [0.0, 1.2]], np.eye(2), sensors, arrivals)
-    assert not np.isnan(paths).any() and np.isinf(paths[:, -1]).all()
+        paths = covariance_paths(np.eye(2), UNSTABLE_2, np.eye(2), SPLIT_SENSORS, arrivals, kernel=kernel)
+    assert not np.isnan(paths).any()
+    assert np.isinf(paths[1::2, -1]).all() and np.isfinite(paths[::2]).all()
+
+
+def _decimal_paths(arrivals, horizon, digits=120):
+    """The recursion of the test above in 120-digit decimal arithmetic (the exact answer, to float64),
+    and for each step the largest c P c^T / r met so far (the conditioning of the updates)."""
+    from decimal import Decimal, localcontext
+
+    with localcontext() as ctx:
+        ctx.prec = digits
+        A = [[Decimal("1.5"), Decimal("0.2")], [Decimal(0), Decimal("1.2")]]
+        r = Decimal("0.5")
+        out, worst = [], []
+        for row in arrivals:
+            P, ratio, Ps, ratios = [[Decimal(1), Decimal(0)], [Decimal(0), Decimal(1)]], 0.0, [], []
+            Ps.append(P), ratios.append(ratio)
+            for k in range(horizon):
+                for j in range(2):
+                    ratio = max(ratio, float(P[j][j] / r))
+                    if row[k, j]:
+                        s, u = P[j][j] + r, [P[0][j], P[1][j]]
+                        P = [[P[a][b] - u[a] * u[b] / s for b in range(2)] for a in range(2)]
+                AP = [[sum(A[a][t] * P[t][b] for t in range(2)) for b in range(2)] for a in range(2)]
+                P = [[sum(AP[a][t] * A[b][t] for t in range(2)) + (a == b) for b in range(2)] for a in range(2)]
+                Ps.append(P), ratios.append(ratio)
+            out.append([[[float(x) for x in q] for q in P_] for P_ in Ps])
+            worst.append(ratios)
+    return np.array(out), np.array(worst)
+
+
+@pytest.mark.parametrize("kernel", ["compiled", "numpy", "dense"])
+def test_ill_conditioned_paths_are_accurate_to_the_conditioning_or_marked_inf(kernel):
+    """Rare receptions make c P c^T / r reach 1e16 and beyond (riccati.covariance_paths, "Numerical range").
+
+    While a path is finite its error against 120-digit arithmetic is at most a few eps times the
+    largest c P c^T / r met so far (the digits the covariance form keeps); it is marked inf once the
+    posterior along a measured row has no digit left, never before c P c^T / r reaches 1e14, and it
+    stays inf. No NaN, no warning.
+    """
+    rng = np.random.default_rng(0)
+    arrivals = iid_arrivals(rng, 8, 300, [0.05, 0.05])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        paths = covariance_paths(np.eye(2), UNSTABLE_2, np.eye(2), SPLIT_SENSORS, arrivals, kernel=kernel)
+    exact, ratio = _decimal_paths(arrivals, 300)
+    assert not np.isnan(paths).any()
+    finite = np.isfinite(paths).all(axis=(2, 3))
+    lost_at = np.where(finite.all(axis=1), 301, np.argmin(finite, axis=1))
+    assert (lost_at < 301).sum() >= 4  # the scenario does reach the end of float64's range
+    for i, k in enumerate(lost_at):
+        assert finite[i, :k].all() and np.isinf(paths[i, k:]).all()
+        assert k == 301 or ratio[i, k] >= 1e14
+        rel = np.abs(paths[i, :k] - exact[i, :k]).max(axis=(1, 2)) / np.abs(exact[i, :k]).max(axis=(1, 2))
+        assert np.all(rel <= 4 * np.finfo(float).eps * np.maximum(ratio[i, :k], 1.0))
 
 
 def test_expected_riccati_iteration_of_an_unstable_regime_has_no_nan():

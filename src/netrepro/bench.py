@@ -225,6 +225,7 @@ def reference_covariance_loop(P0, A, Q, c, r, arrivals, floats: bool = False) ->
     return out
 
 
+SCALAR_FLOPS_PER_STEP = 5  # p <- a^2 (r (p / (p + r))) + q: an add, a division, two multiplies, an add
 RICCATI_RTOL = 1e-6  # agreement of two correct float64 implementations over 200 steps of an unstable system
 
 
@@ -266,10 +267,15 @@ def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak
             scale = np.max(np.abs(ref_last), axis=(1, 2), keepdims=True)
             diff = float(np.max(np.abs(ours_last - ref_last) / scale))
             rate, ref_rate = n_paths * horizon / t_ours, ref_paths * horizon / t_ref
-            flops = 5 if n == 1 else packed_flops_per_step(n, 1)
+            flops = SCALAR_FLOPS_PER_STEP if n == 1 else packed_flops_per_step(n, 1)
             name = f"riccati_{kind}_n{n}"
             rows.append(BenchRow(name, "path_steps_per_s", rate, ref_rate, rate / ref_rate, "path-steps/s"))
-            if n > 1:  # against the batched dense form this kernel replaced (np.linalg.solve per update)
+            with _single_thread_blas():  # against the batched numpy kernel the compiled one replaced
+                t_np = median_time(lambda: covariance_paths(P0, A, Q, sensors, arr, keep="last", kernel="numpy"),
+                                   max(1, repeats // 2))
+            rows.append(BenchRow(name, "path_steps_per_s_vs_numpy_batched", rate, n_paths * horizon / t_np,
+                                 t_np / t_ours, "path-steps/s"))
+            if n > 1:  # against the batched dense form (np.linalg.solve per update)
                 from .engines.riccati import _dense_paths
 
                 sub = arr[: max(ref_paths, n_paths // 8)]

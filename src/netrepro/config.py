@@ -46,7 +46,7 @@ SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 # Used when the distribution metadata is unavailable (e.g. running from a source tree).
 REQUIRED_PACKAGES = (
     "snakemake>=9", "numpy>=2", "scipy>=1.12", "cvxpy>=1.5", "clarabel>=0.9", "matplotlib>=3.8", "pandas>=2.2",
-    "papermill>=2.6", "ipykernel>=6", "nbconvert>=7", "jsonschema>=4.20", "pyyaml>=6",
+    "papermill>=2.6", "ipykernel>=6", "nbconvert>=7", "jsonschema>=4.20", "pyyaml>=6", "numba>=0.60",
 )
 # Distribution name -> import name, where they differ.
 IMPORT_NAMES = {"pyyaml": "yaml", "scikit-learn": "sklearn"}
@@ -59,6 +59,7 @@ PURPOSE = {
     "ipykernel": "the kernel of the report notebooks",
     "jsonschema": "validating the configuration",
     "snakemake": "the workflow",
+    "numba": "the compiled covariance-recursion kernels",
 }
 
 

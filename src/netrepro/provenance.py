@@ -39,7 +39,7 @@ __all__ = [
 PARTIAL_MARK = ".part"
 
 TRACKED_PACKAGES = (
-    "numpy", "scipy", "cvxpy", "clarabel", "matplotlib", "pandas", "snakemake", "papermill",
+    "numpy", "scipy", "cvxpy", "clarabel", "numba", "matplotlib", "pandas", "snakemake", "papermill",
 )
 
 

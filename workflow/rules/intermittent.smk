@@ -8,7 +8,7 @@ MC_KEYS = ("a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "bloc
 
 rule intermittent_exact_mean:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py"),
+        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py"),
     output:
         table="results/intermittent/exact_mean.csv",
     params:
@@ -24,7 +24,7 @@ rule intermittent_exact_mean:
 
 rule intermittent_monte_carlo_shard:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py", "engines/channels.py", "engines/montecarlo.py"),
+        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py", "engines/channels.py", "engines/montecarlo.py"),
     output:
         sums="results/intermittent/shards/monte_carlo_{shard}.npz",
     wildcard_constraints:
@@ -142,7 +142,7 @@ rule intermittent_two_sensor_region:
 
 rule intermittent_two_sensor_simulation:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py", "engines/montecarlo.py"),
+        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py", "engines/montecarlo.py"),
     output:
         table="results/intermittent/two_sensor_simulation.csv",
     params:

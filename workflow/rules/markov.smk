@@ -91,7 +91,7 @@ rule markov_stability_map:
 
 rule markov_sample_paths:
     input:
-        code=src(*MARKOV_CODE, "engines/riccati.py", "engines/channels.py"),
+        code=src(*MARKOV_CODE, "engines/riccati.py", "engines/kernels.py", "engines/channels.py"),
         moments="results/markov/exact_moments.csv",
     output:
         table="results/markov/sample_paths.csv",

@@ -15,6 +15,11 @@ the stacked received rows (Liu & Goldsmith 2004, eq. (14) of the report).
 Everything here is batched over sample paths: ``P`` has shape ``(N, n, n)``
 (or ``(N,)`` on the scalar fast path) and the loop runs over time only.
 Diverging paths are kept as ``inf`` (never NaN).
+
+Three implementations of :func:`covariance_paths`, which agree to rounding: the compiled
+kernels of :mod:`netrepro.engines.kernels` (default for n <= 3; one fused loop per step,
+vectorised across paths), the batched numpy kernels below (``kernel="numpy"``; a fixed handful
+of array calls per step), and the dense ``(N, n, n)`` form (any n; the reference form).
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import kernels
 from .channels import arrival_patterns
 
 __all__ = [
@@ -84,7 +90,7 @@ def measurement_update(P: np.ndarray, sensor: Sensor, received: np.ndarray) -> n
     return np.where(received[:, None, None], post, P)
 
 
-def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all") -> np.ndarray:
+def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all", kernel: str = "compiled") -> np.ndarray:
     """Prediction-error covariances along many loss sequences at once (eq. (4) / (14)).
 
     Parameters
@@ -96,11 +102,26 @@ def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all")
     arrivals : bool array ``(N, T)`` (one sensor) or ``(N, T, n_sensors)``
     keep : ``"all"`` returns ``P_0..P_T`` with shape ``(N, T+1, n, n)``;
         ``"last"`` returns ``P_T`` with shape ``(N, n, n)``.
+    kernel : ``"compiled"`` (default) runs n <= 3 on the fused numba kernels of
+        :mod:`netrepro.engines.kernels`; ``"numpy"`` on the batched numpy kernels (the
+        reference form the benchmark and tests compare with); ``"dense"`` on the plain
+        ``(N, n, n)`` batches with one LAPACK-style update per sensor. All three agree to
+        rounding; n > 3 (or a sensor noise that is not positive definite) always runs dense.
 
     Notes
     -----
     The scalar case (n = 1, scalar sensors) runs on flat arrays and returns
     shapes ``(N, T+1)`` / ``(N,)``. Paths that diverge become ``inf``.
+
+    Numerical range: the covariance-form update ``P - P c^T c P / (c P c^T + r)`` leaves a
+    posterior variance of about ``r`` along ``c`` as the difference of two numbers of size
+    ``c P c^T``; once ``c P c^T / r`` nears 1/eps (~1e15; e.g. an unobserved unstable mode after
+    a long loss run) no digit of it survives, the computed ``P`` stops being a covariance and its
+    later values are rounding noise, different for each implementation. Every kernel checks,
+    after each update, the posterior ``c P c^T`` against its exact value, ``r - r^2 / (s0 + r)``
+    after a reception (a form free of cancellation; ``s0 = c P c^T`` before the update) and ``s0``
+    after a loss, and marks a path that misses it by more than ``r / 2`` as ``inf`` from then on, as if it had overflowed: its covariance has
+    left what float64 can follow in this form. Below that range the check never fires.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
@@ -113,15 +134,74 @@ def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all")
     N, T = arrivals.shape[:2]
     if keep not in ("all", "last"):
         raise ValueError(f"keep must be 'all' or 'last', got {keep!r}")
+    if kernel not in KERNELS:
+        raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
 
-    if _is_scalar_problem(A, sensors):
-        return _scalar_paths(float(np.asarray(P0, dtype=float).reshape(-1)[0]), float(A[0, 0]), float(Q[0, 0]),
-                             [float(s.R[0, 0]) / float(s.C[0, 0]) ** 2 for s in sensors], arrivals, keep)
-    if n <= PACKED_MAX_STATES:
+    if kernel != "dense" and _is_scalar_problem(A, sensors):
+        scalar = _compiled_scalar_paths if kernel == "compiled" else _scalar_paths
+        return scalar(float(np.asarray(P0, dtype=float).reshape(-1)[0]), float(A[0, 0]), float(Q[0, 0]),
+                      [float(s.R[0, 0]) / float(s.C[0, 0]) ** 2 for s in sensors], arrivals, keep)
+    if kernel != "dense" and n <= PACKED_MAX_STATES:
         rows = _whitened_rows(sensors)
         if rows is not None:
-            return _small_paths(np.atleast_2d(np.asarray(P0, dtype=float)), A, Q, rows, arrivals, keep)
+            small = _compiled_small_paths if kernel == "compiled" else _small_paths
+            return small(np.atleast_2d(np.asarray(P0, dtype=float)), A, Q, rows, arrivals, keep)
     return _dense_paths(P0, A, Q, sensors, arrivals, keep)
+
+
+KERNELS = ("compiled", "numpy", "dense")
+
+
+def _compiled_scalar_paths(p0, a, q, r_eff, arrivals, keep):
+    """:func:`_scalar_paths` on the fused compiled kernel (one division per update; equal to rounding)."""
+    N, T, _ = arrivals.shape
+    hist = np.empty((N, T + 1)) if keep == "all" else np.empty((N, 0))
+    last = np.empty(N)
+    kernels.scalar_kernel()(p0, a * a, q, np.asarray(r_eff, dtype=float), kernels.arrival_words(arrivals), T,
+                            hist, last)
+    return hist if keep == "all" else last
+
+
+def _compiled_small_paths(P0, A, Q, rows, arrivals, keep):
+    """:func:`_small_paths` on the fused compiled kernel (packed symmetric state, FMAs)."""
+    n = A.shape[0]
+    N, T, _ = arrivals.shape
+    P0_given = np.broadcast_to(P0, (n, n))
+    a_idx, b_idx = np.triu_indices(n)
+    p0 = 0.5 * (P0_given[a_idx, b_idx] + P0_given[b_idx, a_idx])
+    M, q = kernels.packed_prediction(A, Q)
+    rows_c = np.array([c for _, c, _ in rows], dtype=float).reshape(len(rows), n)
+    rows_r = np.array([r for _, _, r in rows], dtype=float)
+    rows_channel = np.array([j for j, _, _ in rows], dtype=np.int64)
+    c = len(p0)
+    hist = np.empty((N, T + 1, c)) if keep == "all" else np.empty((N, 0, c))
+    last = np.empty((N, c))
+    kernels.small_state_kernel(n)(p0, M, q, rows_c, rows_r, rows_channel, kernels.arrival_words(arrivals),
+                                  arrivals.shape[2], T, hist, last)
+    full = kernels.packed_index(n).ravel()
+    if keep == "last":
+        return last[:, full].reshape(N, n, n)
+    out = hist[:, :, full].reshape(N, T + 1, n, n)
+    out[:, 0] = P0_given
+    return out
+
+
+def _lost_precision(prior, post, sensor, received):
+    """Paths whose update lost the measured directions to rounding (see :func:`covariance_paths`).
+
+    In exact arithmetic ``C P+ C^T = S0 - S0 S^{-1} S0 = R - R S^{-1} R`` (``S0 = C P C^T``,
+    ``S = S0 + R``) after a reception, the second form free of cancellation, and ``S0`` after a
+    loss; a path is lost when the stored posterior misses that by more than
+    ``LOST_TOLERANCE`` times the smallest noise variance, or when ``S0`` has a negative diagonal
+    entry (impossible for a covariance).
+    """
+    C, R = sensor.C, sensor.R
+    S0 = C @ prior @ C.T
+    with np.errstate(invalid="ignore", over="ignore"):
+        updated = R - R @ np.linalg.solve(S0 + R, np.broadcast_to(R, S0.shape))
+        want = np.where(received[:, None, None], updated, S0)
+        err = np.abs(C @ post @ C.T - want).max(axis=(1, 2))
+    return (np.diagonal(S0, axis1=1, axis2=2) < 0).any(axis=1) | (err > kernels.LOST_TOLERANCE * np.diag(R).min())
 
 
 def _dense_paths(P0, A, Q, sensors, arrivals, keep):
@@ -135,7 +215,9 @@ def _dense_paths(P0, A, Q, sensors, arrivals, keep):
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(T):
             for j, sensor in enumerate(sensors):
+                prior = P
                 P = measurement_update(P, sensor, arrivals[:, k, j])
+                P[_lost_precision(prior, P, sensor, arrivals[:, k, j])] = np.nan  # inf below
             P = A @ P @ A.T + Q
             P[~np.isfinite(P).all(axis=(1, 2))] = np.inf
             if out is not None:
@@ -217,14 +299,16 @@ def _whitened_rows(sensors):
 def packed_flops_per_step(n: int, n_rows: int) -> int:
     """Floating-point operations one path-step needs (symmetric storage, dense coefficients).
 
-    Per scalar row ``c``: ``u = P c^T`` (2 n c), ``s = c u + r`` (2 n), ``w = gamma / s`` (1),
-    ``t = w u`` (n), ``P -= t u^T`` on the ``c = n (n + 1) / 2`` distinct entries (2 c);
-    prediction ``A P A^T + Q`` as a map on the distinct entries (2 c^2). Multiply-adds count
-    as two. This is the count the benchmark's "fraction of peak" uses; the kernel itself
-    works on all n^2 entries (more flops, fewer and larger numpy calls).
+    Per scalar row ``c``: ``u = P c^T`` (``n^2`` multiply-adds), ``s = c u + r`` (``n``
+    multiply-adds), ``w = gamma / s`` (1), ``t = w u`` (n), ``P -= t u^T`` on the
+    ``m = n (n + 1) / 2`` distinct entries (``m`` multiply-adds); the prediction
+    ``A P A^T + Q`` as a map on the distinct entries (``m^2`` multiply-adds). A multiply-add
+    counts as two flops. This is the count of the compiled kernel
+    (:func:`netrepro.engines.kernels.small_state_kernel`) and the one the benchmark's
+    "fraction of peak" uses; the numpy kernel works on all ``n^2`` entries (more flops).
     """
-    c = n * (n + 1) // 2
-    return n_rows * (2 * n * c + 2 * n + 1 + n + 2 * c) + 2 * c * c
+    m = n * (n + 1) // 2
+    return n_rows * (2 * n * n + 2 * n + 1 + n + 2 * m) + 2 * m * m
 
 
 def _small_operators(A, Q, rows):
@@ -293,7 +377,7 @@ def _small_paths(P0, A, Q, rows, arrivals, keep):
             pa[n2] = 1.0
             p = pa[:n2]
             upper = np.empty((Maug.shape[0], B))
-            us, w = np.empty((n + 1, B)), np.empty(B)
+            us, w, check = np.empty((n + 1, B)), np.empty(B), np.empty((n + 1, B))
             v, outer = np.empty((n, B)), np.empty((n, n, B))
             outer_flat = outer.reshape(n2, B)
             dead = None
@@ -303,12 +387,18 @@ def _small_paths(P0, A, Q, rows, arrivals, keep):
                 for S, r, j in zip(Ss, rs, chan):
                     np.matmul(S, p, out=us)
                     s = us[n]
+                    s0 = s.copy()
                     s += r
                     np.divide(gam[k, j], s, out=w)
                     np.sqrt(w, out=w)
                     np.multiply(us[:n], w, out=v)
                     np.multiply(v[:, None, :], v[None, :, :], out=outer)
                     p -= outer_flat
+                    np.matmul(S, p, out=check)  # accuracy check, see covariance_paths
+                    exact = np.where(gam[k, j] > 0, r - r * (r / s), s0)
+                    lost = (s0 < 0) | (np.abs(check[n] - exact) > kernels.LOST_TOLERANCE * r)
+                    if lost.any():
+                        p[:, lost] = np.nan
                 np.matmul(Maug, pa, out=upper)
                 np.take(upper, full, axis=0, out=p)
                 if not np.isfinite(p.sum()):
