@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import netrepro.engines.riccati as ric
 from netrepro.engines.lmi import bisect_bracketed, bisect_monotone, sweep_thresholds
@@ -141,7 +143,7 @@ def test_bracketed_bisection_agrees_with_plain(guess, width):
     plain = bisect_monotone(f, 0.0, 1.0, tol=1e-6)
     warm = bisect_bracketed(f, 0.0, 1.0, guess, width, tol=1e-6)
     assert warm.bracketed and warm.lower < 0.3137 <= warm.threshold
-    assert abs(warm.threshold - plain.threshold) <= 1e-6
+    assert (warm.threshold, warm.lower) == (plain.threshold, plain.lower)  # same lattice point, whatever the guess
     assert warm.threshold - warm.lower <= 1e-6
 
 
@@ -149,6 +151,19 @@ def test_bracketed_bisection_saves_solves_with_a_good_guess():
     f, calls = _step(0.3137)
     bisect_bracketed(f, 0.0, 1.0, 0.3136, 2e-4, tol=1e-6)
     assert len(calls) <= 12 < bisect_monotone(_step(0.3137)[0], 0.0, 1.0, tol=1e-6).n_evals
+
+
+@settings(max_examples=200, deadline=None)
+@given(threshold=st.floats(-0.5, 2.5), guess=st.floats(-1.0, 3.0), width=st.floats(0.0, 2.0),
+       lo=st.floats(-1.0, 0.5), span=st.floats(1e-3, 2.0), tol=st.floats(1e-7, 0.1))
+def test_bracketed_and_plain_bisection_return_the_same_lattice_point(threshold, guess, width, lo, span, tol):
+    hi = lo + span
+    plain = bisect_monotone(_step(threshold)[0], lo, hi, tol=tol)
+    warm = bisect_bracketed(_step(threshold)[0], lo, hi, guess, width, tol=tol)
+    assert warm.bracketed == plain.bracketed
+    assert np.array_equal([warm.threshold, warm.lower], [plain.threshold, plain.lower], equal_nan=True)
+    if plain.bracketed:
+        assert plain.lower < threshold <= plain.threshold and plain.threshold - plain.lower <= tol
 
 
 @pytest.mark.parametrize("threshold,expected", [(-1.0, 0.0), (2.0, np.nan)])
@@ -167,7 +182,7 @@ def test_sweep_warm_start_matches_plain_and_needs_fewer_solves():
     warm = sweep_thresholds(make, grid, 0.0, 1.0, tol=1e-5)
     plain = sweep_thresholds(make, grid, 0.0, 1.0, tol=1e-5, warm_start=False)
     for w, p, x in zip(warm, plain, grid):
-        assert abs(w.threshold - p.threshold) <= 1e-5
+        assert w.threshold == p.threshold  # warm starts change the solves, not the answers
         assert w.threshold >= curve(x) - 1e-12
     assert sum(r.n_evals for r in warm) < 0.7 * sum(r.n_evals for r in plain)
 

@@ -49,22 +49,38 @@ class BisectionResult:
     bracketed: bool  # True when lo was infeasible and hi feasible
 
 
-def _halve(check, a, b, tol, history, max_evals) -> BisectionResult:
-    """Halve a bracket (a infeasible, b feasible) until it is at most ``tol`` wide."""
-    while b - a > tol and len(history) < max_evals:
-        mid = 0.5 * (a + b)
-        if check(mid):
+def _lattice(lo: float, hi: float, tol: float, max_evals: int):
+    """The points a bisection of ``[lo, hi]`` to width ``tol`` can visit: ``lo + (hi - lo) j / n``.
+
+    ``n = 2^L`` with ``L`` the number of halvings that bring ``hi - lo`` to at most ``tol``
+    (capped so that the ends and the halvings fit in ``max_evals``). Plain and bracketed
+    bisections evaluate only these points, so for a monotone predicate both end on the same
+    smallest feasible point, whatever the starting bracket.
+    """
+    levels = 0
+    while (hi - lo) / 2.0 ** levels > tol and levels < max(max_evals - 2, 0):
+        levels += 1
+    n = 2 ** levels
+    return n, (lambda j: lo + (hi - lo) * (j / n))
+
+
+def _halve(check, point, a, b, history) -> BisectionResult:
+    """Halve a bracket of lattice indices (``a`` infeasible, ``b`` feasible) to adjacent points."""
+    while b - a > 1:
+        mid = (a + b) // 2
+        if check(point(mid)):
             b = mid
         else:
             a = mid
-    return BisectionResult(b, a, len(history), history, True)
+    return BisectionResult(point(b), point(a), len(history), history, True)
 
 
 def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_evals: int = 60) -> BisectionResult:
     """Smallest x in [lo, hi] with ``is_feasible(x)`` for a monotone predicate (False ... False True ... True).
 
     The ends are evaluated first; if ``lo`` is feasible, the threshold is ``lo``;
-    if ``hi`` is infeasible the result has ``threshold = nan``.
+    if ``hi`` is infeasible the result has ``threshold = nan``. Otherwise the bracket is
+    halved until it is at most ``tol`` wide; the threshold is a point of :func:`_lattice`.
     """
     history = []
 
@@ -73,25 +89,27 @@ def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_ev
         history.append((float(x), ok))
         return ok
 
-    if check(lo):
+    n, point = _lattice(lo, hi, tol, max_evals)
+    if check(point(0)):
         return BisectionResult(lo, np.nan, len(history), history, False)
-    if not check(hi):
+    if not check(point(n)):
         return BisectionResult(np.nan, hi, len(history), history, False)
-    a, b = lo, hi
-    return _halve(check, a, b, tol, history, max_evals)
+    return _halve(check, point, 0, n, history)
 
 
 def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: float, tol: float = 1e-4,
                      max_evals: int = 60) -> BisectionResult:
-    """:func:`bisect_monotone` warm-started from a guess of the threshold.
+    """:func:`bisect_monotone` warm-started from a guess of the threshold; the same answer.
 
-    The first bracket is ``[guess - width, guess + width]`` (clipped to ``[lo, hi]``);
-    while an end is on the wrong side it moves outwards by doubling steps, and
-    reaching ``lo`` feasible or ``hi`` infeasible gives the same answers as
-    :func:`bisect_monotone` (threshold ``lo``, or ``nan``). Then the bracket is
-    halved until it is at most ``tol`` wide. With a good guess this needs
-    about ``2 + log2(2 width / tol)`` evaluations instead of ``2 + log2((hi - lo) / tol)``.
-    The threshold agrees with :func:`bisect_monotone`'s to within ``tol``.
+    The first bracket is ``[guess - width, guess + width]`` (clipped to ``[lo, hi]``; at least one
+    lattice cell each side, so ``width = 0`` means the lattice points next to the guess) on the
+    lattice of :func:`bisect_monotone`; while an end is on the wrong side it moves outwards by
+    doubling steps, and reaching ``lo`` feasible or ``hi`` infeasible gives the same answers as
+    :func:`bisect_monotone` (threshold ``lo``, or ``nan``). Then the bracket is halved to two
+    adjacent lattice points. For a monotone predicate the threshold and the lower end are
+    exactly those of :func:`bisect_monotone` (both are the smallest feasible lattice point and
+    its neighbour), so the guess changes the number of evaluations, never the answer. With a
+    good guess that is about ``2 + log2(2 width / tol)`` instead of ``2 + log2((hi - lo) / tol)``.
     """
     if not lo <= hi:
         raise ValueError(f"bisect_bracketed needs lo <= hi, got lo={lo}, hi={hi}")
@@ -104,27 +122,29 @@ def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: flo
         history.append((float(x), ok))
         return ok
 
-    width = max(float(width), tol)
-    guess = min(max(float(guess), lo), hi)
-    step = width
-    b = min(hi, guess + width)
-    a = None  # largest point known infeasible
-    while not check(b):
+    n, point = _lattice(lo, hi, tol, max_evals)
+    cell = (hi - lo) / n if n else 1.0
+    centre = int(round((min(max(float(guess), lo), hi) - lo) / cell)) if hi > lo else 0
+    half = max(1, int(np.ceil(float(width) / cell))) if cell > 0 else 1
+    step = half
+    b = min(n, centre + half)
+    a = None  # largest index known infeasible
+    while not check(point(b)):
         a = b
-        if b >= hi:
+        if b >= n:
             return BisectionResult(np.nan, hi, len(history), history, False)
-        step *= 2.0
-        b = min(hi, b + step)
+        step *= 2
+        b = min(n, b + step)
     if a is None:
-        step = width
-        a = max(lo, min(guess - width, b - width))
-        while check(a):
+        step = half
+        a = max(0, min(centre - half, b - half))
+        while check(point(a)):
             b = a
-            if a <= lo:
+            if a <= 0:
                 return BisectionResult(lo, np.nan, len(history), history, False)
-            step *= 2.0
-            a = max(lo, a - step)
-    return _halve(check, a, b, tol, history, max_evals)
+            step *= 2
+            a = max(0, a - step)
+    return _halve(check, point, a, b, history)
 
 
 def sweep_thresholds(make_predicate, grid, lo: float, hi: float, tol: float = 1e-4, max_evals: int = 60,
@@ -137,7 +157,8 @@ def sweep_thresholds(make_predicate, grid, lo: float, hi: float, tol: float = 1e
     the extrapolation of the previous bracketed thresholds (quadratic from three,
     width the second difference; linear from two, width half the last change;
     at least ``2 tol``). ``warm_start=False`` runs plain bisections throughout
-    (the reference). Every threshold agrees with a plain bisection's to within ``tol``.
+    (the reference). For monotone predicates every threshold equals the plain bisection's
+    exactly (:func:`bisect_bracketed`); only the number of solves changes.
     """
     results, found = [], []
     for x in grid:

@@ -42,7 +42,7 @@ from scipy import optimize
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from ..config import ConfigError
 from ..engines.channels import arrival_patterns, iid_arrivals
-from ..engines.lmi import MareStabilizabilityLMI, bisect_monotone
+from ..engines.lmi import MareStabilizabilityLMI, bisect_bracketed
 from ..engines.montecarlo import load_sums, merge_block_sums, run_blocks, run_monte_carlo, save_sums, shard_blocks
 from ..engines.riccati import Sensor, covariance_paths
 from ..io import read_table
@@ -247,8 +247,9 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
     Feasibility of eq. (16) is decided by the LMI of
     :class:`~netrepro.engines.lmi.MareStabilizabilityLMI` (one parametrised
     problem for the whole sweep) and certified by the spectral radius of the
-    closed-loop second-moment operator; lambda2 is found by an independent
-    bisection at each grid point (so sharding the grid cannot change any answer).
+    closed-loop second-moment operator; lambda2 is found by a bisection at each grid
+    point bracketed from the closed-form lower bound of that point (so sharding the grid
+    cannot change any answer, and a plain bisection would return the same lattice point).
     The noise terms of phi do not affect feasibility (the condition is
     homogeneous in X), so the bound depends on a and the C_i only.
 
@@ -268,10 +269,13 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
 
         return feasible
 
-    # one plain bisection per grid point: a point's answer must not depend on which other points share
-    # its shard (warm starts from neighbours, engines.lmi.sweep_thresholds, save ~40% of the solves but
-    # make the thresholds depend on the shard split, within tol)
-    results = [bisect_monotone(make_predicate(lam1), 0.0, 1.0, tol=tol) for lam1 in grid]
+    # each point's bisection starts from its own closed-form lower bound (a guess only: the LMI still
+    # decides both ends of the final bracket, and for a monotone predicate the answer is the plain
+    # bisection's, engines.lmi.bisect_bracketed); nothing depends on the neighbours, so no shard
+    # split can change an answer
+    guesses = two_sensor_lower_bound(grid, a)
+    results = [bisect_bracketed(make_predicate(lam1), 0.0, 1.0, guess, 0.0, tol=tol)  # one lattice cell each side
+               for lam1, guess in zip(grid, guesses)]
     rows = []
     for lam1, res in zip(grid, results):
         seen_outcomes = outcomes[float(lam1)]
