@@ -12,6 +12,7 @@ import pytest
 import yaml
 from scipy import integrate, linalg, stats
 
+from netrepro.engines.kernels import scalar_information_steps
 from netrepro.claims import CLAIM_COLUMNS, ERRATA_COLUMNS, RECONSTRUCTION_COLUMNS
 from netrepro.config import ConfigError
 from netrepro.papers import onebit as ob
@@ -382,3 +383,27 @@ def test_config_sections_validate(name):
     schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents
     jsonschema.Draft202012Validator(schema).validate(section)
     ob.check_config(section)
+
+
+def test_compiled_bim_steps_equal_numpy_loop_and_general_recursion_7():
+    """(24)/(34) as compiled: bit-identical to the numpy loop it replaced, and equal to the general (7)
+    with the random walk's D11 = a^2/s, D12 = -a/s, D22 = 1/s (an independent form)."""
+    rng = np.random.default_rng(3)
+    a2, s2 = 0.98**2, rng.uniform(0.01, 2.0, 6)
+    F = rng.uniform(0.0, 3.0, (50, 6))
+    j0 = rng.uniform(0.1, 5.0, 6)
+    j, J = j0.copy(), np.empty_like(F)
+    scalar_information_steps(j, a2, s2, F, J)
+    ref, tmp, out = j0.copy(), np.empty(6), []
+    for i in range(len(F)):  # the numpy form
+        np.divide(a2, ref, out=tmp)
+        tmp += s2
+        np.divide(1.0, tmp, out=ref)
+        ref += F[i]
+        out.append(ref.copy())
+    assert np.array_equal(J, np.array(out)) and np.array_equal(j, J[-1])
+    a = np.sqrt(a2)
+    for lane in range(6):
+        s = s2[lane]
+        general = ob.filtering_bims(j0[lane], a2 / s, -a / s, 1.0 / s, F[:, lane].reshape(-1, 1, 1), len(F))
+        assert np.allclose(general[1:, 0, 0], J[:, lane], rtol=1e-12)

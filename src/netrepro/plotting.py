@@ -1,13 +1,14 @@
-"""Deterministic figure output: Agg backend, fixed style, no date or version stamps."""
+"""Deterministic figure output: Agg backend, fixed style, no date or version stamps.
+
+matplotlib is imported on first use, not with this module: the paper modules import it, and
+the workflow imports every paper module at start-up to validate the configuration.
+"""
 
 from __future__ import annotations
 
-import matplotlib
+from functools import lru_cache
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from .io import atomic_path  # noqa: E402
+from .io import atomic_path
 
 __all__ = ["STYLE", "new_figure", "save_figure"]
 
@@ -25,8 +26,19 @@ STYLE = {
 }
 
 
+@lru_cache(maxsize=None)
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def new_figure(nrows=1, ncols=1, figsize=(6.4, 4.0), **kw):
     """A figure and axes under the project style."""
+    plt = _pyplot()
     with plt.rc_context(STYLE):
         fig, axes = plt.subplots(nrows, ncols, figsize=figsize, **kw)
     return fig, axes
@@ -34,6 +46,7 @@ def new_figure(nrows=1, ncols=1, figsize=(6.4, 4.0), **kw):
 
 def save_figure(fig, path) -> None:
     """Save atomically as PNG without software/date metadata, then close the figure."""
+    plt = _pyplot()
     with plt.rc_context(STYLE), atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
     plt.close(fig)

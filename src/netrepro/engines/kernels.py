@@ -1,4 +1,5 @@
-"""Compiled (numba) kernels of the batched covariance recursion, for state dimension 1 to 3.
+"""Compiled (numba) kernels: the batched covariance recursion for state dimension 1 to 3, and the
+scalar information recursion of the `onebit` paper.
 
 The numpy kernels of :mod:`netrepro.engines.riccati` make a fixed handful of array calls per
 time step, so each step streams the whole batch through memory several times and reaches a
@@ -26,13 +27,10 @@ import numpy as np
 from numba import njit
 
 __all__ = ["packed_index", "packed_prediction", "arrival_words", "small_state_kernel", "scalar_kernel",
-           "BLOCK_PATHS"]
+           "scalar_information_steps", "BLOCK_PATHS"]
 
 BLOCK_PATHS = 256  # paths per block: state, gains and arrivals of a block stay in the L1/L2 cache
 _ROW_PAD = 8  # doubles added to each row of a block buffer (see module docstring)
-# A path is lost when its posterior variance along a measured row misses the exact value by more
-# than this fraction of the row's noise variance (riccati.covariance_paths, "Numerical range").
-LOST_TOLERANCE = 0.5
 
 
 def packed_index(n: int) -> np.ndarray:
@@ -103,12 +101,14 @@ def _transpose_block(words, lo, B, out):
 def small_state_kernel(n: int):
     """Compiled recursion for state dimension ``n`` (eq. (4) / (14) of the `intermittent` report).
 
-    ``kernel(p0, M, q, rows_c, rows_r, rows_channel, words, n_channels, T, hist, last)`` runs, for every
+    ``kernel(p0, M, q, rows_c, rows_r, rows_channel, words, n_channels, T, lost_tolerance, hist, last)``
+    runs, for every
     path and step ``k``: for each scalar measurement row ``c`` (noise variance ``r``, gated by
     the arrival of its channel) ``P <- P - gamma (P c^T)(c P) / (c P c^T + r)``, then
     ``P <- M P + q`` (:func:`packed_prediction`); a path with a non-finite entry becomes
-    ``inf`` in every entry and stays so, and so does a path whose update lost the measured
-    direction to rounding (:func:`netrepro.engines.riccati.covariance_paths`, "Numerical range"). ``words`` are the arrivals from
+    ``inf`` in every entry and stays so, and so does a path whose posterior variance along a row
+    misses its exact value by more than ``lost_tolerance * r`` (the update lost the measured
+    direction to rounding: :func:`netrepro.engines.riccati.covariance_paths`, "Numerical range"). ``words`` are the arrivals from
     :func:`arrival_words`; ``hist`` is ``(N, T + 1, c)`` (the packed ``P_0 .. P_T``; ``T`` is
     taken from it) and ``last`` (``(N, c)``) receives ``P_T``.
     """
@@ -119,7 +119,7 @@ def small_state_kernel(n: int):
 
     # contract: multiply-adds become FMAs (one rounding instead of two; not reassociation)
     @njit(cache=True, boundscheck=False, error_model="numpy", fastmath={"contract"})
-    def kernel(p0, M, q, rows_c, rows_r, rows_channel, words, n_channels, T, hist, last):
+    def kernel(p0, M, q, rows_c, rows_r, rows_channel, words, n_channels, T, lost_tolerance, hist, last):
         N = words.shape[0]
         n_rows = rows_c.shape[0]
         keep_all = hist.shape[1] > 0
@@ -167,7 +167,7 @@ def small_state_kernel(n: int):
                         r = rows_r[row]
                         s0 = s - r
                         exact = (r - r * (r / s)) if g else s0
-                        lost = (s0 < 0.0) | (abs(v - exact) > LOST_TOLERANCE * r)
+                        lost = (s0 < 0.0) | (abs(v - exact) > lost_tolerance * r)
                         p[0, i] = np.nan if lost else p[0, i]
                 for i in range(B):
                     total = 0.0
@@ -239,3 +239,21 @@ def scalar_kernel():
                 last[lo + i] = p[i]
 
     return kernel
+
+
+@njit(cache=True)
+def scalar_information_steps(j, a2, s2, F, J):
+    """Scalar information (Fisher/BIM) recursion, one step per row of ``F``: ``j <- 1 / (a2 / j + s2) + F[i]``.
+
+    The filtering BIM of a scalar random walk ``theta_k = a theta_{k-1} + w_k`` (``Var w = s2``)
+    observed with Fisher information ``F`` per step: eqs. (24) and (34) of the `onebit` paper,
+    the special case of its general (7) with ``D11 = a^2 / s2``, ``D12 = -a / s2``,
+    ``D22 = 1 / s2``. In place on ``j`` (one lane per independent recursion); ``J[i]`` receives
+    ``j`` after step ``i``. Sequential in the step by nature; compiled because a numpy loop over
+    ~1e6 steps of a few dozen lanes is all interpreter overhead. Same operations in the same
+    order as that numpy loop, so bit-identical to it.
+    """
+    for i in range(F.shape[0]):
+        for lane in range(j.shape[0]):
+            j[lane] = 1.0 / (a2 / j[lane] + s2[lane]) + F[i, lane]
+            J[i, lane] = j[lane]

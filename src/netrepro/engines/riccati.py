@@ -28,7 +28,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
 from .channels import arrival_patterns
 
 __all__ = [
@@ -150,10 +149,15 @@ def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all",
 
 
 KERNELS = ("compiled", "numpy", "dense")
+# A path is lost when its posterior variance along a measured row misses the exact value by more
+# than this fraction of the row's noise variance (covariance_paths, "Numerical range").
+LOST_TOLERANCE = 0.5
 
 
 def _compiled_scalar_paths(p0, a, q, r_eff, arrivals, keep):
     """:func:`_scalar_paths` on the fused compiled kernel (one division per update; equal to rounding)."""
+    from . import kernels  # numba: imported by the steps that run a recursion, not at workflow start-up
+
     N, T, _ = arrivals.shape
     hist = np.empty((N, T + 1)) if keep == "all" else np.empty((N, 0))
     last = np.empty(N)
@@ -164,6 +168,8 @@ def _compiled_scalar_paths(p0, a, q, r_eff, arrivals, keep):
 
 def _compiled_small_paths(P0, A, Q, rows, arrivals, keep):
     """:func:`_small_paths` on the fused compiled kernel (packed symmetric state, FMAs)."""
+    from . import kernels
+
     n = A.shape[0]
     N, T, _ = arrivals.shape
     P0_given = np.broadcast_to(P0, (n, n))
@@ -177,7 +183,7 @@ def _compiled_small_paths(P0, A, Q, rows, arrivals, keep):
     hist = np.empty((N, T + 1, c)) if keep == "all" else np.empty((N, 0, c))
     last = np.empty((N, c))
     kernels.small_state_kernel(n)(p0, M, q, rows_c, rows_r, rows_channel, kernels.arrival_words(arrivals),
-                                  arrivals.shape[2], T, hist, last)
+                                  arrivals.shape[2], T, LOST_TOLERANCE, hist, last)
     full = kernels.packed_index(n).ravel()
     if keep == "last":
         return last[:, full].reshape(N, n, n)
@@ -201,7 +207,7 @@ def _lost_precision(prior, post, sensor, received):
         updated = R - R @ np.linalg.solve(S0 + R, np.broadcast_to(R, S0.shape))
         want = np.where(received[:, None, None], updated, S0)
         err = np.abs(C @ post @ C.T - want).max(axis=(1, 2))
-    return (np.diagonal(S0, axis1=1, axis2=2) < 0).any(axis=1) | (err > kernels.LOST_TOLERANCE * np.diag(R).min())
+    return (np.diagonal(S0, axis1=1, axis2=2) < 0).any(axis=1) | (err > LOST_TOLERANCE * np.diag(R).min())
 
 
 def _dense_paths(P0, A, Q, sensors, arrivals, keep):
@@ -396,7 +402,7 @@ def _small_paths(P0, A, Q, rows, arrivals, keep):
                     p -= outer_flat
                     np.matmul(S, p, out=check)  # accuracy check, see covariance_paths
                     exact = np.where(gam[k, j] > 0, r - r * (r / s), s0)
-                    lost = (s0 < 0) | (np.abs(check[n] - exact) > kernels.LOST_TOLERANCE * r)
+                    lost = (s0 < 0) | (np.abs(check[n] - exact) > LOST_TOLERANCE * r)
                     if lost.any():
                         p[:, lost] = np.nan
                 np.matmul(Maug, pa, out=upper)

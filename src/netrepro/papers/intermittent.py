@@ -37,12 +37,10 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy import optimize
 
 from ..claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from ..config import ConfigError
 from ..engines.channels import arrival_patterns, iid_arrivals
-from ..engines.lmi import MareStabilizabilityLMI, bisect_bracketed
 from ..engines.montecarlo import load_sums, merge_block_sums, run_blocks, run_monte_carlo, save_sums, shard_blocks
 from ..engines.riccati import Sensor, covariance_paths
 from ..io import read_table
@@ -256,6 +254,8 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5):
     Returns a DataFrame with ``lambda1, lambda2c_upper, bracket_lower, n_solves,
     status_at_threshold, certified_radius, statuses_seen`` (every solver status met in the bisection).
     """
+    from ..engines.lmi import MareStabilizabilityLMI, bisect_bracketed  # cvxpy: only the steps that solve LMIs
+
     lmi = MareStabilizabilityLMI([[a]], two_sensor_modes())
     grid = np.asarray(lambda1_grid, dtype=float)
     outcomes = {float(lam1): {} for lam1 in grid}
@@ -466,6 +466,8 @@ def errata_rows(cfg: dict) -> list[dict]:
 
     # E1: Lemma 1 gain uses R1 instead of R2
     p = 1.0
+    from scipy import optimize
+
     k_opt = optimize.minimize_scalar(lambda K: _phi_scalar(K, p, lam, a, R1, R2)).x
     add("E1", "Section 4, K~ (matrix and scalar forms)", "K~ = -A P C^T (C P C^T + R1)^-1; K~ = -a p/(p + R1)",
         "K~ = -A P C^T (C P C^T + R2)^-1; K~ = -a p/(p + R2)",

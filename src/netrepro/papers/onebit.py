@@ -653,6 +653,7 @@ def iterate_transient(snr_db, eps: float, sigma0: float, mu0: float, sigma_eta: 
     """
     if mu0 != 0.0:
         raise ValueError("iterate_transient: the interpolated (29) assumes mu0 = 0")
+    from ..engines.kernels import scalar_information_steps  # numba: only the steps that iterate
     snr_db = np.atleast_1d(np.asarray(snr_db, dtype=float))
     s = sigma_z2_from_snr(snr_db, eps, sigma_eta, definition)
     var_inf = stationary_variance(eps, s)
@@ -681,19 +682,13 @@ def iterate_transient(snr_db, eps: float, sigma0: float, mu0: float, sigma_eta: 
 
     v0 = np.full((1, n), sigma0**2)
     _record(np.array([0]), v0, efq_fn(v0 / sigma_eta**2) / sigma_eta**2, j[None, :])
-    tmp = np.empty_like(j)
     for start in range(1, n_steps + 1, chunk):
         ks = np.arange(start, min(start + chunk, n_steps + 1))
         var = theta_variance(ks[:, None], eps, sigma0, s[None, :])
         Fq = efq_fn(var / sigma_eta**2) / sigma_eta**2
         F2 = np.concatenate([Fq, np.full_like(Fq, Fi)], axis=1)
         J = np.empty_like(F2)
-        for i in range(len(ks)):
-            np.divide(a2, j, out=tmp)
-            tmp += s2
-            np.divide(1.0, tmp, out=j)
-            j += F2[i]
-            J[i] = j
+        scalar_information_steps(j, a2, s2, F2, J)
         outside = np.abs(J / j_star - 1.0) > rtol
         any_out = outside.any(axis=0)
         last_in_chunk = len(ks) - 1 - np.argmax(outside[::-1], axis=0)
