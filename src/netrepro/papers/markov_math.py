@@ -399,7 +399,10 @@ def riccati_g(P, A, C, Q, R):
     """``g(X) = A X A' + Q - A X C' (C X C' + R)^{-1} C X A'`` (eq. 5), batched over leading axes."""
     PCt = P @ C.T
     S = C @ PCt + R
-    post = P - PCt @ np.linalg.solve(S, np.swapaxes(PCt, -1, -2))
+    if S.shape[-1] == 1:  # one output: a division, not a batched LAPACK solve of 1 x 1 systems
+        post = P - PCt @ (np.swapaxes(PCt, -1, -2) / S)
+    else:
+        post = P - PCt @ np.linalg.solve(S, np.swapaxes(PCt, -1, -2))
     out = A @ post @ A.T + Q
     return 0.5 * (out + np.swapaxes(out, -1, -2))
 
