@@ -269,3 +269,15 @@ def test_linear_trace_estimator_is_unbiased(system):
     assert np.allclose(w @ per_path, exact, rtol=1e-10)
     mean, _, _ = mm.rb_mean_trace(system, np.eye(system.n), p, q, arr, n_batches=len(arr))
     assert np.allclose(mean, per_path.mean(axis=0), rtol=1e-10)
+
+
+def test_sym_norm_3x3_closed_form_matches_lapack():
+    rng = np.random.default_rng(11)
+    X = rng.normal(size=(4000, 3, 3))
+    scales = 10.0 ** rng.uniform(-3, 8, size=(4000, 3))  # condition numbers up to ~1e11
+    Qm = np.linalg.qr(X)[0]
+    P = Qm @ (scales[:, :, None] * np.swapaxes(Qm, 1, 2))
+    P = np.concatenate([P, np.eye(3)[None] * 2.5, np.diag([4.0, 4.0, 1.0])[None], np.zeros((1, 3, 3))])
+    want = np.linalg.eigvalsh(0.5 * (P + np.swapaxes(P, 1, 2)))[:, -1]
+    assert np.allclose(mm.sym_norm(P), want, rtol=1e-10, atol=1e-300)
+    assert np.isinf(mm.sym_norm(np.full((1, 3, 3), np.inf))).all()
