@@ -462,3 +462,16 @@ def test_repeated_warnings_are_logged_once_with_a_count(tmp_path, monkeypatch, c
     assert len(lines) == 1 and "1000 times" in lines[0]
     meta = json.loads(sidecar_path("results/w.csv").read_text())
     assert meta["extra"]["warnings"][0]["count"] == 1000
+
+
+def test_a_sidecar_without_its_table_is_reported_but_harmless(cache, capsys):
+    """Snakemake deletes the outputs of a job it interrupts, possibly after the runner wrote the sidecar."""
+    corrupt_all(cache)
+    runner_main(["verify", "--remove-corrupt", "results"])  # removes the corrupt files and the orphaned sidecar of c
+    capsys.readouterr()
+    (Path("results") / "e.csv").unlink()  # e's sidecar now orphaned, like an interrupted job's
+    assert runner_main(["verify", "results"]) == 0
+    out = capsys.readouterr().out
+    assert "MISSING: results/e.csv" in out and "snakemake rebuilds it" in out and "FAILED" not in out
+    runner_main(["verify", "--remove-corrupt", "results"])
+    assert not sidecar_path(Path("results") / "e.csv").exists()

@@ -228,8 +228,9 @@ def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
         if path.name.endswith(".meta.json"):
             output = path.with_name(path.name[: -len(".meta.json")])
             if not output.exists():
-                verdicts.append(Verdict(output, "missing", f"{output}: missing, but its sidecar {path.name} exists; "
-                                        "rebuild it with snakemake"))
+                verdicts.append(Verdict(output, "missing", f"{output}: missing, but its sidecar {path.name} exists "
+                                        "(an interrupted job, or a deleted table); nothing can read it, and "
+                                        "snakemake rebuilds it"))
             continue
         if not sidecar_path(path).is_file():
             if inputs_only:

@@ -187,10 +187,12 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
 def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, stream=None) -> int:
     """``python -m netrepro verify``: report every result that does not match its sidecar.
 
-    Returns 0 when every checked file verifies (leftover temporary files are
-    reported but harmless), 1 otherwise. With ``remove_corrupt``, corrupt
-    files and their sidecars (and leftover temporary files) are deleted, so
-    the next ``snakemake`` run rebuilds them.
+    Returns 0 when every checked file verifies, 1 otherwise. Reported but harmless: leftover
+    temporary files, and sidecars whose table is missing (Snakemake deletes the outputs of a job
+    it interrupts, which can happen after the runner wrote both; nothing can read a missing
+    table, and the next ``snakemake`` run rebuilds it). With ``remove_corrupt``, corrupt files
+    and their sidecars (and leftover temporary files and orphaned sidecars) are deleted, so the
+    next ``snakemake`` run rebuilds them.
     """
     stream = stream or sys.stdout
     if not paths:
@@ -203,13 +205,13 @@ def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, str
             print(f"{v.status.upper()}: {v.message}", file=stream)
         elif not quiet:
             print(f"OK: {v.path}", file=stream)
-        if remove_corrupt and v.status in ("corrupt", "no-sidecar", "partial"):
+        if remove_corrupt and v.status in ("corrupt", "no-sidecar", "partial", "missing"):
             for path in (v.path, sidecar_path(v.path)):
                 with contextlib.suppress(FileNotFoundError):
                     path.unlink()
-            if v.status != "partial":
+            if v.status not in ("partial", "missing"):
                 print(f"REMOVED: {v.path} (rerun snakemake to rebuild it)", file=stream)
-    bad = sum(n for status, n in counts.items() if status not in ("ok", "partial"))
+    bad = sum(n for status, n in counts.items() if status not in ("ok", "partial", "missing"))
     summary = ", ".join(f"{n} {status}" for status, n in sorted(counts.items())) or "nothing to check"
     print(f"verify: {len(verdicts)} files checked in {', '.join(map(str, paths))}: {summary}", file=stream)
     if bad and not remove_corrupt:
