@@ -27,7 +27,6 @@ from __future__ import annotations
 import importlib.util
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -37,11 +36,9 @@ import pytest
 import yaml
 
 from netrepro.regression import compare_tables
+from tests.conftest import copy_repo
 from tests.slurm.cluster import PARTITION, LocalSlurm, SlurmUnavailable, unavailable_reason
 
-ROOT = Path(__file__).resolve().parents[1]
-TOP_LEVEL_IGNORE = {".venv", ".git", "results", "logs", ".snakemake", "report", "figures", ".pytest_cache",
-                    ".hypothesis", "build", "dist"}
 TABLES = [
     "results/intermittent/exact_mean.csv",
     "results/intermittent/monte_carlo.csv",
@@ -54,19 +51,6 @@ SLURM_TIMEOUT = 1500  # s, the whole run under Slurm
 STATUS_INTERVAL = 3  # s, first status check after a submission (the profile's 20 s is for real clusters)
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("slurm")]
-
-
-def _ignore(directory, names):
-    if Path(directory).resolve() == ROOT:
-        return [n for n in names if n in TOP_LEVEL_IGNORE]
-    return [n for n in names if n == "__pycache__" or n.endswith(".egg-info")]
-
-
-def _scratch_copy(dest: Path) -> Path:
-    shutil.copytree(ROOT, dest, ignore=_ignore)
-    for sub in ("report", "figures"):
-        (dest / sub).mkdir(exist_ok=True)
-    return dest
 
 
 def _env(workdir: Path, cluster: LocalSlurm) -> dict:
@@ -147,8 +131,8 @@ def cluster():
 def test_intermittent_tables_through_slurm(cluster, tmp_path_factory):
     # one test, so that no distribution of tests over workers builds the cluster twice
     base = tmp_path_factory.mktemp("slurm")
-    reference = _scratch_copy(base / "local")
-    on_slurm = _scratch_copy(base / "slurm")
+    reference = copy_repo(base / "local")
+    on_slurm = copy_repo(base / "slurm")
 
     # the Slurm run uses one shard more than the local one, where the configuration is sharded
     cfg = yaml.safe_load((on_slurm / "config/test.yaml").read_text())

@@ -64,6 +64,18 @@ def _lattice(lo: float, hi: float, tol: float, max_evals: int):
     return n, (lambda j: lo + (hi - lo) * (j / n))
 
 
+def _recording(is_feasible):
+    """``(check, history)``: ``check(x)`` evaluates the predicate and appends ``(x, result)`` to ``history``."""
+    history = []
+
+    def check(x):
+        ok = bool(is_feasible(x))
+        history.append((float(x), ok))
+        return ok
+
+    return check, history
+
+
 def _halve(check, point, a, b, history) -> BisectionResult:
     """Halve a bracket of lattice indices (``a`` infeasible, ``b`` feasible) to adjacent points."""
     while b - a > 1:
@@ -82,13 +94,7 @@ def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_ev
     if ``hi`` is infeasible the result has ``threshold = nan``. Otherwise the bracket is
     halved until it is at most ``tol`` wide; the threshold is a point of :func:`_lattice`.
     """
-    history = []
-
-    def check(x):
-        ok = bool(is_feasible(x))
-        history.append((float(x), ok))
-        return ok
-
+    check, history = _recording(is_feasible)
     n, point = _lattice(lo, hi, tol, max_evals)
     if check(point(0)):
         return BisectionResult(lo, np.nan, len(history), history, False)
@@ -115,13 +121,7 @@ def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: flo
         raise ValueError(f"bisect_bracketed needs lo <= hi, got lo={lo}, hi={hi}")
     if not np.isfinite(guess):
         return bisect_monotone(is_feasible, lo, hi, tol, max_evals)
-    history = []
-
-    def check(x):
-        ok = bool(is_feasible(x))
-        history.append((float(x), ok))
-        return ok
-
+    check, history = _recording(is_feasible)
     n, point = _lattice(lo, hi, tol, max_evals)
     cell = (hi - lo) / n if n else 1.0
     centre = int(round((min(max(float(guess), lo), hi) - lo) / cell)) if hi > lo else 0

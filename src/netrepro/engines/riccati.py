@@ -119,8 +119,9 @@ def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all",
     later values are rounding noise, different for each implementation. Every kernel checks,
     after each update, the posterior ``c P c^T`` against its exact value, ``r - r^2 / (s0 + r)``
     after a reception (a form free of cancellation; ``s0 = c P c^T`` before the update) and ``s0``
-    after a loss, and marks a path that misses it by more than ``r / 2`` as ``inf`` from then on, as if it had overflowed: its covariance has
-    left what float64 can follow in this form. Below that range the check never fires.
+    after a loss, and marks a path that misses it by more than ``r / 2`` as ``inf`` from then on,
+    as if it had overflowed: its covariance has left what float64 can follow in this form. Below
+    that range the check never fires.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
