@@ -29,6 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import ConfigError, DependencyError
+
 __all__ = [
     "ConfigError",
     "DependencyError",
@@ -63,12 +65,6 @@ PURPOSE = {
 }
 
 
-class ConfigError(ValueError):
-    """The configuration is invalid; the message names key, value and expectation."""
-
-
-class DependencyError(RuntimeError):
-    """A required package is missing, broken or too old; the message says which and how to fix it."""
 
 
 # ----------------------------------------------------------------------------- dependencies
@@ -303,8 +299,11 @@ def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
     if problems:
         raise ConfigError("invalid configuration:\n  " + "\n  ".join(problems))
     for slug in papers:
+        # a paper package keeps its configuration checks in `checks.py`, light to import at start-up
+        is_package = (Path(__file__).resolve().parent / "papers" / str(slug) / "__init__.py").is_file()
+        module_name = f"netrepro.papers.{slug}.checks" if is_package else f"netrepro.papers.{slug}"
         try:
-            module = importlib.import_module(f"netrepro.papers.{slug}")
+            module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
             if exc.name in (f"netrepro.papers.{slug}", "netrepro.papers"):
                 problems.append(f"config key 'papers' lists {slug!r}, but there is no module netrepro.papers.{slug}")
@@ -319,7 +318,7 @@ def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
             except ConfigError as exc:
                 problems.append(str(exc))
             except (KeyError, TypeError, ValueError, IndexError) as exc:
-                problems.append(f"config section '{slug}' could not be checked by netrepro.papers.{slug}.check_config "
+                problems.append(f"config section '{slug}' could not be checked by {module_name}.check_config "
                                 f"({type(exc).__name__}: {exc}); expected the keys and types of "
                                 f"workflow/schemas/{slug}.schema.yaml")
     if problems:

@@ -19,6 +19,7 @@ from importlib import metadata
 from pathlib import Path
 
 from .io import sha256_file, write_json
+from .errors import CorruptOutputError
 
 __all__ = [
     "params_hash",
@@ -43,8 +44,6 @@ TRACKED_PACKAGES = (
 )
 
 
-class CorruptOutputError(RuntimeError):
-    """A result file does not match the checksum recorded in its sidecar."""
 
 
 def params_hash(params) -> str:

@@ -8,7 +8,10 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 try:
-    from netrepro.config import ConfigError, DependencyError, check_dependencies, validate_config
+    from netrepro.codedeps import code_inputs
+    from netrepro.config import check_dependencies, validate_config
+    from netrepro.errors import NetreproError
+    from netrepro.figurespec import load_figure_specs
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "
@@ -19,14 +22,18 @@ except ImportError as exc:
 try:
     check_dependencies()
     # the schemas of this workflow copy (not of the installed package's checkout)
-    validate_config(config, schema_dir=Path(workflow.basedir) / "workflow" / "schemas")
-except (ConfigError, DependencyError) as exc:
+    validate_config(config, schema_dir=Path(workflow.current_basedir).parent / "schemas")
+except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
 
 PYTHON = sys.executable
-# Filled by each paper's .smk: slug -> dict(figures=[...], tables=[...], claims=..., errata=...,
+# Filled by each paper's .smk: slug -> list of its result tables (shown by its notebook).
+PAPER_TABLES = {}
+# Filled by figures.smk: slug -> dict(figures=[...], tables=[...], claims=..., errata=...,
 # reconstructions=..., notebook=...). The report rule collects from it.
 PAPER_OUTPUTS = {}
+# Software of every rule, for --use-conda (the default route is the .venv/ that `make` builds).
+CONDA_ENV = "../envs/netrepro.yaml"
 
 
 def enabled(slug):
@@ -48,33 +55,13 @@ def io_json(wildcards, input, output):
     return as_json({"inputs": dict(input.items()), "outputs": dict(output.items())})
 
 
-def src(*modules):
-    """Package source files a rule depends on, so that a code change reruns it."""
-    return [f"src/netrepro/{m}" for m in modules] + ["src/netrepro/runner.py"]
-
-
-def finalize_rules(workflow):
-    """Write each rule's own name into its recorded command (the `--rule` of the provenance).
-
-    The command a job executes gets the name from Snakemake's `{rule}` placeholder; the
-    recorded command (`rule.shellcmd`, which Snakemake compares to decide code-triggered
-    reruns) carries the name literally, as the executed command does.
-    """
-    for each in workflow.rules:
-        if each.shellcmd:
-            for placeholder in (RULE_PLACEHOLDER, RULE_FIELD):
-                each.shellcmd = each.shellcmd.replace(placeholder, each.name if placeholder == RULE_PLACEHOLDER
-                                                      else f"--rule {each.name} ")
-
-
-RULE_PLACEHOLDER = "@RULE@"
-RULE_FIELD = "--rule {rule} "
-# Software of every rule, for --use-conda (the default route is the .venv/ that `make` builds).
-CONDA_ENV = "../envs/netrepro.yaml"
+def code(func):
+    """Source files the step ``func`` runs: its module's import closure in the package (derived)."""
+    return code_inputs(func, root="src")
 
 
 def step(func):
-    """Shell command of a pipeline step: one call into the package (`{rule}` is the job's rule name)."""
+    """Shell command of a pipeline step: one call into the package (``{rule}`` is the job's rule name)."""
     # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
         "OPENBLAS_NUM_THREADS={threads} OMP_NUM_THREADS={threads} "
@@ -94,6 +81,27 @@ def notebook(slug):
         f"{PYTHON} -m netrepro.reportgen notebook --slug {slug} "
         "--notebook {input.notebook} --html {output.html} >> {log} 2>&1"
     )
+
+
+def figure_specs(slug):
+    """The paper's figure list (src/netrepro/papers/<slug>/figures.yaml), or a clear error."""
+    try:
+        return load_figure_specs(slug)
+    except NetreproError as exc:
+        raise WorkflowError(str(exc)) from None
+
+
+def figure_inputs(spec):
+    """Named input tables of a figure, as the outputs of the rules that write them."""
+    named = {}
+    for name, (rule_name, output) in spec.input_rules().items():
+        try:
+            named[name] = getattr(getattr(rules, rule_name).output, output)
+        except AttributeError:
+            raise WorkflowError(
+                f"figure {spec.rule}: input {name!r} names {rule_name}.{output}, which is not a rule output"
+            ) from None
+    return named
 
 
 def report_inputs(wildcards):

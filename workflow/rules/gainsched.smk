@@ -8,7 +8,7 @@ GS_MATH = ("papers/gainsched.py", "papers/gainsched_model.py", "papers/gainsched
 
 rule gainsched_design:
     input:
-        code=src(*GS_MATH, "engines/lmi.py"),
+        code=code("netrepro.papers.gainsched:design_step"),
     output:
         gains="results/gainsched/gains.csv",
         designs="results/gainsched/designs.csv",
@@ -30,7 +30,7 @@ rule gainsched_design:
 
 rule gainsched_stability:
     input:
-        code=src(*GS_MATH, "engines/lmi.py"),
+        code=code("netrepro.papers.gainsched:stability_step"),
         gains="results/gainsched/gains.csv",
         solutions="results/gainsched/lmi_solutions.csv",
     output:
@@ -53,7 +53,7 @@ rule gainsched_stability:
 
 rule gainsched_simulation:
     input:
-        code=src(*GS_MATH),
+        code=code("netrepro.papers.gainsched:simulation_step"),
         gains="results/gainsched/gains.csv",
     output:
         errors="results/gainsched/errors.csv",
@@ -76,7 +76,7 @@ rule gainsched_simulation:
 
 rule gainsched_sensitivity:
     input:
-        code=src(*GS_MATH, "engines/lmi.py"),
+        code=code("netrepro.papers.gainsched:sensitivity_step"),
     output:
         table="results/gainsched/sensitivity.csv",
     params:
@@ -96,7 +96,7 @@ rule gainsched_sensitivity:
 
 rule gainsched_timing:
     input:
-        code=src(*GS_MATH, "engines/lmi.py"),
+        code=code("netrepro.papers.gainsched:timing_step"),
     output:
         table="results/gainsched/timing.csv",
     params:
@@ -116,7 +116,7 @@ rule gainsched_timing:
 
 rule gainsched_errata:
     input:
-        code=src(*GS_MATH, "claims.py"),
+        code=code("netrepro.papers.gainsched:errata_step"),
         gains="results/gainsched/gains.csv",
         summary="results/gainsched/error_summary.csv",
         theorem1="results/gainsched/theorem1.csv",
@@ -140,7 +140,7 @@ rule gainsched_errata:
 
 rule gainsched_reconstructions:
     input:
-        code=src(*GS_MATH, "claims.py"),
+        code=code("netrepro.papers.gainsched:reconstructions_step"),
         sensitivity="results/gainsched/sensitivity.csv",
         summary="results/gainsched/error_summary.csv",
     output:
@@ -162,7 +162,7 @@ rule gainsched_reconstructions:
 
 rule gainsched_claims:
     input:
-        code=src(*GS_MATH, "claims.py"),
+        code=code("netrepro.papers.gainsched:claims_step"),
         gains="results/gainsched/gains.csv",
         designs="results/gainsched/designs.csv",
         theorem1="results/gainsched/theorem1.csv",
@@ -189,7 +189,7 @@ rule gainsched_claims:
 
 rule gainsched_fig1:
     input:
-        code=src("papers/gainsched.py", "plotting.py"),
+        code=code("netrepro.papers.gainsched:figure_errors"),
         errors="results/gainsched/errors.csv",
         paths="results/gainsched/sample_paths.csv",
     output:
@@ -208,7 +208,7 @@ rule gainsched_fig1:
 
 rule gainsched_fig2:
     input:
-        code=src("papers/gainsched.py", "plotting.py"),
+        code=code("netrepro.papers.gainsched:figure_errors"),
         errors="results/gainsched/errors.csv",
         paths="results/gainsched/sample_paths.csv",
     output:
@@ -227,7 +227,7 @@ rule gainsched_fig2:
 
 rule gainsched_figS1:
     input:
-        code=src("papers/gainsched.py", "plotting.py"),
+        code=code("netrepro.papers.gainsched:figure_mse"),
         errors="results/gainsched/errors.csv",
         summary="results/gainsched/error_summary.csv",
     output:
@@ -245,7 +245,7 @@ rule gainsched_figS1:
 
 rule gainsched_figS2:
     input:
-        code=src("papers/gainsched.py", "plotting.py"),
+        code=code("netrepro.papers.gainsched:figure_sensitivity"),
         sensitivity="results/gainsched/sensitivity.csv",
     output:
         figure=report("figures/gainsched/figS2.png", caption="../report/gainsched/figS2.rst", category="gainsched"),
@@ -278,7 +278,7 @@ GAINSCHED_TABLES = [
 rule gainsched_notebook:
     input:
         notebook="workflow/notebooks/gainsched.ipynb",
-        code=src("reportgen.py"),
+        code=code("netrepro.reportgen"),
         figures=GAINSCHED_FIGURES,
         tables=GAINSCHED_TABLES,
         claims="results/claims/gainsched.csv",

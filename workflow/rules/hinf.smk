@@ -4,8 +4,8 @@
 HCFG = config.get("hinf", {})
 HINF_SCENARIOS = ["fig2", "fig3", "static_fixed", "static_mobile", "evasive_hinf", "evasive_kalman"]
 HINF_PIECES = ["errors", "single", "trajectories", "summary", "per_run"]
-HINF_CODE = src("papers/hinf.py", "papers/hinf_core.py")
-HINF_PLOT = src("papers/hinf.py", "papers/hinf_core.py", "plotting.py")
+HINF_CODE = code("netrepro.papers.hinf")
+HINF_PLOT = code("netrepro.papers.hinf")
 HINF_SIM_PIECES = {f"{kind}_{s}": f"results/hinf/sim/{s}_{kind}.csv" for kind in HINF_PIECES for s in HINF_SCENARIOS}
 
 
@@ -136,7 +136,7 @@ rule hinf_sensitivity_evasive:
 
 rule hinf_errata:
     input:
-        code=src("papers/hinf.py", "papers/hinf_core.py", "claims.py"),
+        code=code("netrepro.papers.hinf:errata_step"),
     output:
         table="results/errata/hinf.csv",
     params:
@@ -152,7 +152,7 @@ rule hinf_errata:
 
 rule hinf_reconstructions:
     input:
-        code=src("papers/hinf.py", "claims.py"),
+        code=code("netrepro.papers.hinf:reconstructions_step"),
         sensitivity="results/hinf/sensitivity.csv",
         sensitivity_evasive="results/hinf/sensitivity_evasive.csv",
     output:
@@ -170,7 +170,7 @@ rule hinf_reconstructions:
 
 rule hinf_claims:
     input:
-        code=src("papers/hinf.py", "claims.py"),
+        code=code("netrepro.papers.hinf:claims_step"),
         noise_fit="results/hinf/noise_fit.csv",
         consensus="results/hinf/consensus_check.csv",
         attenuation="results/hinf/attenuation.csv",
@@ -374,7 +374,7 @@ HINF_TABLES = [
 rule hinf_notebook:
     input:
         notebook="workflow/notebooks/hinf.ipynb",
-        code=src("reportgen.py"),
+        code=code("netrepro.reportgen"),
         figures=HINF_FIGURES,
         tables=HINF_TABLES,
         claims="results/claims/hinf.csv",

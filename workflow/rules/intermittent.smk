@@ -8,7 +8,7 @@ MC_KEYS = ("a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "bloc
 
 rule intermittent_exact_mean:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py"),
+        code=code("netrepro.papers.intermittent:exact_mean_step"),
     output:
         table="results/intermittent/exact_mean.csv",
     params:
@@ -24,7 +24,7 @@ rule intermittent_exact_mean:
 
 rule intermittent_monte_carlo_shard:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py", "engines/channels.py", "engines/montecarlo.py"),
+        code=code("netrepro.papers.intermittent:monte_carlo_shard_step"),
     output:
         sums="results/intermittent/shards/monte_carlo_{shard}.npz",
     wildcard_constraints:
@@ -52,7 +52,7 @@ rule intermittent_monte_carlo_shard:
 
 rule intermittent_monte_carlo:
     input:
-        code=src("papers/intermittent.py", "engines/montecarlo.py"),
+        code=code("netrepro.papers.intermittent:monte_carlo_merge_step"),
         shards=expand(
             "results/intermittent/shards/monte_carlo_{shard}.npz",
             shard=range(ICFG.get("scalar", {}).get("n_shards", 1)),
@@ -76,7 +76,7 @@ rule intermittent_monte_carlo:
 
 rule intermittent_scalar_bounds:
     input:
-        code=src("papers/intermittent.py"),
+        code=code("netrepro.papers.intermittent:scalar_bounds_step"),
         exact="results/intermittent/exact_mean.csv",
         mc="results/intermittent/monte_carlo.csv",
     output:
@@ -94,7 +94,7 @@ rule intermittent_scalar_bounds:
 
 rule intermittent_two_sensor_region_shard:
     input:
-        code=src("papers/intermittent.py", "engines/lmi.py", "engines/channels.py"),
+        code=code("netrepro.papers.intermittent:two_sensor_region_shard_step"),
     output:
         table="results/intermittent/shards/two_sensor_region_{shard}.csv",
     wildcard_constraints:
@@ -122,7 +122,7 @@ rule intermittent_two_sensor_region_shard:
 
 rule intermittent_two_sensor_region:
     input:
-        code=src("papers/intermittent.py"),
+        code=code("netrepro.papers.intermittent:two_sensor_region_merge_step"),
         shards=expand(
             "results/intermittent/shards/two_sensor_region_{shard}.csv",
             shard=range(ICFG.get("two_sensor", {}).get("n_shards", 1)),
@@ -142,7 +142,7 @@ rule intermittent_two_sensor_region:
 
 rule intermittent_two_sensor_simulation:
     input:
-        code=src("papers/intermittent.py", "engines/riccati.py", "engines/kernels.py", "engines/montecarlo.py"),
+        code=code("netrepro.papers.intermittent:two_sensor_simulation_step"),
     output:
         table="results/intermittent/two_sensor_simulation.csv",
     params:
@@ -161,7 +161,7 @@ rule intermittent_two_sensor_simulation:
 
 rule intermittent_errata:
     input:
-        code=src("papers/intermittent.py", "claims.py"),
+        code=code("netrepro.papers.intermittent:errata_step"),
     output:
         table="results/errata/intermittent.csv",
     params:
@@ -182,7 +182,7 @@ rule intermittent_errata:
 
 rule intermittent_reconstructions:
     input:
-        code=src("papers/intermittent.py", "claims.py"),
+        code=code("netrepro.papers.intermittent:reconstructions_step"),
     output:
         table="results/reconstructions/intermittent.csv",
     params:
@@ -198,7 +198,7 @@ rule intermittent_reconstructions:
 
 rule intermittent_claims:
     input:
-        code=src("papers/intermittent.py", "claims.py"),
+        code=code("netrepro.papers.intermittent:claims_step"),
         bounds="results/intermittent/scalar_bounds.csv",
         region="results/intermittent/two_sensor_region.csv",
         simulation="results/intermittent/two_sensor_simulation.csv",
@@ -222,7 +222,7 @@ rule intermittent_claims:
 
 rule intermittent_fig1:
     input:
-        code=src("papers/intermittent.py", "plotting.py"),
+        code=code("netrepro.papers.intermittent:figure_bounds"),
         bounds="results/intermittent/scalar_bounds.csv",
     output:
         figure=report("figures/intermittent/fig1.png", caption="../report/intermittent/fig1.rst", category="intermittent"),
@@ -239,7 +239,7 @@ rule intermittent_fig1:
 
 rule intermittent_fig2:
     input:
-        code=src("papers/intermittent.py", "plotting.py"),
+        code=code("netrepro.papers.intermittent:figure_bounds"),
         bounds="results/intermittent/scalar_bounds.csv",
     output:
         figure=report("figures/intermittent/fig2.png", caption="../report/intermittent/fig2.rst", category="intermittent"),
@@ -256,7 +256,7 @@ rule intermittent_fig2:
 
 rule intermittent_fig4:
     input:
-        code=src("papers/intermittent.py", "plotting.py"),
+        code=code("netrepro.papers.intermittent:figure_region"),
         region="results/intermittent/two_sensor_region.csv",
     output:
         figure=report("figures/intermittent/fig4.png", caption="../report/intermittent/fig4.rst", category="intermittent"),
@@ -273,7 +273,7 @@ rule intermittent_fig4:
 
 rule intermittent_fig5:
     input:
-        code=src("papers/intermittent.py", "plotting.py"),
+        code=code("netrepro.papers.intermittent:figure_region"),
         region="results/intermittent/two_sensor_region.csv",
         simulation="results/intermittent/two_sensor_simulation.csv",
     output:
@@ -291,7 +291,7 @@ rule intermittent_fig5:
 
 rule intermittent_figS1:
     input:
-        code=src("papers/intermittent.py", "plotting.py"),
+        code=code("netrepro.papers.intermittent:figure_estimators"),
         mc="results/intermittent/monte_carlo.csv",
         exact="results/intermittent/exact_mean.csv",
     output:
@@ -336,7 +336,7 @@ INTERMITTENT_TABLES = [
 rule intermittent_notebook:
     input:
         notebook="workflow/notebooks/intermittent.ipynb",
-        code=src("reportgen.py"),
+        code=code("netrepro.reportgen"),
         figures=INTERMITTENT_FIGURES,
         tables=INTERMITTENT_TABLES,
         claims="results/claims/intermittent.csv",

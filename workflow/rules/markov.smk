@@ -7,7 +7,7 @@ MARKOV_CODE = ("papers/markov.py", "papers/markov_math.py")
 
 rule markov_critical_curves:
     input:
-        code=src(*MARKOV_CODE, "engines/lmi.py"),
+        code=code("netrepro.papers.markov:critical_curves_step"),
     output:
         table="results/markov/critical_curves.csv",
         benchmark="results/markov/lmi_benchmark.csv",
@@ -24,7 +24,7 @@ rule markov_critical_curves:
 
 rule markov_lmi_checks:
     input:
-        code=src(*MARKOV_CODE, "engines/lmi.py"),
+        code=code("netrepro.papers.markov:lmi_checks_step"),
     output:
         table="results/markov/lmi_checks.csv",
     params:
@@ -40,7 +40,7 @@ rule markov_lmi_checks:
 
 rule markov_iid_line:
     input:
-        code=src(*MARKOV_CODE, "engines/lmi.py"),
+        code=code("netrepro.papers.markov:iid_line_step"),
     output:
         table="results/markov/iid_line.csv",
     params:
@@ -56,7 +56,7 @@ rule markov_iid_line:
 
 rule markov_exact_moments:
     input:
-        code=src(*MARKOV_CODE),
+        code=code("netrepro.papers.markov:exact_moments_step"),
     output:
         table="results/markov/exact_moments.csv",
     params:
@@ -74,7 +74,7 @@ rule markov_exact_moments:
 
 rule markov_stability_map:
     input:
-        code=src(*MARKOV_CODE),
+        code=code("netrepro.papers.markov:stability_map_step"),
         moments="results/markov/exact_moments.csv",
     output:
         table="results/markov/stability_map.csv",
@@ -91,7 +91,7 @@ rule markov_stability_map:
 
 rule markov_sample_paths:
     input:
-        code=src(*MARKOV_CODE, "engines/riccati.py", "engines/kernels.py", "engines/channels.py"),
+        code=code("netrepro.papers.markov:sample_paths_step"),
         moments="results/markov/exact_moments.csv",
     output:
         table="results/markov/sample_paths.csv",
@@ -109,7 +109,7 @@ rule markov_sample_paths:
 
 rule markov_errata:
     input:
-        code=src(*MARKOV_CODE, "claims.py"),
+        code=code("netrepro.papers.markov:errata_step"),
         checks="results/markov/lmi_checks.csv",
     output:
         table="results/errata/markov.csv",
@@ -126,7 +126,7 @@ rule markov_errata:
 
 rule markov_reconstructions:
     input:
-        code=src(*MARKOV_CODE, "claims.py"),
+        code=code("netrepro.papers.markov:reconstructions_step"),
     output:
         table="results/reconstructions/markov.csv",
     params:
@@ -142,7 +142,7 @@ rule markov_reconstructions:
 
 rule markov_claims:
     input:
-        code=src(*MARKOV_CODE, "claims.py"),
+        code=code("netrepro.papers.markov:claims_step"),
         checks="results/markov/lmi_checks.csv",
         curves="results/markov/critical_curves.csv",
         iid="results/markov/iid_line.csv",
@@ -163,7 +163,7 @@ rule markov_claims:
 
 rule markov_fig2:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_plane"),
         curves="results/markov/critical_curves.csv",
         map="results/markov/stability_map.csv",
         iid="results/markov/iid_line.csv",
@@ -182,7 +182,7 @@ rule markov_fig2:
 
 rule markov_fig3:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_path"),
         paths="results/markov/sample_paths.csv",
     output:
         figure=report("figures/markov/fig3.png", caption="../report/markov/fig3.rst", category="markov"),
@@ -199,7 +199,7 @@ rule markov_fig3:
 
 rule markov_fig4:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_path"),
         paths="results/markov/sample_paths.csv",
     output:
         figure=report("figures/markov/fig4.png", caption="../report/markov/fig4.rst", category="markov"),
@@ -216,7 +216,7 @@ rule markov_fig4:
 
 rule markov_fig5:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_path"),
         paths="results/markov/sample_paths.csv",
     output:
         figure=report("figures/markov/fig5.png", caption="../report/markov/fig5.rst", category="markov"),
@@ -233,7 +233,7 @@ rule markov_fig5:
 
 rule markov_fig6:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_mean"),
         paths="results/markov/sample_paths.csv",
     output:
         figure=report("figures/markov/fig6.png", caption="../report/markov/fig6.rst", category="markov"),
@@ -250,7 +250,7 @@ rule markov_fig6:
 
 rule markov_figS1:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_estimators"),
         check="results/markov/estimator_check.csv",
     output:
         figure=report("figures/markov/figS1.png", caption="../report/markov/figS1.rst", category="markov"),
@@ -267,7 +267,7 @@ rule markov_figS1:
 
 rule markov_figS2:
     input:
-        code=src(*MARKOV_CODE, "plotting.py"),
+        code=code("netrepro.papers.markov:figure_curves"),
         curves="results/markov/critical_curves.csv",
     output:
         figure=report("figures/markov/figS2.png", caption="../report/markov/figS2.rst", category="markov"),
@@ -298,7 +298,7 @@ MARKOV_TABLES = [
 rule markov_notebook:
     input:
         notebook="workflow/notebooks/markov.ipynb",
-        code=src("reportgen.py"),
+        code=code("netrepro.reportgen"),
         figures=MARKOV_FIGURES,
         tables=MARKOV_TABLES,
         claims="results/claims/markov.csv",

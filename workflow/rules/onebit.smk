@@ -29,7 +29,7 @@ ONEBIT_SHARDS = OCFG.get("estimator", {}).get("n_shards", 2)
 
 rule onebit_efq:
     input:
-        code=src(ONEBIT_CODE),
+        code=code("netrepro.papers.onebit:efq_step"),
     output:
         table="results/onebit/efq.csv",
     params:
@@ -49,7 +49,7 @@ rule onebit_efq:
 
 rule onebit_ratios:
     input:
-        code=src(ONEBIT_CODE),
+        code=code("netrepro.papers.onebit:ratios_step"),
     output:
         table="results/onebit/ratios.csv",
     params:
@@ -69,7 +69,7 @@ rule onebit_ratios:
 
 rule onebit_lag:
     input:
-        code=src(ONEBIT_CODE),
+        code=code("netrepro.papers.onebit:lag_step"),
     output:
         table="results/onebit/lag.csv",
     params:
@@ -89,7 +89,7 @@ rule onebit_lag:
 
 rule onebit_convergence:
     input:
-        code=src(ONEBIT_CODE),
+        code=code("netrepro.papers.onebit:convergence_step"),
     output:
         table="results/onebit/convergence.csv",
         transient="results/onebit/transient.csv",
@@ -110,7 +110,7 @@ rule onebit_convergence:
 
 rule onebit_estimator_shard:
     input:
-        code=src(ONEBIT_CODE, "engines/montecarlo.py"),
+        code=code("netrepro.papers.onebit:estimator_shard_step"),
     output:
         sums="results/onebit/shards/estimator_{shard}.npz",
     wildcard_constraints:
@@ -134,7 +134,7 @@ rule onebit_estimator_shard:
 
 rule onebit_estimator:
     input:
-        code=src(ONEBIT_CODE, "engines/montecarlo.py"),
+        code=code("netrepro.papers.onebit:estimator_step"),
         shards=expand("results/onebit/shards/estimator_{shard}.npz", shard=range(ONEBIT_SHARDS)),
     output:
         table="results/onebit/estimator_mse.csv",
@@ -155,7 +155,7 @@ rule onebit_estimator:
 
 rule onebit_vector_check:
     input:
-        code=src(ONEBIT_CODE),
+        code=code("netrepro.papers.onebit:vector_check_step"),
     output:
         table="results/onebit/vector_check.csv",
     params:
@@ -175,7 +175,7 @@ rule onebit_vector_check:
 
 rule onebit_errata:
     input:
-        code=src(ONEBIT_CODE, "claims.py"),
+        code=code("netrepro.papers.onebit:errata_step"),
     output:
         table="results/errata/onebit.csv",
     params:
@@ -195,7 +195,7 @@ rule onebit_errata:
 
 rule onebit_reconstructions:
     input:
-        code=src(ONEBIT_CODE, "claims.py"),
+        code=code("netrepro.papers.onebit:reconstructions_step"),
     output:
         table="results/reconstructions/onebit.csv",
     params:
@@ -215,7 +215,7 @@ rule onebit_reconstructions:
 
 rule onebit_claims:
     input:
-        code=src(ONEBIT_CODE, "claims.py"),
+        code=code("netrepro.papers.onebit:claims_step"),
         ratios="results/onebit/ratios.csv",
         lag="results/onebit/lag.csv",
         efq="results/onebit/efq.csv",
@@ -239,7 +239,7 @@ rule onebit_claims:
 
 rule onebit_fig1:
     input:
-        code=src(ONEBIT_CODE, "plotting.py"),
+        code=code("netrepro.papers.onebit:figure_rho_sl"),
         ratios="results/onebit/ratios.csv",
     output:
         figure=report("figures/onebit/fig1.png", caption="../report/onebit/fig1.rst", category="onebit"),
@@ -256,7 +256,7 @@ rule onebit_fig1:
 
 rule onebit_fig2:
     input:
-        code=src(ONEBIT_CODE, "plotting.py"),
+        code=code("netrepro.papers.onebit:figure_rho_s_f"),
         ratios="results/onebit/ratios.csv",
     output:
         figure=report("figures/onebit/fig2.png", caption="../report/onebit/fig2.rst", category="onebit"),
@@ -273,7 +273,7 @@ rule onebit_fig2:
 
 rule onebit_figS1:
     input:
-        code=src(ONEBIT_CODE, "plotting.py"),
+        code=code("netrepro.papers.onebit:figure_estimator"),
         estimator="results/onebit/estimator_mse.csv",
     output:
         figure=report("figures/onebit/figS1.png", caption="../report/onebit/figS1.rst", category="onebit"),
@@ -290,7 +290,7 @@ rule onebit_figS1:
 
 rule onebit_figS2:
     input:
-        code=src(ONEBIT_CODE, "plotting.py"),
+        code=code("netrepro.papers.onebit:figure_convergence"),
         transient="results/onebit/transient.csv",
     output:
         figure=report("figures/onebit/figS2.png", caption="../report/onebit/figS2.rst", category="onebit"),
@@ -307,7 +307,7 @@ rule onebit_figS2:
 
 rule onebit_figS3:
     input:
-        code=src(ONEBIT_CODE, "plotting.py"),
+        code=code("netrepro.papers.onebit:figure_lag"),
         lag="results/onebit/lag.csv",
     output:
         figure=report("figures/onebit/figS3.png", caption="../report/onebit/figS3.rst", category="onebit"),
@@ -337,7 +337,7 @@ ONEBIT_TABLES = [
 rule onebit_notebook:
     input:
         notebook="workflow/notebooks/onebit.ipynb",
-        code=src("reportgen.py"),
+        code=code("netrepro.reportgen"),
         figures=ONEBIT_FIGURES,
         tables=ONEBIT_TABLES,
         claims="results/claims/onebit.csv",

@@ -14,7 +14,7 @@ report: "../report/workflow.rst"
 rule report:
     input:
         unpack(report_inputs),
-        code=src("reportgen.py", "provenance.py"),
+        code=code("netrepro.reportgen:build_index"),
     output:
         html="report/index.html",
         files=directory("report/files"),

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
+
 # cvxpy (and the engine that imports it) are imported where needed: steps that only
 # simulate or plot do not pay for the import.
 
@@ -41,7 +43,7 @@ __all__ = [
 ]
 
 
-class GainschedError(ValueError):
+class GainschedError(InputError):
     """Bad argument to a `gainsched` function; the message names the argument."""
 
 

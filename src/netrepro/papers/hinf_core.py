@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ModelError
+
 __all__ = [
     "NoiseModel", "FilterDoesNotExist",
     "inv2", "det2", "sym2", "min_eig2", "rotation", "geometry",
@@ -39,7 +41,7 @@ I2 = np.eye(2)
 _J = np.array([[0.0, -1.0], [1.0, 0.0]])
 
 
-class FilterDoesNotExist(RuntimeError):
+class FilterDoesNotExist(ModelError):
     """The H-infinity filter does not exist: gamma is below the minimum attenuation level gamma_0.
 
     Raised when the information matrix ``Sigma_k^{-1} = Delta_k^{-1} + C^T M^{-1} C - gamma^{-2} L^T Q L``

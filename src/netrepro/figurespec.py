@@ -1,0 +1,98 @@
+"""The per-paper figure list, from which the workflow generates one rule per figure.
+
+Each paper package holds ``figures.yaml``: a mapping from figure id (``fig1``,
+``figS2``, ...) to its plotting function, the tables it reads and the fixed
+arguments of the plot::
+
+    fig1:
+      plot: figure_bounds              # a function of netrepro.papers.<slug>.figures
+      inputs: {bounds: scalar_bounds}  # name -> <rule without the slug prefix>[.<output name>]
+      params: {which: stable}          # optional
+      caption: Figure 1 of the paper   # one line; the rule's report caption is workflow/report/<slug>/<id>.rst
+
+The generated rule is ``<slug>_<id>``; it writes ``figures/<slug>/<id>.png``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from .errors import ConfigError
+
+__all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]
+
+_SRC = Path(__file__).resolve().parent
+_FIGURE_ID = re.compile(r"^fig(S?\d+)$")
+_KEYS = {"plot", "inputs", "params", "caption"}
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """One figure: its rule name, plotting function, input tables (rule, output) and parameters."""
+
+    slug: str
+    figure_id: str
+    plot: str
+    inputs: dict = field(default_factory=dict)
+    params: dict = field(default_factory=dict)
+    caption: str = ""
+
+    @property
+    def rule(self) -> str:
+        return f"{self.slug}_{self.figure_id}"
+
+    @property
+    def path(self) -> str:
+        return f"figures/{self.slug}/{self.figure_id}.png"
+
+    @property
+    def func(self) -> str:
+        return f"netrepro.papers.{self.slug}.figures:{self.plot}"
+
+    def input_rules(self) -> dict[str, tuple[str, str]]:
+        """``{input name: (rule name, output name)}``."""
+        resolved = {}
+        for name, ref in self.inputs.items():
+            rule, _, output = str(ref).partition(".")
+            resolved[name] = (f"{self.slug}_{rule}", output or "table")
+        return resolved
+
+
+def figure_list_path(slug: str, src: Path = _SRC) -> Path:
+    return Path(src) / "papers" / slug / "figures.yaml"
+
+
+def load_figure_specs(slug: str, src: Path = _SRC) -> list[FigureSpec]:
+    """The figures of paper ``slug`` in their listed order.
+
+    Raises
+    ------
+    ConfigError
+        If the list is missing or an entry is malformed; the message names file, figure and field.
+    """
+    path = figure_list_path(slug, src)
+    if not path.is_file():
+        raise ConfigError(f"paper {slug!r} has no figure list {path}")
+    data = yaml.safe_load(path.read_text()) or {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: expected a mapping of figure ids to entries, got {type(data).__name__}")
+    specs = []
+    for figure_id, entry in data.items():
+        where = f"{path}: figure {figure_id!r}"
+        if not _FIGURE_ID.match(str(figure_id)):
+            raise ConfigError(f"{where}: ids look like fig1 or figS1")
+        if not isinstance(entry, dict) or not isinstance(entry.get("plot"), str):
+            raise ConfigError(f"{where}: field 'plot' (the plotting function's name) is required")
+        unknown = set(entry) - _KEYS
+        if unknown:
+            raise ConfigError(f"{where}: unknown fields {sorted(unknown)} (allowed: {sorted(_KEYS)})")
+        for name in ("inputs", "params"):
+            if not isinstance(entry.get(name, {}), dict):
+                raise ConfigError(f"{where}: field {name!r} must be a mapping")
+        specs.append(FigureSpec(slug, str(figure_id), entry["plot"], dict(entry.get("inputs", {})),
+                                dict(entry.get("params", {})), str(entry.get("caption", ""))))
+    return specs

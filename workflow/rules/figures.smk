@@ -1,0 +1,66 @@
+# Generated rules: one per figure of each paper's figure list
+# (src/netrepro/papers/<slug>/figures.yaml), and one notebook per paper.
+# Included after the papers' own rules, whose outputs the figures read.
+
+
+for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
+    _specs = figure_specs(_slug)
+    for _spec in _specs:
+
+        rule:
+            name:
+                _spec.rule
+            input:
+                code=code(_spec.func),
+                **figure_inputs(_spec),
+            output:
+                figure=report(
+                    _spec.path,
+                    caption=f"../report/{_slug}/{_spec.figure_id}.rst",
+                    category=_slug,
+                ),
+            params:
+                cfg=as_json(_spec.params),
+                io=io_json,
+            localrule: True
+            conda:
+                CONDA_ENV
+            log:
+                f"logs/{_slug}/{_spec.figure_id}.log",
+            shell:
+                step(_spec.func)
+
+    _figures = [_spec.path for _spec in _specs]
+    _claims = getattr(rules, f"{_slug}_claims").output.table
+    _errata = getattr(rules, f"{_slug}_errata").output.table
+    _reconstructions = getattr(rules, f"{_slug}_reconstructions").output.table
+
+    rule:
+        name:
+            f"{_slug}_notebook"
+        input:
+            notebook=f"workflow/notebooks/{_slug}.ipynb",
+            code=code("netrepro.reportgen"),
+            figures=_figures,
+            tables=PAPER_TABLES[_slug],
+            claims=_claims,
+            errata=_errata,
+            reconstructions=_reconstructions,
+        output:
+            html=f"report/{_slug}.html",
+        localrule: True
+        conda:
+            CONDA_ENV
+        log:
+            f"logs/{_slug}/notebook.log",
+        shell:
+            notebook(_slug)
+
+    PAPER_OUTPUTS[_slug] = dict(
+        figures=_figures,
+        tables=PAPER_TABLES[_slug],
+        claims=_claims,
+        errata=_errata,
+        reconstructions=_reconstructions,
+        notebook=f"report/{_slug}.html",
+    )
