@@ -50,8 +50,9 @@ def planned_jobs():
         if "-m netrepro run" not in line:
             continue
         args = shlex.split(line[line.index("-m netrepro run"):])
-        rule, func = args[args.index("--rule") + 1], args[args.index("--func") + 1]
+        func = args[args.index("--func") + 1]
         io = json.loads(args[args.index("--io") + 1])
+        rule = io["rule"]
         jobs[rule] = (func, set(io["inputs"]["code"]))
     return jobs
 

@@ -1,6 +1,6 @@
 """The one entry point that Snakemake rules call, and the checker of cached results.
 
-``python -m netrepro run --rule RULE --func module:function --params JSON --io JSON``
+``python -m netrepro run --func module:function --params JSON --io JSON``
 runs one step; ``python -m netrepro verify [PATH ...]`` checks every result
 under ``results/`` and ``figures/`` (or the given files and directories)
 against the checksums in their provenance sidecars.
@@ -224,7 +224,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run one pipeline step")
-    run.add_argument("--rule", required=True)
+    run.add_argument("--rule", default=None, help="rule name (default: the \"rule\" entry of --io)")
     run.add_argument("--func", required=True, help="package.module:function")
     run.add_argument("--params", default="{}", help="JSON object of parameters")
     run.add_argument("--io", default="{}", help='JSON {"inputs": {...}, "outputs": {...}}')
@@ -248,6 +248,7 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.INFO, handlers=handlers, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     logging.captureWarnings(True)
     io = json.loads(args.io)
+    args.rule = args.rule or io.get("rule") or "?"
     try:
         run_step(args.rule, args.func, json.loads(args.params), io.get("inputs", {}), io.get("outputs", {}))
     except Exception:

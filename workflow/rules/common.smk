@@ -12,6 +12,7 @@ try:
     from netrepro.config import check_dependencies, validate_config
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
+    from netrepro.reportgen import rule_for, workflow_producers
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "
@@ -51,8 +52,21 @@ def as_json(obj):
 
 
 def io_json(wildcards, input, output):
-    """Named inputs and outputs of the job, as shell-quoted JSON for the runner."""
-    return as_json({"inputs": dict(input.items()), "outputs": dict(output.items())})
+    """The job's rule name and named inputs and outputs, as shell-quoted JSON for the runner."""
+    rule_name = producing_rule(output[0])
+    return as_json(
+        {"rule": rule_name, "inputs": dict(input.items()), "outputs": dict(output.items())}
+    )
+
+
+def producing_rule(path):
+    """Name of the rule that writes ``path``, from the workflow's own rule table (built once)."""
+    if not _PRODUCERS:
+        _PRODUCERS.update(workflow_producers(workflow.rules))
+    return rule_for(path, _PRODUCERS)
+
+
+_PRODUCERS = {}
 
 
 def code(func):
@@ -60,17 +74,21 @@ def code(func):
     return code_inputs(func, root="src")
 
 
-def step(func):
-    """Shell command of a pipeline step: one call into the package (``{rule}`` is the job's rule name)."""
+def step(func="{params.func}"):
+    """Shell command of a pipeline step: one call into the package.
+
+    Rules generated in a loop pass ``params.func`` (their shell command is formatted when the
+    job runs, after the loop has moved on); hand-written rules pass the function here.
+    """
     # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
         "OPENBLAS_NUM_THREADS={threads} OMP_NUM_THREADS={threads} "
-        f"{PYTHON} -m netrepro run --rule {{rule}} --func {func} "
+        f"{PYTHON} -m netrepro run --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )
 
 
-def notebook(slug):
+def notebook(slug="{params.slug}"):
     """Shell command executing the paper's papermill notebook into report/<slug>.html.
 
     The notebook reads tables directly, so their checksums are verified first (a truncated or

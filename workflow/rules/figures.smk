@@ -11,24 +11,25 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             name:
                 _spec.rule
             input:
-                code=code(_spec.func),
                 **figure_inputs(_spec),
+                code=code(_spec.func),
             output:
                 figure=report(
                     _spec.path,
                     caption=f"../report/{_slug}/{_spec.figure_id}.rst",
                     category=_slug,
                 ),
-            params:
-                cfg=as_json(_spec.params),
-                io=io_json,
+            log:
+                f"logs/{_slug}/{_spec.figure_id}.log",
             localrule: True
             conda:
                 CONDA_ENV
-            log:
-                f"logs/{_slug}/{_spec.figure_id}.log",
+            params:
+                func=_spec.func,
+                cfg=as_json(_spec.params),
+                io=io_json,
             shell:
-                step(_spec.func)
+                step()
 
     _figures = [_spec.path for _spec in _specs]
     _claims = getattr(rules, f"{_slug}_claims").output.table
@@ -48,13 +49,15 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             reconstructions=_reconstructions,
         output:
             html=f"report/{_slug}.html",
+        log:
+            f"logs/{_slug}/notebook.log",
         localrule: True
         conda:
             CONDA_ENV
-        log:
-            f"logs/{_slug}/notebook.log",
+        params:
+            slug=_slug,
         shell:
-            notebook(_slug)
+            notebook()
 
     PAPER_OUTPUTS[_slug] = dict(
         figures=_figures,

@@ -18,6 +18,10 @@ rule report:
     output:
         html="report/index.html",
         files=directory("report/files"),
+    log:
+        "logs/report.log",
+    conda:
+        CONDA_ENV
     params:
         cfg=as_json(
             {
@@ -32,9 +36,5 @@ rule report:
             }
         ),
         io=io_json,
-    conda:
-        CONDA_ENV
-    log:
-        "logs/report.log",
     shell:
         step("netrepro.reportgen:build_index")
