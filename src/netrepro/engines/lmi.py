@@ -237,9 +237,99 @@ class MareStabilizabilityLMI:
             blocks.append(row)
         psi = cp.bmat(blocks)
         size = n * (m + 1)
-        constraints = [0.5 * (psi + psi.T) >> self.t * np.eye(size), self.Y << np.eye(n), self.Y >> 0]
+        self.psi = 0.5 * (psi + psi.T)
+        constraints = [self.psi >> self.t * np.eye(size), self.Y << np.eye(n), self.Y >> 0]
         self.problem = cp.Problem(cp.Maximize(self.t), constraints)
         self.n_solves = 0
+        self._certifier = None
+
+    def certifier(self, box=None, dual_routes=("exact", "box")):
+        """The :class:`~netrepro.engines.certify.CertifiedLMI` of this LMI: blocks ``Psi > 0`` and ``Y > 0``.
+
+        Built on first use and kept (the same cvxpy problem and parameters), so a sweep compiles
+        once. The system is homogeneous in ``(Y, Z_i)``: a ``box`` bounds the coordinates after the
+        normalisation ``lambda_min = 1`` (see :func:`~netrepro.engines.certify.check_dual_certificate`).
+
+        Parameters
+        ----------
+        box : float, dict or None
+            Passed to :class:`~netrepro.engines.certify.CertifiedLMI` on first use only.
+        dual_routes : tuple of str
+            Passed likewise.
+
+        Returns
+        -------
+        CertifiedLMI
+            The certifier.
+        """
+        if self._certifier is None:
+            from .certify import CertifiedLMI
+
+            self._certifier = CertifiedLMI([("Psi", self.psi), ("Y", self.Y)], problem=self.problem, box=box,
+                                           dual_routes=dual_routes)
+        return self._certifier
+
+    def loss_condition(self, weights):
+        """The necessary condition ``w_loss rho(A)^2 < 1``, computed without the LMI.
+
+        ``w_loss`` is the total weight of the modes that deliver nothing (``C_i = None``): the
+        operator dominates ``X -> w_loss A X A^T``, so a solution needs ``w_loss rho(A)^2 < 1``
+        (Sinopoli et al. 2004; for ``C`` invertible it is also sufficient). Called violated
+        only when ``w_loss rho(A)^2 >= 1 + 1e-9`` (the margin covers the eigenvalue error of a
+        moderately conditioned ``A``).
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities.
+
+        Returns
+        -------
+        tuple (bool, str)
+            ``(violated, evidence)``, the form :meth:`CertifiedLMI.certify` takes.
+        """
+        w_loss = float(sum(w for w, C in zip(np.asarray(weights, dtype=float), self.mode_outputs) if C is None))
+        rho = float(np.max(np.abs(np.linalg.eigvals(self.A))))
+        value = w_loss * rho ** 2
+        return value >= 1.0 + 1e-9, f"w_loss * rho(A)^2 = {value:.12g}"
+
+    def certify(self, weights, necessary=True, box=None):
+        """Solve for mode probabilities ``weights`` and return the certified verdict.
+
+        Unlike :meth:`solve` (kept unchanged for the tables that use it), the answer is one of
+        ``feasible`` (our eigenvalue check of ``Psi > 0, Y > 0`` at the returned point),
+        ``infeasible`` (the loss condition of :meth:`loss_condition` is violated, or a checked
+        dual certificate) or ``undecided``; the solver status is information only.
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities (non-negative, one per mode).
+        necessary : bool or callable
+            True: use :meth:`loss_condition`; False: none; a callable: ``() -> (violated, evidence)``.
+        box : float, dict or None
+            Passed to :meth:`certifier` on its first use.
+
+        Returns
+        -------
+        Verdict
+            The certified verdict.
+
+        Raises
+        ------
+        ValueError
+            If ``weights`` has the wrong length or a negative entry.
+        """
+        weights = np.asarray(weights, dtype=float)
+        if weights.shape != (len(self.mode_outputs),) or np.any(weights < 0):
+            raise ValueError(f"weights must be {len(self.mode_outputs)} non-negative numbers, got {weights}")
+        self.sqrt_w.value = np.sqrt(weights)
+        self.n_solves += 1
+        if necessary is True:
+            nec = (lambda: self.loss_condition(weights))
+        else:
+            nec = necessary or None
+        return self.certifier(box).solve(necessary=nec)
 
     def solve(self, weights) -> LMIOutcome:
         """Solve for mode probabilities ``weights``; certify any feasible answer independently."""
