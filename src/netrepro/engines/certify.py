@@ -12,13 +12,16 @@ is decided as one of three verdicts:
     The returned point :math:`\hat u` satisfies every block strictly, checked by our own
     eigenvalue computation (numpy, symmetrised, float64): for every block
     :math:`\lambda_{\min}(\mathrm{sym} \hat F_j) > \tau_j` with the margin
-    :math:`\tau_j = c\, n_j \varepsilon \|\hat F_j\|_F + \gamma_{m+2} \|\, |F_{j0}| + \sum_i |\hat u_i| |F_{ji}|\,\|_F`
+    :math:`\tau_j = c\, n_j \varepsilon \|\hat F_j\|_F + \gamma_{m+2} \|\, |F_{j0}| + \sum_i |\hat u_i| |F_{ji}|\,\|_F
+    + \varepsilon \|\hat F_j\|_F`
     (``c = safety``, 10 by default; :math:`\varepsilon` the float64 unit roundoff,
     :math:`\gamma_k = k\varepsilon/(1 - k\varepsilon)`). The first term bounds the backward error of LAPACK's
     symmetric eigensolver (computed eigenvalues are exact for a matrix within
     :math:`p(n)\varepsilon\|F\|_2` of the one given, :math:`p(n)` a modest function of ``n``;
     Demmel, *Applied Numerical Linear Algebra*, 5.2), the second the rounding of evaluating
-    :math:`F_j(\hat u)` itself. The solver's status plays no part.
+    :math:`F_j(\hat u)` itself, the third the symmetrisation. The solver's status plays no part.
+    The point is the float64 variable values as returned; the data are the float64
+    coefficients as cvxpy builds them.
 ``infeasible``
     Backed by a certificate checked in numpy: a dual (theorem-of-alternatives) certificate,
     see :func:`check_dual_certificate`, or a caller-supplied independent necessary condition
@@ -30,7 +33,10 @@ The coefficient matrices :math:`F_{ji}` are extracted from the cvxpy expressions
 own canonicalisation (the sparse parameter-to-coefficient tensor it compiles for DPP
 problems), once per system: each later call only multiplies that tensor by the current
 parameter values, so a sweep keeps the "build once, update parameters" speed of the problem
-it certifies. Symmetric variables count their independent entries once.
+it certifies. Symmetric variables count their independent entries once. The tensor comes from
+``cvxpy.cvxcore.python.canonInterface.get_problem_matrix``, an internal cvxpy function (the one
+cvxpy's own DPP and gradient code call); ``tests/engines/test_certify.py`` checks the extracted
+coefficients against the expressions' values, so a cvxpy upgrade that changes it fails there.
 
 The rounding-error bounds are the standard a priori bounds of floating-point error analysis
 (Higham, *Accuracy and Stability of Numerical Algorithms*, 3.1 and 3.5), not interval
@@ -377,7 +383,8 @@ def check_dual_certificate(coeffs: LMICoefficients, cert: DualCertificate, box=N
     if coeffs.homogeneous:  # normalisation lambda_min >= 1: F_j0 -> -I
         g0 = -sum(float(np.sum(np.asarray(V) ** 2)) for V in cert.factors)
         e0 = _gamma(max(np.asarray(V).size for V in cert.factors) + 2) * abs(g0)
-    terms = np.where((g == 0) & (e == 0), 0.0, R * (np.abs(g) + e))
+    with np.errstate(invalid="ignore"):  # inf * 0 where a coordinate is unbounded but does not enter
+        terms = np.where((g == 0) & (e == 0), 0.0, R * (np.abs(g) + e))
     U = g0 + e0 + float(np.sum(terms))
     scale = sum(float(np.sum(np.asarray(V) ** 2)) for V in cert.factors)  # tr Z
     detail.update({"box_bound": U, "trace_Z": scale, "normalised": coeffs.homogeneous})
