@@ -30,7 +30,23 @@ SOLVER = "CLARABEL"
 
 @dataclass
 class LMIOutcome:
-    """One solve: the solver's status, its margin, and our independent verdict."""
+    """One solve: the solver's status, its margin, and our independent verdict.
+
+    Attributes
+    ----------
+    status : str
+        The solver's status (or ``solver_error: ...``).
+    margin : float
+        The maximised ``t`` in ``Psi >= t I`` (nan when the solver failed).
+    solver_feasible : bool
+        Status optimal and margin above the tolerance.
+    certified : bool
+        The independent check passed (see :class:`MareStabilizabilityLMI`).
+    certificate_value : float
+        E.g. the spectral radius of the closed loop (nan if none).
+    variables : dict
+        The recovered values (e.g. ``Y`` and the gains ``K``).
+    """
 
     status: str
     margin: float  # the maximised t in Psi >= t I (nan when the solver failed)
@@ -42,6 +58,22 @@ class LMIOutcome:
 
 @dataclass
 class BisectionResult:
+    """Outcome of :func:`bisect_monotone` / :func:`bisect_bracketed`.
+
+    Attributes
+    ----------
+    threshold : float
+        Smallest value found feasible (upper end of the final bracket; nan if none).
+    lower : float
+        Largest value found infeasible (nan if none).
+    n_evals : int
+        Number of predicate evaluations.
+    history : list of (float, bool)
+        ``(value, feasible)`` pairs in evaluation order.
+    bracketed : bool
+        True when ``lower`` was infeasible and ``threshold`` feasible.
+    """
+
     threshold: float  # smallest value found feasible (upper end of the final bracket)
     lower: float  # largest value found infeasible
     n_evals: int
@@ -93,6 +125,22 @@ def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_ev
     The ends are evaluated first; if ``lo`` is feasible, the threshold is ``lo``;
     if ``hi`` is infeasible the result has ``threshold = nan``. Otherwise the bracket is
     halved until it is at most ``tol`` wide; the threshold is a point of :func:`_lattice`.
+
+    Parameters
+    ----------
+    is_feasible : callable
+        ``is_feasible(x) -> bool``, monotone in ``x``.
+    lo, hi : float
+        The search interval.
+    tol : float
+        Target bracket width (the lattice spacing).
+    max_evals : int
+        Caps the number of halvings.
+
+    Returns
+    -------
+    BisectionResult
+        The threshold, the bracket and the evaluation history.
     """
     check, history = _recording(is_feasible)
     n, point = _lattice(lo, hi, tol, max_evals)
@@ -116,6 +164,29 @@ def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: flo
     exactly those of :func:`bisect_monotone` (both are the smallest feasible lattice point and
     its neighbour), so the guess changes the number of evaluations, never the answer. With a
     good guess that is about ``2 + log2(2 width / tol)`` instead of ``2 + log2((hi - lo) / tol)``.
+
+    Parameters
+    ----------
+    is_feasible : callable
+        ``is_feasible(x) -> bool``, monotone in ``x``.
+    lo, hi : float
+        The search interval.
+    guess : float
+        Estimate of the threshold (non-finite: plain :func:`bisect_monotone`).
+    width : float
+        Half-width of the first bracket around ``guess``.
+    tol, max_evals : float, int
+        As in :func:`bisect_monotone`.
+
+    Returns
+    -------
+    BisectionResult
+        The same threshold and lower end as :func:`bisect_monotone`.
+
+    Raises
+    ------
+    ValueError
+        If ``lo > hi``.
     """
     if not lo <= hi:
         raise ValueError(f"bisect_bracketed needs lo <= hi, got lo={lo}, hi={hi}")
@@ -159,6 +230,22 @@ def sweep_thresholds(make_predicate, grid, lo: float, hi: float, tol: float = 1e
     at least ``2 tol``). ``warm_start=False`` runs plain bisections throughout
     (the reference). For monotone predicates every threshold equals the plain bisection's
     exactly (:func:`bisect_bracketed`); only the number of solves changes.
+
+    Parameters
+    ----------
+    make_predicate : callable
+        ``make_predicate(x) -> is_feasible`` for grid point ``x``.
+    grid : iterable of float
+        The grid points, in sweep order.
+    lo, hi, tol, max_evals : float, float, float, int
+        As in :func:`bisect_monotone`.
+    warm_start : bool
+        Start each bisection from the extrapolated neighbours (same answers, fewer solves).
+
+    Returns
+    -------
+    list of BisectionResult
+        One per grid point.
     """
     results, found = [], []
     for x in grid:
@@ -189,6 +276,18 @@ def second_moment_radius(closed_loops, weights) -> float:
 
     The expected error covariance of a switched linear recursion with i.i.d.
     mode weights ``w_i`` stays bounded for every noise level iff this is < 1.
+
+    Parameters
+    ----------
+    closed_loops : sequence of ndarray (n, n)
+        The matrices ``F_i``.
+    weights : sequence of float
+        The weights ``w_i``.
+
+    Returns
+    -------
+    float
+        The spectral radius.
     """
     op = sum(w * np.kron(F, F) for F, w in zip(closed_loops, weights))
     return float(np.max(np.abs(np.linalg.eigvals(np.atleast_2d(op)))))
@@ -212,6 +311,28 @@ class MareStabilizabilityLMI:
     The problem maximises t subject to Psi >= t I and 0 <= Y <= I (the LMI is
     homogeneous, so the bound only fixes the scale). The weights' square
     roots are :class:`cvxpy.Parameter` objects: a sweep compiles once.
+
+    :meth:`solve` keeps its historical decision rule (status optimal, margin above
+    ``margin_tol``, then the second-moment radius); :meth:`certify` gives the verdict of
+    :mod:`netrepro.engines.certify` (feasible / infeasible / undecided, each certified).
+
+    Parameters
+    ----------
+    A : array_like, shape ``(n, n)``
+        State matrix.
+    mode_outputs : sequence of (array_like or None)
+        ``C_i`` delivered by mode ``i`` (None: nothing arrives).
+    margin_tol : float
+        Margin above which :meth:`solve` counts a solve as solver-feasible.
+
+    Attributes
+    ----------
+    problem : cvxpy.Problem
+        The parametrised problem (maximise ``t``).
+    psi : cvxpy.Expression
+        The symmetrised ``Psi``.
+    n_solves : int
+        Solves so far (:meth:`solve` and :meth:`certify`).
     """
 
     def __init__(self, A, mode_outputs, margin_tol: float = 1e-7):
@@ -332,7 +453,23 @@ class MareStabilizabilityLMI:
         return self.certifier(box).solve(necessary=nec)
 
     def solve(self, weights) -> LMIOutcome:
-        """Solve for mode probabilities ``weights``; certify any feasible answer independently."""
+        """Solve for mode probabilities ``weights``; certify any feasible answer independently.
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities (non-negative, one per mode).
+
+        Returns
+        -------
+        LMIOutcome
+            Status, margin, and the second-moment-radius check of the recovered gains.
+
+        Raises
+        ------
+        ValueError
+            If ``weights`` has the wrong length or a negative entry.
+        """
         weights = np.asarray(weights, dtype=float)
         if weights.shape != (len(self.mode_outputs),) or np.any(weights < 0):
             raise ValueError(f"weights must be {len(self.mode_outputs)} non-negative numbers, got {weights}")
