@@ -318,11 +318,24 @@ def test_blocked_import_gives_clear_message(tmp_path, blocked):
 
 
 def test_paper_needing_a_missing_package_is_not_reported_as_a_missing_paper(tmp_path):
-    # pandas: imported by the paper module itself (cvxpy, numba and matplotlib are imported by the
-    # steps that use them, so check_dependencies names those at start-up instead)
+    # a paper's checks module that imports a missing package (pandas, blocked). The packaged papers keep
+    # checks.py light (no pandas), so the import of such a module is simulated by a finder that
+    # loads the real checks module after an `import pandas`
     proc = run_blocked(tmp_path, ["pandas"], """
+        import importlib.abc, importlib.util, sys
         import yaml
         from netrepro.config import validate_config, DependencyError
+
+        class NeedsPandas(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+            def find_spec(self, name, path, target=None):
+                if name == "netrepro.papers.intermittent.checks":
+                    return importlib.util.spec_from_loader(name, self)
+            def create_module(self, spec):
+                return None
+            def exec_module(self, module):
+                import pandas  # noqa: F401  (blocked)
+
+        sys.meta_path.insert(0, NeedsPandas())
         cfg = yaml.safe_load(open("config/test.yaml"))
         try:
             validate_config({"papers": ["intermittent"], "intermittent": cfg["intermittent"]})

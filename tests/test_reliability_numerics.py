@@ -21,7 +21,9 @@ from netrepro.engines.channels import arrival_patterns, iid_arrivals
 from netrepro.engines.montecarlo import merge_block_sums, n_blocks, run_blocks, run_monte_carlo
 from netrepro.engines.riccati import Sensor, covariance_paths, iterate_expected_riccati
 from netrepro.io import atomic_path, write_table
-from netrepro.papers import intermittent as inter
+from netrepro.papers.intermittent import estimators as inter_est
+from netrepro.papers.intermittent import model as inter
+from netrepro.papers.intermittent import two_sensor as inter_two
 from netrepro.provenance import CorruptOutputError, sidecar_path, verify_output, verify_tree
 from netrepro.runner import main as runner_main
 from netrepro.runner import run_step, verify_main
@@ -190,7 +192,7 @@ def intermittent_estimator(lam, horizon):
 
     def simulate(rng, n):
         paths = covariance_paths(P0, [[A]], [[R1]], sensors, iid_arrivals(rng, n, horizon, lam))
-        return {"plain": paths, "cond": inter.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])}
+        return {"plain": paths, "cond": inter_est.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])}
 
     return simulate
 
@@ -242,7 +244,7 @@ def fake_solve(status, t=None, Y=None, Z=None, error=None):
 
 
 def scalar_lmi():
-    return lmi_mod.MareStabilizabilityLMI([[A]], inter.two_sensor_modes())
+    return lmi_mod.MareStabilizabilityLMI([[A]], inter_two.two_sensor_modes())
 
 
 WEIGHTS = arrival_patterns([0.9, 0.9])[1]
@@ -291,18 +293,18 @@ def test_failed_solves_never_produce_a_threshold(monkeypatch, mode):
     fake = {"error": fake_solve(None, error="boom"), "infeasible": fake_solve("infeasible"),
             "inaccurate": fake_solve("optimal_inaccurate", t=1.0, Y=[[1.0]], Z=-A)}[mode]
     monkeypatch.setattr(cp.Problem, "solve", fake)
-    table = inter.two_sensor_upper_bound([0.2, 0.6], A, tol=1e-2)
+    table = pd.DataFrame(inter_two.two_sensor_upper_bound([0.2, 0.6], A, tol=1e-2))
     assert table["lambda2c_upper"].isna().all()
 
 
 def test_failed_solves_are_recorded_with_their_status(monkeypatch):
     monkeypatch.setattr(cp.Problem, "solve", fake_solve(None, error="boom"))
-    table = inter.two_sensor_upper_bound([0.2], A, tol=1e-2)
+    table = pd.DataFrame(inter_two.two_sensor_upper_bound([0.2], A, tol=1e-2))
     assert "solver_error" in table["status_at_threshold"].iloc[0]
 
 
 def test_threshold_found_is_certified():
-    table = inter.two_sensor_upper_bound([0.3], A, tol=1e-3)
+    table = pd.DataFrame(inter_two.two_sensor_upper_bound([0.3], A, tol=1e-3))
     row = table.iloc[0]
     assert row["status_at_threshold"] == "optimal" and row["certified_radius"] < 1.0
 
@@ -403,7 +405,7 @@ def test_intermittent_diverging_case_at_configured_horizons(rng, horizon):
         r = inter.upper_bound_sequence(P0, A, R1, R2, lam, horizon)
         est = inter.report_estimate_sequence(P0, s, r, A, R1, R2, lam)
         paths = covariance_paths(P0, [[A]], [[R1]], [Sensor([[1.0]], [[R2]])], iid_arrivals(rng, 500, horizon, lam))
-        cond = inter.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])
+        cond = inter_est.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])
     for arr in (s, r, est, cond):
         assert not np.isnan(arr).any()
     assert np.all(np.diff(s[-10:]) > 0) and np.all(np.diff(r[-10:]) > 0)
@@ -415,7 +417,7 @@ def test_intermittent_diverging_case_over_a_long_horizon_is_inf_not_nan(rng):
         warnings.simplefilter("error")
         r = inter.upper_bound_sequence(P0, A, R1, R2, lam, horizon)
         paths = covariance_paths(P0, [[A]], [[R1]], [Sensor([[1.0]], [[R2]])], iid_arrivals(rng, 50, horizon, lam))
-        cond = inter.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])
+        cond = inter_est.conditional_mean_paths(paths, P0, A, R1, [R2], [lam])
     assert not np.isnan(r).any() and not np.isnan(cond).any()
 
 

@@ -381,7 +381,7 @@ def bench_lmi(n_sweep: int, grid_points: int, tol: float, repeats: int) -> list[
         timings[label] = time.perf_counter() - start
     # what the pipeline runs: each point bracketed from its own closed-form lower bound
     from .engines.lmi import bisect_bracketed
-    from .papers.intermittent import two_sensor_lower_bound
+    from .papers.intermittent.two_sensor import two_sensor_lower_bound
 
     start = time.perf_counter()
     results["lower_bound"] = [bisect_bracketed(make(l1), 0.0, 1.0, g, 0.0, tol)

@@ -1,0 +1,28 @@
+"""Paper `intermittent`: S. Teerikoski, *Kalman Filtering with Measurement Losses* (report, 2014).
+
+After Sinopoli et al. (2004) and Liu & Goldsmith (2004). The report studies the scalar
+system x_{k+1} = a x_k + v_k, y_k = x_k + w_k with i.i.d. packet losses (arrival
+probability lambda) and the prediction-error variance recursion (6)
+
+    p_{k+1} = a^2 p_k + R1 - gamma_k a^2 p_k^2 / (p_k + R2).
+
+Modules
+-------
+``model``
+    The scalar equations: critical probability, the Riccati step (6), the bounds s_k (10)
+    and r_k (9), the report's rough estimate of E(p_k), exact E(p_k) by enumeration,
+    Sinopoli's operator phi(K, p).
+``estimators``
+    The conditional Monte Carlo estimator of E(p_k) (averages bounded quantities only).
+``two_sensor``
+    The two-sensor stability region (Liu & Goldsmith): closed-form lower bound and the
+    certified LMI upper bound (eq. 16) by bisection.
+``steps``
+    Pipeline steps writing ``results/intermittent/*.csv``.
+``claims``
+    The claims, errata and reconstructions tables.
+``figures``
+    Figs 1, 2, 4, 5 and S1 from the tables.
+``checks``
+    ``check_config``: configuration checks beyond the schema.
+"""
