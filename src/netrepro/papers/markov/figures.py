@@ -1,0 +1,129 @@
+"""Figures of the `markov` paper: plotting only, from the tables under ``results/markov/``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ...plotting import new_figure, save_figure
+
+__all__ = ["figure_plane", "figure_path", "figure_mean", "figure_estimators", "figure_curves"]
+
+
+_COLORS = {"bounded": "#2ca02c", "unbounded": "#d62728", "undecided": "#bbbbbb"}
+
+
+def figure_plane(params, inputs, outputs):
+    """Fig. 2 made quantitative: the p-q plane of both examples with the curves and the stability map."""
+    curves = pd.read_csv(inputs["curves"])
+    smap = pd.read_csv(inputs["map"], keep_default_na=False)
+    iid = pd.read_csv(inputs["iid"]).set_index("example")
+    names = list(params["examples"])
+    fig, axes = new_figure(1, len(names), figsize=(5.2 * len(names), 4.6), squeeze=False)
+    for ax, name in zip(axes[0], names):
+        s = smap[smap.example == name]
+        for verdict, color in _COLORS.items():
+            sub = s[s.verdict == verdict]
+            ax.scatter(sub.q, sub.p, s=7, marker="s", color=color, alpha=0.55, linewidths=0,
+                       label=f"map: E||P_k|| {verdict}")
+        c = curves[curves.example == name]
+        ax.plot(c.q, c.p_thm5, color="k", lw=2, label="Theorem 5 lower bound p(q)")
+        ax.plot(c.q, c.p_prop1, color="tab:blue", lw=1.5, ls="--", label="Proposition 1 (eq. 8)")
+        if c.p_reference.notna().any():
+            ax.plot(c.q, c.p_reference, color="tab:purple", lw=1, ls=":", label="reference p_c (table column reference)")
+        qn = c.q_necessary.iloc[0]
+        ax.axvline(qn, color="tab:orange", lw=1.5, label=f"necessary |lambda|^2(1-q) = 1 (q = {qn:.3f})")
+        ax.plot([0, 1], [1, 0], color="0.3", lw=1, ls="-.", label="i.i.d. line p + q = 1")
+        r = iid.loc[name]
+        ax.plot([r.q_thm5_on_iid_line], [1 - r.q_thm5_on_iid_line], "k*", ms=10, label="Thm 5 on the i.i.d. line")
+        ax.plot([r.lambda_lmi_upper], [1 - r.lambda_lmi_upper], "bv", ms=7, label="Sinopoli LMI bound")
+        ax.plot([r.lambda_lower], [1 - r.lambda_lower], "b^", ms=7, label="Sinopoli lower bound")
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1.02)
+        ax.set_xlabel("recovery rate q")
+        ax.set_ylabel("failure rate p")
+        ax.set_title(f"Example {name}")
+    axes[0][-1].legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_path(params, inputs, outputs):
+    """Figs. 3-5: a sample path of ||P_k|| and gamma_k, with Monte Carlo bands and trustworthy means."""
+    t = pd.read_csv(inputs["paths"])
+    t = t[t.figure == params["figure"]]
+    fig, (ax, ax2) = new_figure(2, 1, figsize=(6.4, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    ax.fill_between(t.k, t.q05, t.q95, color="tab:blue", alpha=0.15, label="5-95% of ||P_k|| (Monte Carlo)")
+    ax.plot(t.k, t.q50, color="tab:blue", lw=1, ls="--", label="median")
+    ax.plot(t.k, t.norm_path, color="k", lw=1.2, label="one sample path ||P_k||")
+    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.5, label="E||P_k|| (conditional estimator)")
+    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, ls=":", label="E||P_k|| (exact, all paths)")
+    ax.set_yscale("log")
+    ax.set_ylabel("||P_k||")
+    p, q = t.p.iloc[0], t.q.iloc[0]
+    ax.set_title(f"Example {t.example.iloc[0]}, p = {p}, q = {q}")
+    ax.legend(fontsize=7)
+    g = t.dropna(subset=["gamma"])
+    ax2.step(g.k, g.gamma, where="post", color="k", lw=0.8)
+    ax2.set_ylim(-0.2, 1.2)
+    ax2.set_yticks([0, 1])
+    ax2.set_ylabel("gamma_k")
+    ax2.set_xlabel("k")
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_mean(params, inputs, outputs):
+    """Fig. 6: divergence of E||P_k|| at (0.99, 0.5) on Example II (exact, conditional, plain)."""
+    t = pd.read_csv(inputs["paths"])
+    t = t[t.figure == params["figure"]]
+    fig, ax = new_figure()
+    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, label="E||P_k|| exact (all channel paths)")
+    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.2, label="conditional estimator (trailing loss run integrated)")
+    ax.plot(t.k, t.plain_mean, color="tab:blue", lw=1, ls="--", label="plain sample mean")
+    ax.plot(t.k, t.q50, color="0.5", lw=1, ls=":", label="median ||P_k||")
+    ax.set_yscale("log")
+    ax.set_xlabel("k")
+    ax.set_ylabel("E||P_k||")
+    ax.set_title(f"Example {t.example.iloc[0]}, p = {t.p.iloc[0]}, q = {t.q.iloc[0]}")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_estimators(params, inputs, outputs):
+    """Fig. S1: plain sample mean vs conditional estimator vs exact expectation."""
+    e = pd.read_csv(inputs["check"])
+    labels = [f"Ex {r.example}\n({r.p:g}, {r.q:g})" for r in e.itertuples()]
+    x = np.arange(len(e))
+    fig, ax = new_figure(figsize=(7.0, 4.0))
+    ax.bar(x - 0.27, e.plain_over_exact, 0.27, label="plain / exact  (k = depth+1)", color="tab:blue")
+    ax.bar(x, e.rb_over_exact, 0.27, label="conditional / exact  (k = depth+1)", color="tab:red")
+    ax.bar(x + 0.27, e.plain_over_rb_long, 0.27, label="plain / conditional  (long horizon)", color="0.5")
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xticks(x)
+    ax.set_xticklabels(labels, fontsize=7)
+    ax.set_ylabel("ratio of estimates of E||P_k||")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_curves(params, inputs, outputs):
+    """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values."""
+    curves = pd.read_csv(inputs["curves"])
+    fig, ax = new_figure()
+    for name, color in zip(params["examples"], ("tab:blue", "tab:green", "tab:red")):
+        c = curves[curves.example == name]
+        ax.plot(c.q, c.p_thm5_uncapped, color=color, lw=2, label=f"Ex {name}: Theorem 5 (uncapped)")
+        ax.plot(c.q, c.p_prop1_uncapped, color=color, lw=1, ls="--", label=f"Ex {name}: Proposition 1")
+        sat = c[c.thm5_saturated.astype(str).str.lower() == "true"]
+        ax.plot(sat.q, sat.p_thm5_uncapped, "^", color=color, ms=5, label=f"Ex {name}: search cap reached")
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xlabel("q")
+    ax.set_ylabel("bound on p")
+    ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}

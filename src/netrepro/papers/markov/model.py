@@ -1,0 +1,492 @@
+"""The equations of the `markov` paper (Wu, Shi, Anderson, Johansson): system, observability,
+Proposition 1 (eq. 8), the operators of Theorems 1-2 (eqs. 7, 9), the Riccati maps (eqs. 4-5)
+and closed forms for the two examples.
+
+Channel convention (eq. 3): ``gamma_k`` is the state of a two-state Markov chain,
+``p = P(gamma_{k+1}=0 | gamma_k=1)`` (failure rate), ``q = P(gamma_{k+1}=1 | gamma_k=0)``
+(recovery rate), and ``gamma_1 = 1``. ``P_k`` is the prediction covariance ``P_{k|k-1}``;
+``P_{k+1} = g(P_k)`` when ``gamma_k = 1`` and ``h(P_k)`` otherwise (eqs. 4-5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...engines.channels import gilbert_elliott_stationary
+from ...errors import InputError
+
+__all__ = [
+    "LinearSystem", "spectral_abs", "observability_index", "stacked_output", "prop1_bound", "loss_factor",
+    "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm",
+    "gilbert_elliott_stationary_loss", "parity_bound_example2", "norm_relaxation_bound",
+]
+
+
+# ----------------------------------------------------------------------------- system
+@dataclass(frozen=True)
+class LinearSystem:
+    """``x_{k+1} = A x_k + w_k``, ``y_k = C x_k + v_k`` (eqs. 1-2) with ``Q = cov w``, ``R = cov v``.
+
+    Parameters
+    ----------
+    A, C, Q, R : array_like
+        System matrix ``(n, n)``, output matrix ``(m, n)``, process noise covariance ``(n, n)`` and
+        measurement noise covariance ``(m, m)`` of eqs. (1)-(2).
+
+    Raises
+    ------
+    InputError
+        If the shapes are inconsistent.
+    """
+
+    A: np.ndarray
+    C: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+
+    def __post_init__(self):
+        for name in ("A", "C", "Q", "R"):
+            object.__setattr__(self, name, np.atleast_2d(np.asarray(getattr(self, name), dtype=float)))
+        n, m = self.A.shape[0], self.C.shape[0]
+        if self.A.shape != (n, n) or self.C.shape[1] != n or self.Q.shape != (n, n) or self.R.shape != (m, m):
+            raise InputError(f"inconsistent shapes A{self.A.shape} C{self.C.shape} Q{self.Q.shape} R{self.R.shape}")
+
+    @property
+    def n(self):
+        """The state dimension.
+
+        Returns
+        -------
+        int
+            The state dimension ``n``.
+        """
+        return self.A.shape[0]
+
+    @classmethod
+    def from_config(cls, cfg: dict) -> "LinearSystem":
+        """Build the system from a configuration example.
+
+        Parameters
+        ----------
+        cfg : dict
+            A configuration example with keys ``A, C, Q, R``.
+
+        Returns
+        -------
+        LinearSystem
+        """
+        return cls(cfg["A"], cfg["C"], cfg["Q"], cfg["R"])
+
+
+def spectral_abs(A) -> float:
+    """``|lambda_A|``: the largest eigenvalue magnitude of ``A`` (paper's notation).
+
+    Parameters
+    ----------
+    A : array_like
+        Square matrix.
+
+    Returns
+    -------
+    float
+        ``max_i |lambda_i(A)|``.
+    """
+    return float(np.max(np.abs(np.linalg.eigvals(np.atleast_2d(A)))))
+
+
+def observability_index(A, C) -> int:
+    """Observability index ``l_o`` (Definition 2).
+
+    The smallest ``l`` with ``rank [C; CA; ...; CA^{l-1}] = n``.
+
+    Raises
+    ------
+    InputError
+        If ``(C, A)`` is not observable.
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)`` system matrix.
+    C : array_like
+        ``(m, n)`` output matrix.
+
+    Returns
+    -------
+    int
+        ``l_o``, between 1 and ``n``.
+    """
+    A, C = np.atleast_2d(A), np.atleast_2d(C)
+    n = A.shape[0]
+    for ell in range(1, n + 1):
+        if np.linalg.matrix_rank(stacked_output(A, C, ell)) == n:
+            return ell
+    raise InputError("(C, A) is not observable")
+
+
+def stacked_output(A, C, i: int) -> np.ndarray:
+    """``C^{(i)} = [C; CA; ...; CA^{i-1}]`` (``m i x n``), our reading of the undefined ``C^{(i)}`` in eqs. 7, 9, 11.
+
+    With ``i`` consecutive receptions starting at a peak time, a (sub-optimal) linear
+    estimator gives the error map ``A^i + K^{(i)} C^{(i)}`` for any gain ``K^{(i)}``.
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)`` system matrix.
+    C : array_like
+        ``(m, n)`` output matrix.
+    i : int
+        Number of stacked blocks.
+
+    Returns
+    -------
+    ndarray
+        ``(m i, n)`` matrix ``[C; CA; ...; CA^{i-1}]``.
+    """
+    A, C = np.atleast_2d(A), np.atleast_2d(C)
+    return np.vstack([C @ np.linalg.matrix_power(A, j) for j in range(i)])
+
+
+# ----------------------------------------------------------------------------- Prop 1, eq (7), eq (9)
+def prop1_bound(lam_abs: float, q, l_o: int, p_max: float = 1.0, tol: float = 1e-12):
+    """Largest ``p`` satisfying Proposition 1, eq. (8).
+
+    .. math:: p q |\\lambda_A|^2 \\sum_{i=1}^{l_o-1} |\\lambda_A|^{2i} (1-p)^{i-1} < 1 - |\\lambda_A|^2 (1-q)
+
+    For ``l_o = 2`` this is ``p < (1 - |lambda|^2 (1-q)) / (|lambda|^4 q)`` (Section 5.1); the
+    value may exceed 1 (returned uncapped). For ``l_o > 2`` the left side is solved by bisection
+    on ``[0, p_max]``. Vectorised over ``q``; ``nan`` where ``|lambda|^2 (1-q) >= 1``.
+
+    Parameters
+    ----------
+    lam_abs : float
+        ``|lambda_A|``.
+    q : array_like
+        Recovery rates.
+    l_o : int
+        Observability index (Definition 2).
+    p_max : float
+        Upper end of the bisection for ``l_o > 2``.
+    tol : float
+        Bisection tolerance for ``l_o > 2``.
+
+    Returns
+    -------
+    ndarray
+        The bound on ``p`` for each ``q`` (``inf`` for ``l_o = 1``, ``nan`` where eq. 8 cannot hold).
+    """
+    q = np.asarray(q, dtype=float)
+    l2 = lam_abs ** 2
+    rhs = 1.0 - l2 * (1.0 - q)
+    out = np.full(q.shape, np.nan)
+    ok = rhs > 0
+    if l_o < 2:
+        out[ok] = np.inf  # one-step observable: no constraint on p
+        return out
+    if l_o == 2:
+        out[ok] = rhs[ok] / (l2 * l2 * q[ok])
+        return out
+
+    def lhs(p, qq):
+        return p * qq * l2 * sum(l2 ** i * (1 - p) ** (i - 1) for i in range(1, l_o))
+
+    lo, hi = np.zeros(q.shape), np.full(q.shape, p_max)
+    while np.max(hi - lo) > tol:
+        mid = 0.5 * (lo + hi)
+        bad = lhs(mid, q) >= rhs
+        hi = np.where(bad, mid, hi)
+        lo = np.where(bad, lo, mid)
+    out[ok] = lo[ok]
+    return out
+
+
+def loss_factor(A, q) -> np.ndarray:
+    """``q [(A (x) A)^{-1} - (1-q) I]^{-1} = sum_{j>=1} q (1-q)^{j-1} (A (x) A)^j`` (first factor of eq. 7).
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)`` system matrix with ``|lambda_A|^2 (1-q) < 1``.
+    q : float
+        Recovery rate.
+
+    Returns
+    -------
+    ndarray
+        ``(n^2, n^2)`` matrix.
+    """
+    A = np.atleast_2d(A)
+    AA = np.kron(A, A)
+    return q * np.linalg.inv(np.linalg.inv(AA) - (1.0 - q) * np.eye(AA.shape[0]))
+
+
+def H_matrix(A, C, K, p, q) -> np.ndarray:
+    """``H(K)`` of Theorem 1, eq. (7).
+
+    .. math::
+        H(K) = qp[(A\\otimes A)^{-1} - (1-q)I]^{-1} \\sum_{i=1}^{l_o-1}
+               \\overline{(A^i + K^{(i)}C^{(i)})} \\otimes (A^i + K^{(i)}C^{(i)}) (1-p)^{i-1}
+
+    Parameters
+    ----------
+    K : list of arrays
+        ``K[i-1]`` is ``K^{(i)}`` of shape ``(n, m i)``, ``i = 1 .. l_o - 1``.
+
+    Returns
+    -------
+    ndarray
+        Complex ``(n^2, n^2)`` matrix ``H(K)``.
+    """
+    A = np.atleast_2d(A)
+    total = np.zeros((A.shape[0] ** 2,) * 2, dtype=complex)
+    for i, Ki in enumerate(K, start=1):
+        M = np.linalg.matrix_power(A, i) + np.asarray(Ki) @ stacked_output(A, C, i)
+        total = total + (1.0 - p) ** (i - 1) * np.kron(np.conj(M), M)
+    return p * loss_factor(A, q) @ total
+
+
+def h_radius(A, C, K, p, q) -> float:
+    """Spectral radius ``|lambda_{H(K)}|`` of eq. (7): the independent certificate of Theorems 1-2.
+
+    Parameters
+    ----------
+    A, C : array_like
+        System and output matrices.
+    K : list of arrays
+        Gains ``K^{(i)}``, as in :func:`H_matrix`.
+    p, q : float
+        Failure and recovery rates.
+
+    Returns
+    -------
+    float
+        ``rho(H(K))``; the filter is mean-square stable with these gains if it is below 1 (Theorem 1).
+    """
+    return float(np.max(np.abs(np.linalg.eigvals(H_matrix(A, C, K, p, q)))))
+
+
+def phi_lyapunov(A, X, q) -> np.ndarray:
+    """``Phi_X``: solution of ``(1-q) A' Phi A + q A' X A = Phi`` (below eq. 9), needs ``|lambda_A|^2 (1-q) < 1``.
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)`` system matrix.
+    X : array_like
+        ``(n, n)`` symmetric matrix.
+    q : float
+        Recovery rate.
+
+    Returns
+    -------
+    ndarray
+        ``Phi_X``, ``(n, n)``.
+    """
+    A = np.atleast_2d(A)
+    n = A.shape[0]
+    rhs = q * A.T @ X @ A
+    # vec(A' Phi A) = (A' (x) A') vec(Phi) with row-major vec of a matrix (symmetric case: either works)
+    op = np.eye(n * n) - (1.0 - q) * np.kron(A.T, A.T)
+    return np.linalg.solve(op, rhs.reshape(-1)).reshape(n, n)
+
+
+def L_operator(A, C, K, p, q, X) -> np.ndarray:
+    """The operator ``L_K`` of eq. (9).
+
+    .. math:: \\mathcal{L}_K(X) = p \\sum_{i=1}^{l_o-1} (1-p)^{i-1} (A^i + K^{(i)}C^{(i)})^* \\Phi_X (A^i + K^{(i)}C^{(i)})
+
+    It is the adjoint of ``vec^{-1} H(K) vec`` (eq. 7) under ``<X, P> = tr(XP)``, so the two share
+    their spectral radius (Theorem 2, (i) <=> (ii)).
+
+    Parameters
+    ----------
+    A, C : array_like
+        System and output matrices.
+    K : list of arrays
+        Gains ``K^{(i)}``, as in :func:`H_matrix`.
+    p, q : float
+        Failure and recovery rates.
+    X : array_like
+        ``(n, n)`` symmetric matrix.
+
+    Returns
+    -------
+    ndarray
+        ``L_K(X)``, ``(n, n)``.
+    """
+    A = np.atleast_2d(A)
+    phi = phi_lyapunov(A, X, q)
+    out = np.zeros_like(phi)
+    for i, Ki in enumerate(K, start=1):
+        M = np.linalg.matrix_power(A, i) + np.asarray(Ki) @ stacked_output(A, C, i)
+        out = out + p * (1.0 - p) ** (i - 1) * M.conj().T @ phi @ M
+    return out
+
+
+# ----------------------------------------------------------------------------- Riccati maps
+def riccati_h(P, A, Q):
+    """``h(X) = A X A' + Q`` (eq. 4), batched over leading axes.
+
+    Parameters
+    ----------
+    P : ndarray
+        ``(..., n, n)`` covariances.
+    A, Q : ndarray
+        System matrix and process noise covariance.
+
+    Returns
+    -------
+    ndarray
+        ``(..., n, n)``.
+    """
+    return A @ P @ A.T + Q
+
+
+def riccati_g(P, A, C, Q, R):
+    """``g(X) = A X A' + Q - A X C' (C X C' + R)^{-1} C X A'`` (eq. 5), batched over leading axes.
+
+    Parameters
+    ----------
+    P : ndarray
+        ``(..., n, n)`` covariances.
+    A, C, Q, R : ndarray
+        System matrices of eqs. (1)-(2).
+
+    Returns
+    -------
+    ndarray
+        ``(..., n, n)``, symmetrised.
+    """
+    PCt = P @ C.T
+    S = C @ PCt + R
+    if S.shape[-1] == 1:  # one output: a division, not a batched LAPACK solve of 1 x 1 systems
+        post = P - PCt @ (np.swapaxes(PCt, -1, -2) / S)
+    else:
+        post = P - PCt @ np.linalg.solve(S, np.swapaxes(PCt, -1, -2))
+    out = A @ post @ A.T + Q
+    return 0.5 * (out + np.swapaxes(out, -1, -2))
+
+
+def sym_norm(P) -> np.ndarray:
+    """Induced 2-norm of symmetric PSD matrices (largest eigenvalue), batched; ``inf`` stays ``inf``.
+
+    Parameters
+    ----------
+    P : array_like
+        ``(..., n, n)`` symmetric matrices (non-finite entries allowed).
+
+    Returns
+    -------
+    ndarray
+        ``(...)`` largest eigenvalues; ``inf`` where a matrix has a non-finite entry.
+    """
+    P = np.asarray(P, dtype=float)
+    bad = ~np.isfinite(P).all(axis=(-1, -2))
+    Pf = np.where(bad[..., None, None], 0.0, P)
+    n = P.shape[-1]
+    if n == 2:
+        a, b, d = Pf[..., 0, 0], 0.5 * (Pf[..., 0, 1] + Pf[..., 1, 0]), Pf[..., 1, 1]
+        val = 0.5 * (a + d) + np.sqrt(0.25 * (a - d) ** 2 + b * b)
+    elif n == 3:
+        val = _largest_eigenvalue_3x3(0.5 * (Pf + np.swapaxes(Pf, -1, -2)))
+    else:
+        val = np.linalg.eigvalsh(Pf)[..., -1]
+    return np.where(bad, np.inf, val)
+
+
+def _largest_eigenvalue_3x3(S) -> np.ndarray:
+    """Largest eigenvalue of symmetric 3 x 3 matrices in closed form (trigonometric solution of the
+    characteristic cubic), batched; LAPACK's ``eigvalsh`` costs ~20 us per small matrix, this a few
+    vectorised operations. With ``q = tr S / 3``, ``p = ||S - q I||_F / sqrt(6)`` and
+    ``r = det((S - q I) / p) / 2``: ``lambda_max = q + 2 p cos(arccos(r) / 3)`` (``q`` where ``p = 0``).
+    """
+    q = np.trace(S, axis1=-2, axis2=-1) / 3.0
+    D = S - q[..., None, None] * np.eye(3)
+    p = np.sqrt(np.sum(D * D, axis=(-2, -1)) / 6.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        B = D / p[..., None, None]
+        b00, b11, b22 = B[..., 0, 0], B[..., 1, 1], B[..., 2, 2]
+        b01, b02, b12 = B[..., 0, 1], B[..., 0, 2], B[..., 1, 2]
+        det = b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) + b02 * (b01 * b12 - b11 * b02)
+        r = det / 2.0
+    phi = np.arccos(np.clip(np.nan_to_num(r), -1.0, 1.0)) / 3.0
+    return np.where(p > 0, q + 2.0 * p * np.cos(phi), q)
+
+
+# ----------------------------------------------------------------------------- i.i.d. line, analytic helpers
+def gilbert_elliott_stationary_loss(p, q) -> float:
+    """Stationary loss probability ``P(gamma = 0) = p / (p + q)`` of the chain (3).
+
+    Parameters
+    ----------
+    p, q : float
+        Failure and recovery rates of eq. (3).
+
+    Returns
+    -------
+    float
+    """
+    return gilbert_elliott_stationary(p, q)[1]
+
+
+def parity_bound_example2(lam_abs: float, q):
+    """Closed-form ``p`` at which ``p q |lambda|^4 / (1 - (|lambda|^2 (1-q))^2) = 1`` (Example II).
+
+    For ``A = |lambda| diag(1, 1, -1)`` with ``C`` of eq. (13): ``A^2 = |lambda|^2 I`` and
+    ``C v = 0`` for ``v = (1, 1, -1)``, so receptions separated by even gaps never observe ``v``.
+    Summing over gaps of ``j`` losses (``j`` odd) gives this renewal ratio; our derivation (see the
+    report) shows it is also the value of Theorem 5's ``p_underline(q)`` for this system (gain with
+    range ``span(S v)`` and ``M S v = 0``), so it is the analytic check of the bisection.
+
+    Parameters
+    ----------
+    lam_abs : float
+        ``|lambda_A|`` of Example II (1.2 in eq. 13).
+    q : array_like
+        Recovery rates.
+
+    Returns
+    -------
+    ndarray
+        The critical ``p`` for each ``q`` (may exceed 1).
+    """
+    q = np.asarray(q, dtype=float)
+    l2 = lam_abs ** 2
+    return (1.0 - (l2 * (1.0 - q)) ** 2) / (l2 * l2 * q)
+
+
+def norm_relaxation_bound(A, q, K=None, i_max: int = 4000):
+    """Largest ``p`` with ``q sum_j (1-q)^{j-1} ||A^j||^2 * p ||A + K C||^2 < 1`` (last line after eq. 8, l_o = 2).
+
+    The norm relaxation by which the paper says its Theorem 1 covers the criteria of [15-17];
+    with ``K = 0`` it is our proxy for the criterion of [16] (which we cannot recompute from the text).
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)`` system matrix.
+    q : float
+        Recovery rate.
+    K : array_like, optional
+        ``K C`` added to ``A`` (``None``: ``K = 0``).
+    i_max : int
+        Maximum number of series terms.
+
+    Returns
+    -------
+    float
+        The largest ``p`` of the relaxation.
+    """
+    A = np.atleast_2d(A)
+    M = A if K is None else A + K
+    s, Aj = 0.0, np.eye(A.shape[0])
+    for j in range(1, i_max + 1):
+        Aj = Aj @ A
+        term = q * (1 - q) ** (j - 1) * np.linalg.norm(Aj, 2) ** 2
+        s += term
+        if term < 1e-14 * s:
+            break
+    return 1.0 / (s * np.linalg.norm(M, 2) ** 2)

@@ -1,0 +1,310 @@
+"""Paper `markov`: Wu, Shi, Anderson, Johansson, *Stability Conditions and Phase Transition for
+Kalman Filtering over Markovian Channels*. Pipeline steps.
+
+The mathematics lives in the math modules of this package (:mod:`.model`, :mod:`.lmis`,
+:mod:`.exact`, :mod:`.estimators`, :mod:`.stability`); this module holds the step functions called
+by ``workflow/rules/markov.smk`` (signature ``fn(params, inputs, outputs)``).
+
+Tables (``results/markov/``)
+----------------------------
+``critical_curves.csv``
+    one row per example and q: ``example, q, q_necessary`` (= 1 - 1/|lambda_A|^2, the
+    necessary-condition boundary of [18]), ``necessary_ok`` (|lambda_A|^2 (1-q) < 1),
+    ``p_prop1`` / ``p_prop1_uncapped`` (Proposition 1, eq. 8), ``p_thm5`` / ``p_thm5_uncapped``
+    (Theorem 5, eq. 12, largest certified-feasible p of the bisection; capped at 1),
+    ``p_thm5_upper`` (smallest infeasible p), ``thm5_saturated`` (feasible at the search cap),
+    ``thm5_n_solves``, ``thm5_n_uncertified`` (solver-feasible answers that failed the
+    rho(H(K)) < 1 check), ``thm5_statuses`` (solver statuses seen), ``rho_H_at_lower``,
+    ``p_reference`` and ``reference`` (the known critical value where theory gives it:
+    Example I non-degenerate => p_c = 1 [18]; Example II => our parity renewal formula).
+``lmi_checks.csv``
+    point checks of Theorem 2 / 5: ``check, example, p, q, status, margin, solver_feasible,
+    certified, rho_H, lyap_margin``.
+``lmi_benchmark.csv``
+    ``mode`` (parametrised / rebuilt), ``n_solves, seconds, solves_per_second``.
+``iid_line.csv``
+    ``example, lambda_lower`` (1 - 1/|lambda_max(A)|^2), ``lambda_lmi_upper`` (Sinopoli LMI),
+    ``q_thm5_on_iid_line`` (smallest q with the Theorem 2 LMI certified at p = 1 - q),
+    ``lambda_c_reference`` and ``reference``, ``consistent``.
+``exact_moments.csv``
+    polynomial coefficients of the exact E||P_k||: ``example, depth, n11, n10, n01, n00,
+    sum_norm, sum_trace`` (see :class:`~netrepro.papers.markov.exact.ExactMoments`).
+``stability_map.csv``
+    ``example, p, q, bounded`` (True / False / empty when undecided), ``verdict`` (bounded /
+    unbounded / undecided), ``growth_rate`` (log-growth per step of the method that decided),
+    ``growth_rate_exact`` (extrapolated from the exact E||P_k||), ``growth_rate_last`` (raw rate over
+    the last two exact steps), ``mean_norm_last`` (exact E||P_K||), ``growth_rate_long`` and
+    ``rel_halfwidth_long`` (long-horizon conditional estimator, only for points the exact horizon
+    left undecided), ``method`` (which computation decided).
+``sample_paths.csv``
+    for each of Figs 3-6: ``figure, example, p, q, k, gamma`` (one sample path; gamma_k),
+    ``norm_path`` (||P_k|| along it), ``q05, q50, q95`` (Monte Carlo quantiles of ||P_k||),
+    ``plain_mean`` (sample mean), ``rb_mean`` (conditional estimator), ``exact_mean`` (k <= depth+1).
+``estimator_check.csv``
+    ``example, p, q, k, exact_mean, plain_mean, plain_ci_high, rb_mean, rb_ci_low, rb_ci_high,
+    plain_over_exact, rb_over_exact`` at ``k = depth + 1`` (conditional estimator against the
+    exact value); ``k_long, plain_mean_long, rb_mean_long, plain_over_rb_long`` at the long
+    horizon (the plain sample mean failing); ``n_paths``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pandas as pd
+
+from . import estimators as est
+from .exact import ExactMoments, exact_moments
+from .lmis import GilbertElliottLMI, bisect_monotone, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
+from .model import LinearSystem, observability_index, parity_bound_example2, prop1_bound, spectral_abs
+from .stability import REFINE_DEFAULTS, classify_growth, refine_long_horizon
+
+__all__ = [
+    "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
+    "sample_paths_step", "load_moments",
+]
+
+
+def _system(ex):
+    return LinearSystem.from_config(ex)
+
+
+def _q_grid(lam, n_points, margin):
+    q_nec = 1.0 - 1.0 / lam ** 2
+    return np.linspace(q_nec + margin, 1.0 - margin, n_points), q_nec
+
+
+def _reference(name, ex, q):
+    """Known critical failure rate where theory gives it (see module docstring)."""
+    kind = ex.get("reference", "none")
+    lam = spectral_abs(ex["A"])
+    q = np.asarray(q, dtype=float)
+    if kind == "nondegenerate":
+        return np.where(lam ** 2 * (1 - q) < 1, 1.0, 0.0), "non-degenerate: MSS iff |lambda|^2(1-q)<1 [18], so p_c=1"
+    if kind == "parity":
+        return np.minimum(parity_bound_example2(lam, q), 1.0), "parity renewal condition (our derivation)"
+    return np.full(q.shape, np.nan), ""
+
+
+# ----------------------------------------------------------------------------- Theorem 5 curves
+def critical_curves_step(params, inputs, outputs):
+    """Proposition 1 (eq. 8) and Theorem 5 (eq. 12) curves p(q) for every example, plus the LMI benchmark."""
+    cc = params["curves"]
+    rows, bench = [], []
+    for name, ex in params["examples"].items():
+        A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
+        lam = spectral_abs(A)
+        l_o = observability_index(A, C)
+        qs, q_nec = _q_grid(lam, cc["q_points"], cc["q_margin"])
+        prop = prop1_bound(lam, qs, l_o)
+        ref, ref_text = _reference(name, ex, qs)
+        lmi = GilbertElliottLMI(A, C, l_o)
+        p_max = cc["p_uncapped_max"] if l_o == 2 else 1.0
+        t0 = time.perf_counter()
+        for q, pp, pr in zip(qs, prop, ref):
+            res = thm5_lower_bound(lmi, float(q), p_max, cc["bisection_tol"])
+            rows.append({
+                "example": name, "q": q, "q_necessary": q_nec, "necessary_ok": bool(lam ** 2 * (1 - q) < 1),
+                "p_prop1": min(pp, 1.0), "p_prop1_uncapped": pp,
+                "p_thm5": min(res["p_lower"], 1.0), "p_thm5_uncapped": res["p_lower"], "p_thm5_upper": res["p_upper"],
+                "thm5_saturated": res["saturated"], "thm5_n_solves": res["n_solves"],
+                "thm5_n_uncertified": res["n_uncertified"], "thm5_statuses": "|".join(res["statuses"]),
+                "rho_H_at_lower": res["rho_at_lower"], "p_reference": pr, "reference": ref_text,
+            })
+        elapsed = time.perf_counter() - t0
+        # benchmark, same run: parametrised problem vs rebuilding it for every solve
+        nb = cc["benchmark_solves"]
+        grid = np.linspace(0.2, 0.9, nb)
+        t1 = time.perf_counter()
+        for p in grid:
+            lmi.solve(float(p), float(qs[len(qs) // 2]))
+        t_param = time.perf_counter() - t1
+        t2 = time.perf_counter()
+        for p in grid:
+            rebuild_solve(A, C, float(p), float(qs[len(qs) // 2]), l_o)
+        t_build = time.perf_counter() - t2
+        bench += [
+            {"example": name, "mode": "parametrised (compiled once, cp.Parameter)", "n_solves": nb, "seconds": t_param,
+             "solves_per_second": nb / t_param},
+            {"example": name, "mode": "rebuilt every solve", "n_solves": nb, "seconds": t_build,
+             "solves_per_second": nb / t_build},
+            {"example": name, "mode": "theorem-5 sweep (parametrised)", "n_solves": lmi.n_solves - nb,
+             "seconds": elapsed, "solves_per_second": (lmi.n_solves - nb) / elapsed},
+        ]
+    return {"table": pd.DataFrame(rows), "benchmark": pd.DataFrame(bench),
+            "provenance": {"n_solves": int(sum(r["thm5_n_solves"] for r in rows))}}
+
+
+def lmi_checks_step(params, inputs, outputs):
+    """Point checks of Theorem 2 (iv) and Theorem 5 that the paper states (Section 5)."""
+    ck = params["checks"]
+    rows = []
+    for item in ck["points"]:
+        ex = params["examples"][item["example"]]
+        A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
+        lmi = GilbertElliottLMI(A, C)
+        p = float(item["p"])
+        r = lmi.solve(p, float(item["q"]))
+        rows.append({"check": item["name"], "example": item["example"], "p": p, "q": item["q"], "status": r.status,
+                     "margin": r.margin, "solver_feasible": r.solver_feasible, "certified": r.certified,
+                     "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
+    for item in ck["tight"]:
+        ex = params["examples"][item["example"]]
+        A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
+        lmi = GilbertElliottLMI(A, C)
+        res = thm5_lower_bound(lmi, float(item["q"]), 1.0, ck["tight_tol"])
+        for label, p in (("tight_lower", res["p_lower"]), ("tight_upper", res["p_upper"])):
+            r = lmi.solve(float(p), float(item["q"]))
+            rows.append({"check": f"{item['name']}_{label}", "example": item["example"], "p": p, "q": item["q"],
+                         "status": r.status, "margin": r.margin, "solver_feasible": r.solver_feasible,
+                         "certified": r.certified, "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
+    return {"table": pd.DataFrame(rows)}
+
+
+def iid_line_step(params, inputs, outputs):
+    """The i.i.d. line p + q = 1 (Remark 4): Sinopoli's bounds on lambda_c and Theorem 5's crossing."""
+    tol = params["iid"]["tol"]
+    rows = []
+    for name, ex in params["examples"].items():
+        A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
+        lam = spectral_abs(A)
+        lower = 1.0 - 1.0 / lam ** 2
+        upper, _ = sinopoli_lmi_threshold(A, C, tol)
+        lmi = GilbertElliottLMI(A, C)
+        # feasibility at (p, q) = (1 - q, q) is monotone in q: p falls while p_underline(q) rises
+        res = bisect_monotone(lambda q: lmi.solve(1.0 - q, q).certified, lower + 1e-6, 1.0 - 1e-6, tol=tol)
+        kind = ex.get("reference", "none")
+        if kind == "nondegenerate":
+            ref, text = lower, "non-degenerate: lambda_c = 1 - 1/|lambda|^2 (Mo & Sinopoli)"
+        elif kind == "parity":
+            ref, text = 1.0 - 1.0 / lam ** 4, "parity argument: lambda_c = 1 - 1/|lambda|^4"
+        else:
+            ref, text = np.nan, ""
+        rows.append({"example": name, "lambda_lower": lower, "lambda_lmi_upper": upper,
+                     "q_thm5_on_iid_line": res.threshold, "lambda_c_reference": ref, "reference": text,
+                     "consistent": bool(lower - tol <= ref <= min(upper, res.threshold) + tol)})
+    return {"table": pd.DataFrame(rows)}
+
+
+def exact_moments_step(params, inputs, outputs):
+    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`markov_math.exact_moments`)."""
+    frames = []
+    for name, ex in params["examples"].items():
+        em = exact_moments(_system(ex), np.asarray(ex["Sigma0"], float), params["exact"]["depth"])
+        for d, c in enumerate(em.coef, start=1):
+            f = pd.DataFrame(c, columns=["n11", "n10", "n01", "n00", "sum_norm", "sum_trace"])
+            f.insert(0, "depth", d)
+            f.insert(0, "example", name)
+            frames.append(f)
+        frames.append(pd.DataFrame([{"example": name, "depth": 0, "n11": 0, "n10": 0, "n01": 0, "n00": 0,
+                                     "sum_norm": em.P1_norm, "sum_trace": em.P1_trace}]))
+    table = pd.concat(frames, ignore_index=True)
+    for col in ("n11", "n10", "n01", "n00"):
+        table[col] = table[col].astype(int)
+    return {"table": table}
+
+
+def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
+    """Rebuild :class:`~netrepro.papers.markov_math.ExactMoments` from ``exact_moments.csv``."""
+    sub = table[table["example"] == example]
+    head = sub[sub["depth"] == 0].iloc[0]
+    cols = ["n11", "n10", "n01", "n00", "sum_norm", "sum_trace"]
+    coef = [sub[sub["depth"] == d][cols].to_numpy(float) for d in range(1, int(sub["depth"].max()) + 1)]
+    return ExactMoments(coef, float(head["sum_norm"]), float(head["sum_trace"]))
+
+
+def stability_map_step(params, inputs, outputs):
+    """Independent stability map of E||P_k|| on a (p, q) grid.
+
+    1. Exact E||P_k|| over all channel paths for ``k <= depth + 1`` (:func:`markov_math.exact_moments`),
+       growth extrapolated by :func:`classify_growth`.
+    2. Points left undecided get the long-horizon conditional estimator of E tr P_k
+       (:func:`refine_long_horizon`; trace and 2-norm are equivalent norms for boundedness),
+       trusted only where its confidence interval is narrow.
+    """
+    table = pd.read_csv(inputs["moments"])
+    mp = params["map"]
+    opts = dict(REFINE_DEFAULTS, **mp.get("refine", {}))
+    ps = np.linspace(mp["p_min"], mp["p_max"], mp["p_points"])
+    qs = np.linspace(mp["q_min"], mp["q_max"], mp["q_points"])
+    P, Qg = np.meshgrid(ps, qs, indexing="ij")
+    frames = []
+    for e_idx, (name, ex) in enumerate(params["examples"].items()):
+        em = load_moments(table, name)
+        means = em.mean(P, Qg, "norm")
+        rate, last, verdict = classify_growth(means, mp["bounded_tol"], mp["unbounded_tol"])
+        exact_method = f"exact E||P_k|| over all 2^{em.depth - 1} channel paths (k<={em.depth + 1}), extrapolated growth"
+        f = pd.DataFrame({"example": name, "p": P.ravel(), "q": Qg.ravel(), "verdict": verdict.ravel(),
+                          "growth_rate": rate.ravel(), "growth_rate_exact": rate.ravel(), "growth_rate_last": last.ravel(),
+                          "mean_norm_last": means[..., -1].ravel(), "growth_rate_long": np.nan,
+                          "rel_halfwidth_long": np.nan, "method": exact_method})
+        todo = np.flatnonzero(f.verdict.to_numpy() == "undecided")
+        if opts["enabled"] and len(todo):
+            rng = np.random.default_rng([opts["seed"], e_idx])
+            r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
+                                                      f.p.to_numpy()[todo], f.q.to_numpy()[todo], opts, rng)
+            f.loc[todo, "growth_rate_long"] = r_long
+            f.loc[todo, "rel_halfwidth_long"] = rel
+            decided = todo[v_long != "undecided"]
+            f.loc[decided, "verdict"] = v_long[v_long != "undecided"]
+            f.loc[decided, "growth_rate"] = r_long[v_long != "undecided"]
+            f.loc[decided, "method"] = (f"conditional estimator of E tr P_k, k<={opts['horizon'] + 1}, "
+                                        f"{opts['n_paths']} paths, 95% half-width < {opts['rel_tol']:g} of the mean")
+            f.loc[todo[v_long == "undecided"], "method"] = "undecided: exact horizon too short, conditional estimator not trusted"
+        f.insert(3, "bounded", f.verdict.map({"bounded": "True", "unbounded": "False"}).fillna(""))
+        frames.append(f)
+    return {"table": pd.concat(frames, ignore_index=True)}
+
+
+def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
+    """Plain sample mean and conditional estimator of E||P_k||: against the exact value at k = depth + 1,
+    and against each other at the long horizon ``k = horizon + 1`` (where only the conditional one is trusted)."""
+    exact = em.mean(p, q, "norm")
+    k = len(exact)
+    norms, arrivals = est.plain_mc(system, S0, p, q, n, max(horizon, k - 1), rng)
+    rb = est.rb_mean_norm(system, S0, p, q, arrivals)
+    plain, rbk = norms[:, k - 1], rb[:, k - 1]
+    se_p, se_r = plain.std(ddof=1) / np.sqrt(n), rbk.std(ddof=1) / np.sqrt(n)
+    kl = rb.shape[1]
+    return {"example": example, "p": p, "q": q, "k": k, "exact_mean": exact[k - 1],
+            "plain_mean": plain.mean(), "plain_ci_high": plain.mean() + 1.96 * se_p,
+            "rb_mean": rbk.mean(), "rb_ci_low": rbk.mean() - 1.96 * se_r, "rb_ci_high": rbk.mean() + 1.96 * se_r,
+            "plain_over_exact": plain.mean() / exact[k - 1], "rb_over_exact": rbk.mean() / exact[k - 1],
+            "k_long": kl, "plain_mean_long": norms[:, kl - 1].mean(), "rb_mean_long": rb[:, kl - 1].mean(),
+            "plain_over_rb_long": norms[:, kl - 1].mean() / rb[:, kl - 1].mean(), "n_paths": n}
+
+
+def sample_paths_step(params, inputs, outputs):
+    """Sample paths, Monte Carlo bands, plain and conditional means, exact means for Figs 3-6."""
+    sp = params["paths"]
+    table = pd.read_csv(inputs["moments"])
+    rows, checks = [], []
+    for case in sp["cases"]:
+        ex = params["examples"][case["example"]]
+        system = _system(ex)
+        S0 = np.asarray(ex["Sigma0"], float)
+        p, q = float(case["p"]), float(case["q"])
+        rng = np.random.default_rng([sp["seed"], int(case["figure"].replace("fig", ""))])
+        norms, arrivals = est.plain_mc(system, S0, p, q, sp["n_paths"], sp["horizon"], rng)
+        rb_arr = arrivals[: sp["rb_paths"], : sp["rb_horizon"]]
+        rb = est.rb_mean_norm(system, S0, p, q, rb_arr)
+        em = load_moments(table, case["example"])
+        exact = em.mean(p, q, "norm")
+        K = sp["horizon"] + 1
+        qs = np.quantile(norms, [0.05, 0.5, 0.95], axis=0)
+        for k in range(1, K + 1):
+            rows.append({
+                "figure": case["figure"], "example": case["example"], "p": p, "q": q, "k": k,
+                "gamma": int(arrivals[0, k - 1]) if k <= sp["horizon"] else np.nan, "norm_path": norms[0, k - 1],
+                "q05": qs[0, k - 1], "q50": qs[1, k - 1], "q95": qs[2, k - 1], "plain_mean": norms[:, k - 1].mean(),
+                "rb_mean": rb[:, k - 1].mean() if k <= rb.shape[1] else np.nan,
+                "exact_mean": exact[k - 1] if k <= len(exact) else np.nan,
+            })
+    for j, point in enumerate(sp["estimator_points"]):
+        ex = params["examples"][point["example"]]
+        em = load_moments(table, point["example"])
+        rng = np.random.default_rng([sp["seed"], 100 + j])
+        checks.append(_estimator_check(_system(ex), np.asarray(ex["Sigma0"], float), point["example"],
+                                       float(point["p"]), float(point["q"]), em, sp["rb_paths"], sp["rb_horizon"], rng))
+    return {"table": pd.DataFrame(rows), "check": pd.DataFrame(checks)}
