@@ -424,7 +424,7 @@ def _fisher_functions():
     are used only when ``netrepro.papers.onebit`` does not provide them.
     """
     try:
-        from .papers.onebit import expected_fisher_1bit, expected_fisher_1bit_quad
+        from .papers.onebit.fisher import expected_fisher_1bit, expected_fisher_1bit_quad
         return expected_fisher_1bit, (lambda v: expected_fisher_1bit_quad(v)[0]), "netrepro.papers.onebit"
     except ImportError:  # pragma: no cover - only before the onebit paper exists
         pass

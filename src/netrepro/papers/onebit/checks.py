@@ -1,0 +1,41 @@
+"""Configuration checks of the `onebit` section that the JSON schema cannot express."""
+
+from __future__ import annotations
+
+from ...config import require_matrix, require_pd
+from ...errors import ConfigError
+
+__all__ = ["check_config"]
+
+
+def check_config(section: dict) -> None:
+    """Checks the schema cannot express: grids, the vector model's shapes and definiteness."""
+    g = section["snr_grid_db"]
+    if g["stop"] <= g["start"]:
+        raise ConfigError(f"config key 'onebit.snr_grid_db' = {g!r}: stop must exceed start")
+    if section["fig1_one_minus_alpha"] not in section["one_minus_alpha"]:
+        raise ConfigError(f"config key 'onebit.fig1_one_minus_alpha' = {section['fig1_one_minus_alpha']!r} must be one "
+                          f"of onebit.one_minus_alpha = {section['one_minus_alpha']!r}")
+    conv = section["convergence"]
+    for key in ("n_steps", "n_lag_steps"):
+        if len(conv[key]) != len(section["one_minus_alpha"]):
+            raise ConfigError(f"config key 'onebit.convergence.{key}' = {conv[key]!r} needs one entry per "
+                              f"onebit.one_minus_alpha ({len(section['one_minus_alpha'])})")
+    est = section["estimator"]
+    w0, w1 = est["window"]
+    if not 0 <= w0 < w1 <= est["horizon"]:
+        raise ConfigError(f"config key 'onebit.estimator.window' = {est['window']!r}: expected "
+                          f"0 <= start < stop <= horizon ({est['horizon']})")
+    vec = section["vector_check"]
+    A = require_matrix("onebit.vector_check.A", vec["A"], square=True)
+    n = A.shape[0]
+    require_pd("onebit.vector_check.Q", vec["Q"])
+    require_matrix("onebit.vector_check.Q", vec["Q"], shape=(n, n))
+    C = require_matrix("onebit.vector_check.C", vec["C"])
+    if C.shape[1] != n:
+        raise ConfigError(f"config key 'onebit.vector_check.C' has shape {C.shape}; expected (m, {n})")
+    require_pd("onebit.vector_check.R", vec["R"])
+    require_matrix("onebit.vector_check.R", vec["R"], shape=(C.shape[0], C.shape[0]))
+    require_pd("onebit.vector_check.P0", vec["P0"])
+    require_matrix("onebit.vector_check.P0", vec["P0"], shape=(n, n))
+

@@ -1,0 +1,129 @@
+"""Figures of the `onebit` paper: plotting only, from the tables of :mod:`.steps`."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ...plotting import new_figure, save_figure
+
+__all__ = ["figure_rho_sl", "figure_rho_s_f", "figure_estimator", "figure_convergence", "figure_lag"]
+
+
+def _db(x):
+    return 10.0 * np.log10(x)
+
+
+def _alpha_label(alpha):
+    """Legend text of an alpha: 1 - 10^n, or the limit."""
+    if alpha == 1.0:
+        return r"$\alpha \to 1$"
+    n = math.log10(1.0 - alpha)
+    return rf"$\alpha = 1 - 10^{{{n:.0f}}}$" if abs(n - round(n)) < 1e-6 else rf"$\alpha = {alpha:g}$"
+
+
+def _new_fig(figsize=(6.4, 4.0)):
+    return new_figure(figsize=figsize)
+
+
+def figure_rho_sl(params, inputs, outputs):
+    """Fig 1: rho_SL vs SNR for alpha = 1 - 1e-5 (with the other alphas and the limit, thin)."""
+    rat = pd.read_csv(inputs["ratios"])
+    fig, ax = _new_fig()
+    a_main = 1.0 - params["fig1_one_minus_alpha"]
+    for alpha, g in rat.groupby("alpha"):
+        main = np.isclose(alpha, a_main, rtol=0, atol=1e-15)
+        lab = _alpha_label(alpha)
+        ax.plot(g["snr_db"], g["rho_sl_db"], lw=2.0 if main else 1.0, ls="-" if main else ":", label=lab)
+    ax.axhline(5 * math.log10(2 / math.pi), color="k", lw=0.8, ls="--", label=r"$\sqrt{2/\pi}$ (-0.98 dB)")
+    ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
+    ax.set_ylabel(r"$\rho_{SL}$ [dB]")
+    ax.set_title(r"Fig 1: 1-bit loss of smoothing, $\rho_{SL}$")
+    ax.legend()
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_rho_s_f(params, inputs, outputs):
+    """Fig 2: rho_S and rho_F vs SNR as alpha -> 1 (limit bold, finite alphas thin)."""
+    rat = pd.read_csv(inputs["ratios"])
+    fig, ax = _new_fig()
+    for alpha, g in rat.groupby("alpha"):
+        lim = alpha == 1.0
+        lab = _alpha_label(alpha)
+        ax.plot(g["snr_db"], g["rho_s_db"], color="C0", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
+                label=rf"$\rho_S$, {lab}")
+        ax.plot(g["snr_db"], g["rho_f_db"], color="C3", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
+                label=rf"$\rho_F$, {lab}")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.axhline(10 * math.log10(2 * math.sqrt(2 / math.pi)), color="k", lw=0.8, ls="--", label="+2.03 dB")
+    ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
+    ax.set_ylabel("information ratio [dB]")
+    ax.set_title(r"Fig 2: $\rho_S$ and $\rho_F$ ($\alpha \to 1$)")
+    ax.legend(fontsize=7, ncol=2)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_estimator(params, inputs, outputs):
+    """Fig S1: MSE of the grid filter/smoother (1-bit) and Kalman/RTS with 95% CIs next to the bounds."""
+    est = pd.read_csv(inputs["estimator"])
+    fig, (ax, ax2) = new_figure(1, 2, figsize=(10.0, 4.0))
+    styles = {"filter_1bit": ("C3", "o"), "smoother_1bit": ("C0", "s"), "kalman_filter": ("C1", "^"),
+              "rts_smoother": ("C2", "v")}
+    for i, (kind, g) in enumerate(est.groupby("kind", sort=False)):
+        col, mk = styles[kind]
+        x = g["snr_db"] + 0.3 * (i - 1.5)
+        m, lo, hi = _db(g["mse"]), _db(g["mse_lo"]), _db(g["mse_hi"])
+        ax.errorbar(x, m, yerr=[m - lo, hi - m], color=col, marker=mk, ls="none", label=f"MSE, {kind}")
+        ax.plot(g["snr_db"], _db(g["bound"]), color=col, lw=1.0)
+        b = _db(g["bound"])
+        ax2.errorbar(x, m - b, yerr=[m - lo, hi - m], color=col, marker=mk, ls="-", lw=0.8, label=kind)
+    ax.set_xlabel("SNR [dB]")
+    ax.set_ylabel(r"MSE (markers, 95% CI) and BCRB (lines) [dB re $\sigma_\eta^2$]")
+    ax.legend(fontsize=7)
+    ax2.axhline(0.0, color="k", lw=0.8)
+    ax2.set_xlabel("SNR [dB]")
+    ax2.set_ylabel("MSE / BCRB [dB]")
+    ax2.legend(fontsize=7)
+    fig.suptitle(rf"Fig S1: near-optimal estimators vs the bounds ($\alpha = {est['alpha'].iloc[0]:g}$)")
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_convergence(params, inputs, outputs):
+    """Fig S2: transients of Var[theta_k], E[F_q(theta_k)] and J_{k|k,q} (iterate / fixed point)."""
+    tr = pd.read_csv(inputs["transient"])
+    alphas = sorted(tr["alpha"].unique())
+    fig, axes = new_figure(1, len(alphas), figsize=(4.2 * len(alphas), 3.8), squeeze=False)
+    for ax, alpha in zip(axes[0], alphas):
+        sub = tr[tr["alpha"] == alpha]
+        for j, (snr, g) in enumerate(sub.groupby("snr_db")):
+            g = g[g["k"] > 0]
+            ax.loglog(g["k"], np.abs(g["j_f_q_ratio"] - 1) + 1e-17, color=f"C{j}", label=f"{snr:g} dB")
+            ax.loglog(g["k"], np.abs(g["var_ratio"] - 1) + 1e-17, color=f"C{j}", ls=":")
+        ax.set_xlabel("k")
+        ax.set_title(_alpha_label(alpha), fontsize=9)
+        ax.set_ylim(1e-16, 1e4)
+        ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("relative distance to the fixed point")
+    fig.suptitle(r"Fig S2: $|J_{k|k,q}/\tilde J_{k|k,q} - 1|$ (solid) and $|\mathrm{Var}\,\theta_k/\sigma^2_{\theta,\infty} - 1|$ "
+                 r"(dotted) from $\sigma_{\theta_0} = 1$", fontsize=10, y=1.04)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_lag(params, inputs, outputs):
+    """Fig S3: smoothing lag Delta needed (0.01 dB) vs SNR."""
+    lag = pd.read_csv(inputs["lag"])
+    fig, ax = _new_fig()
+    for alpha, g in lag.groupby("alpha"):
+        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", label=_alpha_label(alpha))
+    ax.set_xlabel("SNR [dB]")
+    ax.set_ylabel(r"lag $\Delta$ for %g dB" % lag["tol_db"].iloc[0])
+    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed")
+    ax.legend()
+    save_figure(fig, outputs["figure"])
+    return {}

@@ -1,0 +1,48 @@
+"""Tests of netrepro.papers.onebit.checks: each equation against an independent computation."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from netrepro.config import ConfigError
+from netrepro.papers.onebit import checks
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    return yaml.safe_load((ROOT / "config" / "test.yaml").read_text())["onebit"]
+
+
+def test_check_config_rejects_bad_sections(cfg):
+    checks.check_config(cfg)
+    bad = copy.deepcopy(cfg)
+    bad["estimator"]["window"] = [50, 10]
+    with pytest.raises(ConfigError, match="window"):
+        checks.check_config(bad)
+    bad = copy.deepcopy(cfg)
+    bad["vector_check"]["Q"] = [[1.0, 2.0], [2.0, 1.0]]
+    with pytest.raises(ConfigError, match="Q"):
+        checks.check_config(bad)
+    bad = copy.deepcopy(cfg)
+    bad["fig1_one_minus_alpha"] = 0.5
+    with pytest.raises(ConfigError, match="fig1_one_minus_alpha"):
+        checks.check_config(bad)
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "test.yaml"])
+def test_config_sections_validate(name):
+    import jsonschema
+
+    from netrepro.config import load_schemas
+
+    section = yaml.safe_load((ROOT / "config" / name).read_text())["onebit"]
+    _, registry = load_schemas()
+    schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents
+    jsonschema.Draft202012Validator(schema).validate(section)
+    checks.check_config(section)

@@ -1,0 +1,114 @@
+"""Tests of netrepro.papers.onebit.randomwalk: each equation against an independent computation."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import linalg
+
+from netrepro.engines.kernels import scalar_information_steps
+from netrepro.papers.onebit import fisher
+from netrepro.papers.onebit import model
+from netrepro.papers.onebit import randomwalk
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def test_stable_forms_equal_printed_scalar_equations():
+    eps, s, F = 0.05, 0.2, 0.8
+    a = 1 - eps
+    J = np.linspace(0.5, 20, 9)
+    printed24 = 1 / s + F - (a / s) ** 2 / (J + a * a / s)
+    np.testing.assert_allclose(randomwalk.rw_filtering_step(J, F, eps, s), printed24, rtol=1e-13)
+    printed25 = 1 / s - (a / s) ** 2 / (a * a / s + J)
+    np.testing.assert_allclose(randomwalk.rw_prediction_step(J, eps, s), printed25, rtol=1e-13)
+    kap = np.linspace(0, 10, 9)
+    printed27 = a * a / s - (a / s) ** 2 / (1 / s + F + kap)
+    np.testing.assert_allclose(randomwalk.rw_smoothing_gain_step(kap, F, eps, s), printed27, rtol=1e-12)
+    # the scalar step equals the general step with the blocks (22)
+    D11, D12, D22 = model.linear_gaussian_blocks([[a]], [[s]])
+    assert D11[0, 0] == pytest.approx(a * a / s) and D12[0, 0] == pytest.approx(-a / s)
+    assert float(model.filtering_bim_step([[3.0]], D11, D12, D22, [[F]])[0, 0]) == pytest.approx(
+        float(randomwalk.rw_filtering_step(3.0, F, eps, s)), rel=1e-13)
+
+
+@pytest.mark.parametrize("eps,s,F", [(1e-3, 1e-4, 0.6), (1e-2, 0.5, 0.07), (0.3, 2.0, 1.0), (1e-5, 2e-8, 0.63)])
+def test_fixed_points_match_dare_and_long_iteration(eps, s, F):
+    a = 1 - eps
+    Jstar = float(randomwalk.rw_filtering_fixed_point(F, eps, s))
+    M = linalg.solve_discrete_are(np.array([[a]]), np.array([[1.0]]), np.array([[s]]), np.array([[1 / F]]))[0, 0]
+    assert 1 / M + F == pytest.approx(Jstar, rel=1e-9)  # DARE: predicted variance M
+    J, kap = 1.0, 0.0
+    kstar = float(randomwalk.rw_smoothing_gain_fixed_point(F, eps, s))
+    for _ in range(400_000 if eps < 1e-4 else 60_000):
+        J = randomwalk.rw_filtering_step(J, F, eps, s)
+        kap = randomwalk.rw_smoothing_gain_step(kap, F, eps, s)
+    assert J == pytest.approx(Jstar, rel=1e-10)
+    assert kap == pytest.approx(kstar, rel=1e-10)
+    # and the smoothing variance equals the steady-state RTS variance
+    Pf = 1 / Jstar
+    Pp = a * a * Pf + s
+    G = Pf * a / Pp
+    Ps = Pf * (1 - G * G * Pp / Pf) / (1 - G * G)   # P_s = P_f + G^2 (P_s - P_p)
+    assert 1 / (Jstar + kstar) == pytest.approx(Ps, rel=1e-8)
+
+
+def test_lag_closed_form_equals_iteration():
+    eps = 1e-3
+    snr_db = np.arange(-30, 21, 2.5)
+    s = model.sigma_z2_from_snr(snr_db, eps)
+    F = fisher.expected_fisher_1bit(model.stationary_variance(eps, s))
+    for tol in (0.01, 0.001):
+        np.testing.assert_array_equal(randomwalk.rw_lag_needed(F, eps, s, tol), randomwalk.rw_lag_iterated(F, eps, s, tol))
+    assert np.all(randomwalk.rw_lag_needed(F, eps, s, 0.01) > 0)
+
+
+def test_ratios_tend_to_limit_and_limit_values():
+    snr_db = np.array([-20.0, 0.0, 10.0])
+    lim = randomwalk.information_ratios_limit(snr_db)
+    near = randomwalk.information_ratios(snr_db, 1e-10)
+    for key in ("rho_sl_db", "rho_f_db", "rho_s_db"):
+        np.testing.assert_allclose(near[key], lim[key], atol=2e-3)
+    low = randomwalk.information_ratios_limit(np.array([-80.0]))
+    assert low["rho_f_db"][0] == pytest.approx(5 * math.log10(2 / math.pi), abs=1e-6)
+    assert low["rho_s_db"][0] == pytest.approx(10 * math.log10(2 * math.sqrt(2 / math.pi)), abs=1e-6)
+    r = randomwalk.information_ratios(np.linspace(-30, 20, 11), 1e-3)
+    assert np.all(r["rho_s_db"] > r["rho_f_db"])
+    assert np.all(r["j_s_q"] <= r["j_s_inf"]) and np.all(r["j_f_q"] <= r["j_f_inf"])
+
+
+def test_transient_iteration_reaches_fixed_point():
+    out = randomwalk.iterate_transient([-10.0, 10.0], 1e-2, 1.0, 0.0, 1.0, 6000, 1e-9, record=[0, 10, 100])
+    np.testing.assert_allclose(out["j_f_q"], out["j_f_q_star"], rtol=1e-9)
+    np.testing.assert_allclose(out["j_f_inf"], out["j_f_inf_star"], rtol=1e-12)
+    assert np.all(out["k_conv_q"] < 6000)
+    assert out["trace"]["j_f_q_ratio"].shape == (3, 2)
+    with pytest.raises(ValueError, match="mu0"):
+        randomwalk.iterate_transient([0.0], 1e-2, 1.0, 1.0, 1.0, 10, 1e-9)
+
+
+def test_compiled_bim_steps_equal_numpy_loop_and_general_recursion_7():
+    """(24)/(34) as compiled: bit-identical to the numpy loop it replaced, and equal to the general (7)
+    with the random walk's D11 = a^2/s, D12 = -a/s, D22 = 1/s (an independent form)."""
+    rng = np.random.default_rng(3)
+    a2, s2 = 0.98**2, rng.uniform(0.01, 2.0, 6)
+    F = rng.uniform(0.0, 3.0, (50, 6))
+    j0 = rng.uniform(0.1, 5.0, 6)
+    j, J = j0.copy(), np.empty_like(F)
+    scalar_information_steps(j, a2, s2, F, J)
+    ref, tmp, out = j0.copy(), np.empty(6), []
+    for i in range(len(F)):  # the numpy form
+        np.divide(a2, ref, out=tmp)
+        tmp += s2
+        np.divide(1.0, tmp, out=ref)
+        ref += F[i]
+        out.append(ref.copy())
+    assert np.array_equal(J, np.array(out)) and np.array_equal(j, J[-1])
+    a = np.sqrt(a2)
+    for lane in range(6):
+        s = s2[lane]
+        general = model.filtering_bims(j0[lane], a2 / s, -a / s, 1.0 / s, F[:, lane].reshape(-1, 1, 1), len(F))
+        assert np.allclose(general[1:, 0, 0], J[:, lane], rtol=1e-12)
