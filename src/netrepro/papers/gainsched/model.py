@@ -1,4 +1,4 @@
-"""Model, analysis LMI and simulation of the `gainsched` paper.
+"""Model, analysis LMI, second moments and simulation of the `gainsched` paper.
 
 G. Wei, Z. Wang, B. Shen, M. Li, *Probability-Dependent Gain-Scheduled Filtering
 for Stochastic Systems with Missing Measurements*. This module holds the plant
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ...errors import InputError
 
 # cvxpy (and the engine that imports it) are imported where needed: steps that only
 # simulate or plot do not pay for the import.
@@ -40,11 +40,22 @@ __all__ = [
     "frozen_radius",
     "scheduled_growth_rate",
     "simulate",
+    "Theorem1Result",
+    "zero_gains",
+    "augmented_initial_moment",
+    "plant_ms_radius",
+    "lyapunov_difference_bounds",
 ]
 
 
 class GainschedError(InputError):
-    """Bad argument to a `gainsched` function; the message names the argument."""
+    """Bad argument to a `gainsched` function; the message names the argument.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the argument.
+    """
 
 
 @dataclass(frozen=True)
@@ -54,6 +65,22 @@ class System:
     Attributes are the paper's matrices: ``A, B, C, D, Z`` (n x n, n x nz,
     m x n, n x n, nz x n), the sector bounds ``F1, F2`` (nz x nz), the variance
     ``sigma2`` of the scalar multiplicative noise w(k) and ``p1 <= p(k) <= p2``.
+
+    Parameters
+    ----------
+    A, B, C, D, Z : ndarray
+        Matrices of (1), (2), (6).
+    F1, F2 : ndarray (nz, nz)
+        Sector bounds of (3).
+    sigma2 : float
+        E{w(k)^2} of (1).
+    p1, p2 : float
+        Bounds of p(k) in (7).
+
+    Returns
+    -------
+    System
+        A frozen record; ``n``, ``m``, ``nz``, ``F = F2 - F1`` and ``N = [I 0]`` (11) as properties.
     """
 
     A: np.ndarray
@@ -69,14 +96,17 @@ class System:
 
     @property
     def n(self) -> int:
+        """Plant order n (rows of A)."""
         return self.A.shape[0]
 
     @property
     def m(self) -> int:
+        """Number of outputs m (rows of C)."""
         return self.C.shape[0]
 
     @property
     def nz(self) -> int:
+        """Dimension nz of z = Zx (columns of B)."""
         return self.Z.shape[0]
 
     @property
@@ -92,7 +122,18 @@ class System:
 
 @dataclass(frozen=True)
 class Gains:
-    """Constant filter parameters of (9): G(p) = G0 + p Gf, H(p) = H0 + p Hf."""
+    """Constant filter parameters of (9): G(p) = G0 + p Gf, H(p) = H0 + p Hf.
+
+    Parameters
+    ----------
+    G0, Gf : ndarray (n, n)
+    H0, Hf : ndarray (n, m)
+
+    Returns
+    -------
+    Gains
+        A frozen record with the scheduled gains ``G(p)``, ``H(p)`` of (9).
+    """
 
     G0: np.ndarray
     Gf: np.ndarray
@@ -100,14 +141,39 @@ class Gains:
     Hf: np.ndarray
 
     def G(self, p: float) -> np.ndarray:
-        """G(p) of (9)."""
+        """G(p) = G0 + p Gf of (9).
+
+        Parameters
+        ----------
+        p : float
+
+        Returns
+        -------
+        ndarray (n, n)
+        """
         return self.G0 + p * self.Gf
 
     def H(self, p: float) -> np.ndarray:
-        """H(p) of (9)."""
+        """H(p) = H0 + p Hf of (9).
+
+        Parameters
+        ----------
+        p : float
+
+        Returns
+        -------
+        ndarray (n, m)
+        """
         return self.H0 + p * self.Hf
 
     def as_dict(self) -> dict:
+        """The four matrices by name.
+
+        Returns
+        -------
+        dict
+            ``{"G0": ..., "Gf": ..., "H0": ..., "Hf": ...}``.
+        """
         return {"G0": self.G0, "Gf": self.Gf, "H0": self.H0, "Hf": self.Hf}
 
 
@@ -124,7 +190,21 @@ def system_from_config(cfg: dict) -> System:
     """The example of Section IV from the ``system`` config section.
 
     ``F1``, ``F2`` are given as diagonals (the paper prints ``diag{...}``);
-    ``C`` as one row per output. Raises :class:`GainschedError` on bad shapes.
+    ``C`` as one row per output.
+
+    Parameters
+    ----------
+    cfg : dict
+        Keys ``A, B, C, D, Z, F1_diag, F2_diag, sigma2, p1, p2``.
+
+    Returns
+    -------
+    System
+
+    Raises
+    ------
+    GainschedError
+        On shapes that disagree, F2 - F1 not positive, p bounds outside (0, 1), sigma2 < 0.
     """
     A = _mat("A", cfg["A"])
     n = A.shape[0]
@@ -155,7 +235,24 @@ def system_from_config(cfg: dict) -> System:
 
 
 def gains_from_dict(d: dict, sys: System | None = None) -> Gains:
-    """Gains from a mapping with keys G0, Gf, H0, Hf (H as column vectors or nested lists)."""
+    """Gains (9) from a mapping with keys G0, Gf, H0, Hf (H as column vectors or nested lists).
+
+    Parameters
+    ----------
+    d : dict
+        The four matrices as nested lists.
+    sys : System, optional
+        If given, the shapes are checked against it.
+
+    Returns
+    -------
+    Gains
+
+    Raises
+    ------
+    GainschedError
+        On a shape that does not match ``sys``.
+    """
     G0, Gf = _mat("G0", d["G0"]), _mat("Gf", d["Gf"])
     H0 = np.asarray(d["H0"], dtype=float).reshape(G0.shape[0], -1)
     Hf = np.asarray(d["Hf"], dtype=float).reshape(G0.shape[0], -1)
@@ -180,9 +277,17 @@ def augmented(sys: System, gains: Gains, p: float):
         \\bar B = \\begin{bmatrix} B \\\\ 0 \\end{bmatrix},\\;
         \\bar D = \\begin{bmatrix} D \\\\ 0 \\end{bmatrix},\\; N = [I\\;0].
 
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p : float
+        p(k).
+
     Returns
     -------
-    dict with keys ``A`` (2n x 2n), ``B`` (2n x nz), ``C`` (2n x n), ``D`` (2n x n), ``N`` (n x 2n).
+    dict
+        Keys ``A`` (2n x 2n), ``B`` (2n x nz), ``C`` (2n x n), ``D`` (2n x n), ``N`` (n x 2n).
     """
     n = sys.n
     Ga, Ha = gains.G(p), gains.H(p)
@@ -207,6 +312,17 @@ def sector_nonlinearity(z, F1, F2, kind: str = "sine_mid"):
     ----------
     z : ndarray (..., nz)
     F1, F2 : ndarray (nz, nz), diagonal
+    kind : str
+
+    Returns
+    -------
+    ndarray (..., nz)
+        f(z).
+
+    Raises
+    ------
+    GainschedError
+        On an unknown ``kind``.
     """
     z = np.asarray(z, dtype=float)
     d1, d2 = np.diag(F1), np.diag(F2)
@@ -222,8 +338,17 @@ def sector_nonlinearity(z, F1, F2, kind: str = "sine_mid"):
 def sector_split(f, z, F1, F2):
     """Decomposition (4) f = F1 z + f_s and the sector value of (5).
 
-    Returns ``(f_s, s)`` with ``f_s = f - F1 z`` and ``s = f_s^T (f_s - F z)``
-    (per row), which (5) says is ``<= 0`` for f in the sector [F1, F2].
+    Parameters
+    ----------
+    f, z : ndarray (..., nz)
+        Values of the nonlinearity and its argument.
+    F1, F2 : ndarray (nz, nz)
+
+    Returns
+    -------
+    tuple
+        ``(f_s, s)`` with ``f_s = f - F1 z`` and ``s = f_s^T (f_s - F z)``
+        (per row), which (5) says is ``<= 0`` for f in the sector [F1, F2].
     """
     z = np.asarray(z, dtype=float)
     fs = np.asarray(f, dtype=float) - z @ F1.T
@@ -232,7 +357,17 @@ def sector_split(f, z, F1, F2):
 
 
 def sector_cases(sys: System) -> dict:
-    """Linear sector extremes: every diagonal F with F_ii in {F1_ii, F2_ii} (vertices of the diagonal sector)."""
+    """Linear sector extremes of (3): every diagonal F with F_ii in {F1_ii, F2_ii}.
+
+    Parameters
+    ----------
+    sys : System
+
+    Returns
+    -------
+    dict
+        Name (``"F11"``, ``"F12"``, ...; digit i = which bound for z_i) -> diagonal F.
+    """
     d1, d2 = np.diag(sys.F1), np.diag(sys.F2)
     cases = {}
     nz = sys.nz
@@ -248,6 +383,19 @@ def p_schedule(k, p1: float, p2: float, omega: float):
 
     The argument of the sine is illegible in the source; ``omega`` is the
     reconstruction (config key ``simulation.sine_omega``).
+
+    Parameters
+    ----------
+    k : array_like
+        Time indices.
+    p1, p2 : float
+        Bounds of (7).
+    omega : float
+
+    Returns
+    -------
+    ndarray
+        p(k), same shape as ``k``.
     """
     k = np.asarray(k, dtype=float)
     return p1 + (p2 - p1) * np.abs(np.sin(omega * k))
@@ -271,8 +419,21 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
     :math:`\\Omega_1 = S^T(\\mathcal A(p(k)) + \\bar B F_1 Z N)`,
     :math:`\\Omega_2 = \\Theta(k) S^T \\bar C(p(k)) N` (13).
 
-    ``Q_now``, ``Q_next``, ``S`` may be ndarrays or cvxpy expressions; the
-    result is then an ndarray or a cvxpy ``bmat`` (not symmetrised).
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    Q_now, Q_next : ndarray or cvxpy expression (2n, 2n)
+        Q(p(k)) and Q(p(k+1)).
+    S : ndarray or cvxpy expression (2n, 2n)
+        The slack variable of (12).
+    p : float
+        p(k).
+
+    Returns
+    -------
+    ndarray or cvxpy expression (8n + nz, 8n + nz)
+        The matrix of (12) (a cvxpy ``bmat`` if any argument is a cvxpy expression; not symmetrised).
     """
     aug = augmented(sys, gains, p)
     N = aug["N"]
@@ -304,7 +465,24 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
 
 @dataclass
 class Theorem1Result:
-    """Outcome of the Theorem 1 test of given gains."""
+    """Outcome of the Theorem 1 test (12) of given gains.
+
+    Parameters
+    ----------
+    status : str
+        Solver status (information).
+    margin : float
+        Maximised t.
+    solver_feasible : bool
+    Q0, Qp, S : ndarray or None
+        The certificate candidate Q(p) = Q0 + p Qp (27) and S.
+    n_pairs : int
+        Number of (p, p+) pairs imposed.
+
+    Returns
+    -------
+    Theorem1Result
+    """
 
     status: str
     margin: float  # maximised t with (12) <= -t I and Q(p) >= t I on the solve pairs
@@ -326,10 +504,27 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     Q(p) >= t I, t <= ``margin_cap``, with entries of S and Q bounded by
     ``bound`` (scale fixing; an uncapped margin drives the solver to
     ``optimal_inaccurate``).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    n_grid : int
+        Grid points per axis of (p(k), p(k+1)) in [p1, p2]^2.
+    margin_tol : float
+        Margin above which an ``optimal`` answer counts as feasible.
+    bound : float
+        Entry-wise bound on Q0, Qp, S.
+    margin_cap : float
+        Upper bound on t.
+
+    Returns
+    -------
+    Theorem1Result
     """
     import cvxpy as cp
 
-    from ..engines.lmi import SOLVER
+    from ...engines.lmi import SOLVER
 
     nn = 2 * sys.n
     Q0 = cp.Variable((nn, nn), symmetric=True, name="Q0")
@@ -363,7 +558,22 @@ def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, 
     An independent numerical check (no solver) of a Theorem 1 certificate.
     With ``performance`` the (1,1) block carries :math:`+L^TL`, :math:`L = [I\; -I]`
     (the bound :math:`E\Delta V \le -E\|e\|^2` of the performance design).
-    Returns ``(max_eig_12, min_eig_Q, max_eig_at_vertices)``.
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    Q0, Qp, S : ndarray (2n, 2n)
+        Certificate of (12), (27).
+    n_fine : int
+        Grid points per axis.
+    performance : bool
+        Add L^T L to the (1,1) block.
+
+    Returns
+    -------
+    tuple of float
+        ``(max_eig_12, min_eig_Q, max_eig_at_vertices)``.
     """
     L = np.hstack([np.eye(sys.n), -np.eye(sys.n)])
     grid = np.linspace(sys.p1, sys.p2, n_fine)
@@ -394,7 +604,20 @@ def second_moment_operator(sys: System, gains: Gains, p: float, F):
         E\\bar z\\bar z^T(k+1) = M X M^T + p(1-p)\\,\\bar C N X N^T\\bar C^T + \\sigma^2 \\bar D N X N^T \\bar D^T,
         \\quad M = \\mathcal A(p) + \\bar B F Z N .
 
-    Returns ``(loops, weights)`` for :func:`netrepro.engines.lmi.second_moment_radius`.
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p : float
+        Frozen p(k).
+    F : ndarray (nz, nz)
+        Linear gain of f(z) = F z (inside the sector).
+
+    Returns
+    -------
+    tuple
+        ``(loops, weights)`` for :func:`netrepro.engines.lmi.second_moment_radius`:
+        ``[M, C̄N, D̄N]`` and ``[1, p(1-p), sigma^2]``.
     """
     aug = augmented(sys, gains, p)
     N = aug["N"]
@@ -403,8 +626,20 @@ def second_moment_operator(sys: System, gains: Gains, p: float, F):
 
 
 def frozen_radius(sys: System, gains: Gains, p: float, F) -> float:
-    """Spectral radius of the second-moment operator at frozen p and linear f = F z (< 1: MS stable)."""
-    from ..engines.lmi import second_moment_radius
+    """Spectral radius of the second-moment operator of (10) at frozen p and linear f = F z (< 1: MS stable).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p : float
+    F : ndarray (nz, nz)
+
+    Returns
+    -------
+    float
+    """
+    from ...engines.lmi import second_moment_radius
 
     loops, weights = second_moment_operator(sys, gains, p, F)
     return second_moment_radius(loops, weights)
@@ -416,6 +651,17 @@ def scheduled_growth_rate(sys: System, gains: Gains, p_seq, F) -> float:
     Product of the second-moment operators :math:`\\mathcal L_{p(k)} = M\\otimes M + p(1-p) \\bar CN\\otimes\\bar CN
     + \\sigma^2 \\bar DN\\otimes\\bar DN`, normalised each step; returns
     :math:`(\\|\\mathcal L_{p(K-1)}\\cdots\\mathcal L_{p(0)}\\|_2)^{1/K}`.
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p_seq : array_like (K,)
+    F : ndarray (nz, nz)
+
+    Returns
+    -------
+    float
     """
     nn = 2 * sys.n
     prod = np.eye(nn * nn)
@@ -444,12 +690,16 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
 
     Parameters
     ----------
+    sys : System
     gains : Gains or None
         ``None`` is the trivial estimate x_f = 0.
     p_seq : ndarray (K,)
         p(0..K-1); the result has K+1 time points.
     x0 : ndarray (runs, n)
         Initial states.
+    rng : numpy.random.Generator
+    nonlinearity : str
+        Kind of :func:`sector_nonlinearity`.
     xf0 : ndarray (n,) or None
         Initial filter state (default 0); ignored for the trivial estimate.
 
@@ -479,3 +729,107 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
         x = x @ sys.A.T + f @ sys.B.T + w[:, None] * (x @ sys.D.T)
         errs[:, k + 1] = x - xf
     return errs
+
+
+# ----------------------------------------------------------------------------- helpers of the steps
+def zero_gains(sys: System) -> Gains:
+    """All-zero gains of (9): the trivial estimate x_f = 0.
+
+    Parameters
+    ----------
+    sys : System
+        The plant (sets the shapes n x n and n x m).
+
+    Returns
+    -------
+    Gains
+        G0 = Gf = 0 (n x n), H0 = Hf = 0 (n x m).
+    """
+    return Gains(np.zeros((sys.n, sys.n)), np.zeros((sys.n, sys.n)), np.zeros((sys.n, sys.m)),
+                 np.zeros((sys.n, sys.m)))
+
+
+def augmented_initial_moment(cov, n: int):
+    """Second moment E z̄(0) z̄(0)^T of the augmented state (10) for E x0 x0^T = ``cov`` and x_f(0) = 0.
+
+    Parameters
+    ----------
+    cov : array_like (n, n)
+        Second moment of x(0).
+    n : int
+        Plant order.
+
+    Returns
+    -------
+    ndarray (2n, 2n)
+        ``[[cov, 0], [0, 0]]``.
+    """
+    cov = np.asarray(cov, dtype=float)
+    X0 = np.zeros((2 * n, 2 * n))
+    X0[:n, :n] = cov  # x_f(0) = 0
+    return X0
+
+
+def plant_ms_radius(sys: System) -> float:
+    """Largest frozen second-moment radius of the plant (1) alone over the sector vertices (p-independent).
+
+    The plant block of (10) is :math:`x(k+1) = (A + BFZ)x + Dx\\,w`; its second moment is MS stable
+    iff the radius of :math:`(A+BFZ)\\otimes(A+BFZ) + \\sigma^2 D\\otimes D` is below 1.
+
+    Parameters
+    ----------
+    sys : System
+        The plant.
+
+    Returns
+    -------
+    float
+        The maximum over the diagonal sector vertices F of that radius (computed with zero gains).
+    """
+    return max(frozen_radius(sys, zero_gains(sys), sys.p1, F) for F in sector_cases(sys).values())
+
+
+def lyapunov_difference_bounds(sys: System, gains: Gains, Q0, Qp, p: float, pn: float, zbar, f):
+    """E{ΔV} of (14) for given z̄ and f, and the right sides of (15) with '-' (corrected) and '+' (printed).
+
+    With V = z̄^T Q(p) z̄, Q(p) = Q0 + p Qp (27),
+
+    .. math::
+
+        E\\{\\Delta V\\} = (\\mathcal A\\bar z + \\bar B f)^T Q^+ (\\cdot) + p(1-p)\\,\\bar z^T N^T\\bar C^T Q^+ \\bar C N\\bar z
+        + \\sigma^2 \\bar z^T N^T\\bar D^T Q^+\\bar D N\\bar z - \\bar z^T Q \\bar z,
+
+    and (15) subtracts :math:`2 f_s^T(f_s \\mp FZN\\bar z)` (sector term (5)).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    Q0, Qp : ndarray (2n, 2n)
+        The Lyapunov matrix Q(p) = Q0 + p Qp of (27).
+    p, pn : float
+        p(k) and p(k+1).
+    zbar : ndarray (R, 2n)
+        Augmented states, one per row.
+    f : ndarray (R, nz)
+        Values f(Z N z̄) of the nonlinearity, one per row.
+
+    Returns
+    -------
+    tuple of ndarray (R,)
+        ``(dv, corrected, printed)``: E{ΔV} and the two right sides of (15).
+    """
+    aug = augmented(sys, gains, p)
+    N = aug["N"]
+    Qn, Qc = Q0 + pn * Qp, Q0 + p * Qp
+    nxt = zbar @ aug["A"].T + f @ aug["B"].T
+    CN, DN = aug["C"] @ N, aug["D"] @ N
+    quad = lambda X, M: np.einsum("ri,ij,rj->r", X, M, X)  # noqa: E731
+    dv = (quad(nxt, Qn) + p * (1 - p) * quad(zbar @ CN.T, Qn) + sys.sigma2 * quad(zbar @ DN.T, Qn)
+          - quad(zbar, Qc))
+    z = zbar @ (sys.Z @ N).T
+    fs, _ = sector_split(f, z, sys.F1, sys.F2)
+    Fz = z @ sys.F.T
+    corrected = dv - 2 * np.einsum("ri,ri->r", fs, fs - Fz)
+    printed = dv - 2 * np.einsum("ri,ri->r", fs, fs + Fz)
+    return dv, corrected, printed

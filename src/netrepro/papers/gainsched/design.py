@@ -45,8 +45,8 @@ from dataclasses import dataclass, field
 import cvxpy as cp
 import numpy as np
 
-from ..engines.lmi import SOLVER
-from .gainsched_model import Gains, GainschedError, System
+from ...engines.lmi import SOLVER
+from .model import Gains, GainschedError, System
 
 __all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "congruence_residual",
            "REALISATIONS"]
@@ -56,7 +56,26 @@ REALISATIONS = ("identity_T", "S21_identity")
 
 @dataclass
 class Theorem3Solution:
-    """One solve of Theorem 3: status, margin/objective and the variable values."""
+    """One solve of Theorem 3 (24)-(25): status, margin/objective and the variable values.
+
+    Parameters
+    ----------
+    status : str
+        Solver status (information).
+    margin : float
+        Maximised t (feasibility problems) or eps (performance problems).
+    objective : float
+        t, or gamma of the performance design.
+    solver_feasible : bool
+    values : dict
+        Variable name -> ndarray (empty when the solver returned no point).
+    solve_time_s : float
+    n_scalar_variables : int
+
+    Returns
+    -------
+    Theorem3Solution
+    """
 
     status: str
     margin: float
@@ -100,6 +119,16 @@ class Theorem3:
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
         (the correct noise-free condition).
+
+    Returns
+    -------
+    Theorem3
+        The cvxpy problem in ``problem``, variables in ``vars``; :meth:`solve` solves it.
+
+    Raises
+    ------
+    GainschedError
+        On a bad ``gamma3_top`` or ``X0`` shape.
     """
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
@@ -167,32 +196,87 @@ class Theorem3:
 
     # -- the blocks of (24)-(25), one function each, so they read against the paper
     def Qbar(self, p):
-        """Q̄^i = Q̄0 + p_i Q̄p (25), (27)."""
+        """Q̄^i = Q̄0 + p_i Q̄p (25), (27).
+
+        Parameters
+        ----------
+        p : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         return self.vars["Q0"] + p * self.vars["Qp"]
 
     def Gbar(self, p):
-        """Ḡ^i = Ḡ0 + p_i Ḡf (25)."""
+        """Ḡ^i = Ḡ0 + p_i Ḡf (25).
+
+        Parameters
+        ----------
+        p : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         return self.vars["G0"] + p * self.vars["Gf"] if self.scheduled else self.vars["G0"]
 
     def Hbar(self, p):
-        """H̄^i = H̄0 + p_i H̄f (25)."""
+        """H̄^i = H̄0 + p_i H̄f (25).
+
+        Parameters
+        ----------
+        p : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         return self.vars["H0"] + p * self.vars["Hf"] if self.scheduled else self.vars["H0"]
 
     def Lambda(self, pl):
-        """Λ^l = [[S11 + S11^T, R1 + R2^T], [R1^T + R2, R2 + R2^T]] - Q̄^l (25)."""
+        """Λ^l = [[S11 + S11^T, R1 + R2^T], [R1^T + R2, R2 + R2^T]] - Q̄^l (25).
+
+        Parameters
+        ----------
+        pl : float
+            p_l of (25).
+
+        Returns
+        -------
+        cvxpy expression
+        """
         v = self.vars
         SS = cp.bmat([[v["S11"] + v["S11"].T, v["R1"] + v["R2"].T], [v["R1"].T + v["R2"], v["R2"] + v["R2"].T]])
         return SS - self.Qbar(pl)
 
     def Gamma1(self, pi, pj):
-        """Γ1^{ij} = [[S11^T A + p_j H̄^i C + S11^T B F1 Z, Ḡ^i], [R1^T A + p_j H̄^i C + R1^T B F1 Z, Ḡ^i]] (25)."""
+        """Γ1^{ij} = [[S11^T A + p_j H̄^i C + S11^T B F1 Z, Ḡ^i], [R1^T A + p_j H̄^i C + R1^T B F1 Z, Ḡ^i]] (25).
+
+        Parameters
+        ----------
+        pi, pj : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         s, v = self.sys, self.vars
         AF = s.A + s.B @ s.F1 @ s.Z
         HC = pj * (self.Hbar(pi) @ s.C)
         return cp.bmat([[v["S11"].T @ AF + HC, self.Gbar(pi)], [v["R1"].T @ AF + HC, self.Gbar(pi)]])
 
     def Gamma3(self, pi, pj, pr):
-        """Γ3^{ijr} = Θ^{jr} [H̄^i C; H̄^i C] N, Θ^{jr} = p_j (1 - p_r) (25) (= T^T Θ S^T C̄ N T)."""
+        """Γ3^{ijr} = Θ^{jr} [H̄^i C; H̄^i C] N, Θ^{jr} = p_j (1 - p_r) (25) (= T^T Θ S^T C̄ N T).
+
+        Parameters
+        ----------
+        pi, pj, pr : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         s = self.sys
         theta = pj * (1.0 - pr)
         n = s.n
@@ -201,18 +285,37 @@ class Theorem3:
         return theta * cp.bmat([[top, np.zeros((n, n))], [HC, np.zeros((n, n))]])
 
     def Gamma4(self):
-        """Γ4 = σ² [S11^T D; R1^T D] N (22)."""
+        """Γ4 = σ² [S11^T D; R1^T D] N (22).
+
+        Returns
+        -------
+        cvxpy expression
+        """
         s, v = self.sys, self.vars
         n = s.n
         return self.sigma2 * cp.bmat([[v["S11"].T @ s.D, np.zeros((n, n))], [v["R1"].T @ s.D, np.zeros((n, n))]])
 
     def Bhat(self):
-        """B̂ = [S11^T B; R1^T B] (22)."""
+        """B̂ = [S11^T B; R1^T B] (22).
+
+        Returns
+        -------
+        cvxpy expression
+        """
         s, v = self.sys, self.vars
         return cp.vstack([v["S11"].T @ s.B, v["R1"].T @ s.B])
 
     def vertex(self, pi, pj, pr, pl):
-        """The vertex matrix M^{ijrl} of (24) (lower triangle written, upper by transposition)."""
+        """The vertex matrix M^{ijrl} of (24) (lower triangle written, upper by transposition).
+
+        Parameters
+        ----------
+        pi, pj, pr, pl : float
+
+        Returns
+        -------
+        cvxpy expression
+        """
         s = self.sys
         nn, nz = 2 * s.n, s.nz
         theta = pj * (1.0 - pr)
@@ -235,10 +338,25 @@ class Theorem3:
         ])
 
     def n_scalar_variables(self) -> int:
+        """Number of scalar decision variables (Q̄0, Q̄p, S11, R1, R2, Ḡ, H̄).
+
+        Returns
+        -------
+        int
+        """
         return int(sum(x.size for x in self.vars.values()))
 
     def solve(self, sigma2: float | None = None) -> Theorem3Solution:
-        """Solve at noise variance ``sigma2`` (default: the system's); keep the status string."""
+        """Solve at noise variance ``sigma2`` (default: the system's); keep the status string.
+
+        Parameters
+        ----------
+        sigma2 : float, optional
+
+        Returns
+        -------
+        Theorem3Solution
+        """
         self.sigma2.value = self.sys.sigma2 if sigma2 is None else float(sigma2)
         start = time.perf_counter()
         try:
@@ -283,8 +401,23 @@ def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains,
       choose), giving G = Ḡ R2^{-T}, H = H̄. Similar to the first as a
       system, but the *estimate* x_f differs by the factor J = R2^T.
 
-    Returns the gains and the full slack S = [[S11, S12], [S21, S22]] with
-    S12 = R1 S21^{-1} S22 (from R1 = S12 S22^{-1} S21, (23)) and T.
+    Parameters
+    ----------
+    values : dict
+        A Theorem 3 solution (``Theorem3Solution.values``).
+    realisation : str
+        One of :data:`REALISATIONS`.
+
+    Returns
+    -------
+    tuple
+        The gains and ``{"S": S, "T": T}``: the full slack S = [[S11, S12], [S21, S22]] with
+        S12 = R1 S21^{-1} S22 (from R1 = S12 S22^{-1} S21, (23)) and T.
+
+    Raises
+    ------
+    GainschedError
+        On an unknown realisation.
     """
     R2 = values["R2"]
     if realisation == "identity_T":
@@ -310,7 +443,19 @@ def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains,
 
 
 def certificate_from_solution(values: dict, realisation: str = "identity_T") -> dict:
-    """Theorem 1 certificate (Q0, Qp, S) in original coordinates: Q = T^{-T} Q̄ T^{-1} (proof of Thm 2)."""
+    """Theorem 1 certificate (Q0, Qp, S) in original coordinates: Q = T^{-T} Q̄ T^{-1} (proof of Thm 2).
+
+    Parameters
+    ----------
+    values : dict
+        A Theorem 3 solution.
+    realisation : str
+
+    Returns
+    -------
+    dict
+        ``Q0``, ``Qp``, ``S`` for (12), (27).
+    """
     _, extra = recover_gains(values, realisation)
     Tinv = np.linalg.inv(extra["T"])
     return {"Q0": Tinv.T @ values["Q0"] @ Tinv, "Qp": Tinv.T @ values["Qp"] @ Tinv, "S": extra["S"]}
@@ -325,8 +470,22 @@ def congruence_residual(sys: System, values: dict, pairs, realisation: str = "id
     diag(T, I, T, T, T)^T (12) diag(T, I, T, T, T) of the Theorem 1 matrix built
     from the gains (26), the slack S of (23) and Q = T^{-T} Q̄ T^{-1}. Zero (to
     rounding) when every block of (24)-(25) is read correctly.
+
+    Parameters
+    ----------
+    sys : System
+    values : dict
+        A Theorem 3 solution.
+    pairs : iterable of (float, float)
+        (p(k), p(k+1)) pairs.
+    realisation : str
+    gamma3_top : {"HC", "zero"}
+
+    Returns
+    -------
+    float
     """
-    from .gainsched_model import theorem1_matrix
+    from .model import theorem1_matrix
 
     prob = Theorem3(sys, gamma3_top=gamma3_top)
     for name, var in prob.vars.items():

@@ -1,0 +1,16 @@
+"""Paper `gainsched`: probability-dependent gain-scheduled filtering (Wei, Wang, Shen, Li).
+
+G. Wei, Z. Wang, B. Shen, M. Li, *Probability-Dependent Gain-Scheduled Filtering for
+Stochastic Systems with Missing Measurements*.
+
+Modules:
+
+* :mod:`.model`: plant (1)-(7), filter (8)-(9), augmented system (10)-(11), sector (3)-(5),
+  Theorem 1 (12), second moments, simulation of Algorithm 1;
+* :mod:`.design`: Theorem 3 vertex LMIs (24)-(25), gain recovery (26), performance variant;
+* :mod:`.tuning`: gains of form (9) tuned by Monte Carlo (a yardstick, not the paper's);
+* :mod:`.steps`: pipeline steps (designs, stability, simulation, sensitivity, timing);
+* :mod:`.claims`: claims, errata and reconstructions steps;
+* :mod:`.figures`: Figs 1-2, S1, S2 from the tables;
+* :mod:`.checks`: configuration checks; ``figures.yaml``: the figure list.
+"""

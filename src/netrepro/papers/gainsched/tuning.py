@@ -1,0 +1,75 @@
+"""Monte Carlo tuned gains of the form (9): a yardstick of what the filter structure can achieve.
+
+Not a result of the paper: the gains are tuned by Nelder-Mead on common random numbers
+for a named nonlinearity, without any worst-case guarantee.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import Gains, System, simulate
+
+__all__ = ["tune_gains"]
+
+
+def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, scheduled: bool, maxiter: int,
+               start: Gains | None = None):
+    """Gains of form (9) minimising the Monte Carlo sum_k E||e(k)||^2 (x0 ~ N(0, I)), Nelder-Mead.
+
+    Common random numbers (one generator state per evaluation) make the cost
+    a deterministic smooth-ish function of the gains. Starts from ``start``
+    (default zero gains, the trivial estimate). Not a result of the paper: a yardstick.
+
+    Parameters
+    ----------
+    sys : System
+    p_seq : ndarray (K,)
+        p(0..K-1) of the cost horizon.
+    n_runs : int
+        Monte Carlo runs of :func:`~netrepro.papers.gainsched.model.simulate`.
+    seed : int
+        Seed of the initial states (``seed``) and of the noise (``seed + 1``).
+    nonlinearity : str
+        Kind of the sector nonlinearity.
+    scheduled : bool
+        Tune Gf, Hf as well (else they are zero).
+    maxiter : int
+        Nelder-Mead iterations.
+    start : Gains, optional
+
+    Returns
+    -------
+    tuple
+        The gains and ``{"cost", "n_eval", "start_cost"}``.
+    """
+    n, m = sys.n, sys.m
+    x0 = np.random.default_rng(seed).standard_normal((n_runs, n))
+
+    def unpack(v):
+        G0 = v[: n * n].reshape(n, n)
+        H0 = v[n * n: n * n + n * m].reshape(n, m)
+        if scheduled:
+            off = n * n + n * m
+            Gf = v[off: off + n * n].reshape(n, n)
+            Hf = v[off + n * n:].reshape(n, m)
+        else:
+            Gf, Hf = np.zeros((n, n)), np.zeros((n, m))
+        return Gains(G0, Gf, H0, Hf)
+
+    def cost(v):
+        e = simulate(sys, unpack(v), p_seq, x0, np.random.default_rng(seed + 1), nonlinearity)
+        return float((e ** 2).sum(-1).mean(0).sum())
+
+    from scipy.optimize import minimize
+
+    dim = (n * n + n * m) * (2 if scheduled else 1)
+    v0 = np.zeros(dim)
+    if start is not None:
+        parts = [start.G0.ravel(), start.H0.ravel()] + ([start.Gf.ravel(), start.Hf.ravel()] if scheduled else [])
+        v0 = np.concatenate(parts)
+    res = minimize(cost, v0, method="Nelder-Mead",
+                   options={"maxiter": int(maxiter), "xatol": 1e-4, "fatol": 1e-6, "adaptive": True})
+    best = res.x if res.fun <= cost(v0) else v0
+    return unpack(best), {"cost": float(min(res.fun, cost(v0))), "n_eval": int(res.nfev), "start_cost": cost(v0)}
+
