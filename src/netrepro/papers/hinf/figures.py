@@ -1,0 +1,171 @@
+"""Figures of the `hinf` paper: plotting only, from the tables under ``results/hinf/``.
+
+``figures.yaml`` lists which function draws which figure from which tables.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ...plotting import new_figure, save_figure
+
+__all__ = ["figure_noise", "figure_errors", "figure_trajectories", "figure_hinf_vs_kalman", "figure_sensitivity",
+           "figure_consensus"]
+
+
+def figure_noise(params, inputs, outputs):
+    """Fig 1: uncertainty ellipses (eq (3)-(4)) of three sensors, drawn at the sensor locations."""
+    from matplotlib.patches import Ellipse
+    t = pd.read_csv(inputs["table"])
+    scale = float(params.get("scale", 3.0))
+    fig, ax = new_figure(figsize=(6.0, 5.0))
+    ax.plot(0, 0, "ks", ms=8, label="target")
+    for _, row in t.iterrows():
+        fr, fb = row["f_r"], row["f_b"]
+        ell = Ellipse((row["x"], row["y"]), 2 * scale * math.sqrt(fr), 2 * scale * math.sqrt(fb),
+                      angle=math.degrees(row["theta"]), fill=False, lw=1.5, color=f"C{int(row['sensor'])}")
+        ax.add_patch(ell)
+        ax.plot(row["x"], row["y"], "o", color=f"C{int(row['sensor'])}",
+                label=f"sensor {int(row['sensor'])}: r = {row['r']:g}, f_r = {fr:.3f}, f_b = {fb:.3f}")
+        ax.plot([row["x"], 0], [row["y"], 0], ":", color=f"C{int(row['sensor'])}", lw=0.8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title(f"Measurement uncertainty ellipses ({scale:g}-sigma)")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_errors(params, inputs, outputs):
+    """Figs 2-5: estimation error of two (scenario, filter) series, one agent of one run and the Monte Carlo band."""
+    err = pd.read_csv(inputs["errors"])
+    single = pd.read_csv(inputs["single"])
+    fig, axes = new_figure(1, 2, figsize=(11, 4), sharey=False)
+    for (scen, filt, label), color in zip(params["series"], ("C0", "C3")):
+        s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
+        axes[0].plot(s["k"], s["error"], color=color, lw=1, label=label)
+        e = err[(err["scenario"] == scen) & (err["filter"] == filt)]
+        axes[1].plot(e["k"], e["error_mean"], color=color, lw=1.5, label=label + " (mean)")
+        axes[1].fill_between(e["k"], e["error_lo"], e["error_hi"], color=color, alpha=0.2, lw=0)
+    agent = int(single["agent"].iloc[0])
+    axes[0].set_title(f"one agent (agent {agent}, run {int(single['run'].iloc[0])})")
+    axes[1].set_title("mean over runs and agents, 10-90 % band")
+    for ax in axes:
+        ax.set_xlabel("time step k")
+        ax.set_ylabel("estimation error |x_hat - x|")
+        ax.legend()
+    if params.get("log"):
+        axes[1].set_yscale("log")
+    fig.suptitle(params["title"])
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_trajectories(params, inputs, outputs):
+    """Fig 6: trajectories of the agents (circles) and the evasive target (square), with tails."""
+    tr = pd.read_csv(inputs["trajectories"], dtype={"who": str})
+    tr = tr[(tr["scenario"] == params["scenario"]) & (tr["run"] == int(params.get("run", 0)))]
+    fig, ax = new_figure(figsize=(6.5, 6.0))
+    for i, (who, g) in enumerate(tr.groupby("who", sort=True)):
+        g = g.sort_values("k")
+        is_t = who == "target"
+        color = "k" if is_t else f"C{i}"
+        ax.plot(g["x"], g["y"], "-", color=color, lw=1, alpha=0.7)
+        ax.plot(g["x"].iloc[0], g["y"].iloc[0], "s" if is_t else "o", color=color, mfc="none", ms=8)
+        ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=8,
+                label="target" if is_t else f"agent {who}")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title(params["title"] + " (open: start, filled: end)")
+    ax.legend(fontsize=8)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_hinf_vs_kalman(params, inputs, outputs):
+    """Fig S1: late-window mean error of H-infinity vs Kalman filters in every scenario (beyond the paper)."""
+    s = pd.read_csv(inputs["summary"])
+    fig, ax = new_figure(figsize=(10, 4.5))
+    kinds = ["local", "decentralized", "centralized"]
+    scen = list(dict.fromkeys(s["scenario"]))
+    width = 0.13
+    for j, kind in enumerate(kinds):
+        for m, (pref, hatch) in enumerate((("", None), ("kalman_", "//"))):
+            vals, errs = [], []
+            for sc in scen:
+                name = pref + kind
+                if sc == "evasive_kalman" and pref == "":
+                    name = "__none__"
+                row = s[(s["scenario"] == sc) & (s["filter"] == name)]
+                vals.append(row["late_mean"].iloc[0] if len(row) else np.nan)
+                errs.append(2 * row["late_se"].iloc[0] if len(row) else np.nan)
+            x = np.arange(len(scen)) + (2 * j + m - 2.5) * width
+            ax.bar(x, vals, width, yerr=errs, color=f"C{j}", hatch=hatch, alpha=0.8 if m == 0 else 0.45,
+                   label=("Kalman " if m else "H-inf ") + kind)
+    ax.set_xticks(np.arange(len(scen)))
+    ax.set_xticklabels(scen, fontsize=8)
+    ax.set_ylabel("late-window mean error (+- 2 SE)")
+    ax.set_title("H-infinity vs Kalman filters (beyond the paper)")
+    ax.legend(fontsize=7, ncol=3)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_sensitivity(params, inputs, outputs):
+    """Fig S2: decentralized/local error ratio against each swept reconstruction."""
+    s = pd.concat([pd.read_csv(inputs["table"]), pd.read_csv(inputs["evasive"])], ignore_index=True)
+    pars = [p for p in ("gamma", "gamma_c", "K_p", "K_i", "h", "iters") if p in set(s["parameter"])]
+    ev = s[s["parameter"] == "gamma_evasive"]
+    fig, axes = new_figure(1, len(pars) + (len(ev) > 0), figsize=(2.6 * (len(pars) + 1), 3.2), squeeze=False)
+    for ax, p in zip(axes[0], pars):
+        for i, (scen, g) in enumerate(s[s["parameter"] == p].groupby("scenario", sort=False)):
+            g = g.sort_values("value")
+            ax.plot(g["value"], g["ratio_dec_local"], "o-", color=f"C{i}", label=f"{scen} (W={g['W'].iloc[0]:g})")
+            nx = g[~g["exists"] | ~np.isfinite(g["ratio_dec_local"])]
+            ax.plot(nx["value"], np.ones(len(nx)), "x", color=f"C{i}")
+        ax.axhline(1.0, color="k", lw=0.8, ls=":")
+        ax.set_xlabel(p)
+        if p == "gamma":
+            ax.set_xscale("log")
+    if len(ev):
+        ax = axes[0][-1]
+        fin = ev[np.isfinite(ev["value"]) & ev["exists"]]
+        ax.plot(fin["value"], fin["decentralized_error"], "o-", color="C2", label="H-inf (evasive)")
+        nx = ev[np.isfinite(ev["value"]) & ~ev["exists"]]
+        ax.plot(nx["value"], np.full(len(nx), np.nanmin(fin["decentralized_error"]) if len(fin) else 1.0), "x", color="C2")
+        kal = ev[~np.isfinite(ev["value"])]
+        if len(kal):
+            ax.axhline(kal["decentralized_error"].iloc[0], color="k", ls="--", label="Kalman (evasive)")
+        ax.set_xscale("log")
+        ax.set_xlabel("gamma (evasive target)")
+        ax.set_ylabel("decentralized late error")
+        ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("decentralized / local error")
+    axes[0][0].legend(fontsize=7)
+    fig.subplots_adjust(wspace=0.5)
+    fig.suptitle("Sensitivity of the Fig 2-3 comparison (x: no result)")
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_consensus(params, inputs, outputs):
+    """Fig S3: spectral radius and steady-state error of the PI consensus (5) against the step h."""
+    c = pd.read_csv(inputs["table"])
+    fig, axes = new_figure(1, 2, figsize=(10, 3.6))
+    axes[0].plot(c["h"], c["spectral_radius"], "o-")
+    axes[0].axhline(1.0, color="k", ls=":")
+    axes[0].axvline(c["h_max"].iloc[0], color="C3", ls="--", label=f"h_max = {c['h_max'].iloc[0]:.3f}")
+    axes[0].set_ylabel("spectral radius of (5)")
+    err = c["steady_state_error"].replace(np.inf, np.nan).clip(lower=1e-16, upper=1e6)
+    axes[1].semilogy(c["h"], err, "o-")
+    axes[1].set_ylabel("steady-state error (clipped)")
+    for ax in axes:
+        ax.set_xlabel("h")
+    axes[0].legend()
+    save_figure(fig, outputs["figure"])
+    return {}

@@ -1,0 +1,224 @@
+"""The H-infinity filters of the `hinf` paper: centralized (6), decentralized (9), their Kalman limit, gamma_0.
+
+All filters are written in the information form of Section III: with ``C_i = I_2``,
+``S = sum_i C_i^T M_i^{-1} C_i`` and ``y_info = sum_i C_i^T M_i^{-1} y_i``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ModelError
+from .algebra import I2, inv2, min_eig2, sym2
+
+__all__ = [
+    "FilterDoesNotExist", "hinf_information", "hinf_update", "decentralized_update", "kalman_update",
+    "minimum_attenuation",
+]
+
+
+class FilterDoesNotExist(ModelError):
+    """The H-infinity filter does not exist: gamma is below the minimum attenuation level gamma_0.
+
+    Raised when the information matrix ``Sigma_k^{-1} = Delta_k^{-1} + C^T M^{-1} C - gamma^{-2} L^T Q L``
+    of eq (6) (or (9)) is not positive definite at some step.
+    """
+
+
+def hinf_information(Delta, S, gamma_inv2: float, Lbar):
+    """Information matrix ``Sigma^{-1} = Delta^{-1} + S - gamma^{-2} L^T Q L`` of eq (6).
+
+    The filter exists at this step iff it is positive definite.
+
+    Parameters
+    ----------
+    Delta, S : ndarray, shape ``(..., 2, 2)``
+        Prior covariance ``Delta_k`` and ``C^T M^{-1} C``.
+    gamma_inv2 : float
+        ``gamma^{-2}``.
+    Lbar : ndarray, shape ``(2, 2)``
+        ``L^T Q L``.
+
+    Returns
+    -------
+    ndarray, shape ``(..., 2, 2)``
+        The symmetrised information matrix.
+    """
+    return sym2(inv2(Delta) + S - gamma_inv2 * Lbar)
+
+
+def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: bool = True):
+    """One step of the centralized H-infinity filter, eq (6), in its information form.
+
+    .. math::
+
+        \\Delta_k &= A \\Sigma_{k-1} A^T + B W_{k-1} B^T \\\\
+        K_k &= \\Delta_k (I + C^T M_k^{-1} C \\Delta_k)^{-1} C^T M_k^{-1} \\\\
+        \\hat x_k &= A \\hat x_{k-1} + K_k (y_k - C A \\hat x_{k-1}) \\\\
+        \\Sigma_k &= \\Delta_k (I - \\gamma^{-2} L_k^T Q_k L_k \\Delta_k + C^T M_k^{-1} C \\Delta_k)^{-1}
+
+    Using ``C^T M^{-1} C = S`` and ``C^T M^{-1} y = y_info`` (the sums of Section III),
+    ``K_k (y_k - C A x) = Delta (I + S Delta)^{-1} (y_info - S A x)``.
+    With ``gamma_inv2 = 0`` this is the Kalman filter.
+
+    Parameters
+    ----------
+    xhat : ndarray, shape ``(..., 2)``
+        Previous estimate.
+    Sigma : ndarray, shape ``(..., 2, 2)``
+        Previous ``Sigma_{k-1}``.
+    y_info : ndarray, shape ``(..., 2)``
+        ``C^T M^{-1} y``.
+    S : ndarray, shape ``(..., 2, 2)``
+        ``C^T M^{-1} C``.
+    A, BWB, Lbar : ndarray, shape ``(2, 2)``
+        Target dynamics, ``B W B^T`` and ``Lbar = L^T Q L``.
+    gamma_inv2 : float
+        ``gamma^{-2}``.
+    check : bool
+        Raise :class:`FilterDoesNotExist` when ``Sigma_k^{-1}`` is not positive definite.
+
+    Returns
+    -------
+    xhat, Sigma, Delta, min_info_eig : ndarray
+        New estimate and ``Sigma_k``, the prior ``Delta_k``, and the smallest eigenvalue of ``Sigma_k^{-1}``.
+
+    Raises
+    ------
+    FilterDoesNotExist
+        If ``check`` and ``Sigma_k^{-1}`` is not positive definite (gamma below gamma_0).
+    """
+    Delta = A @ Sigma @ A.T + BWB
+    xpred = xhat @ A.T
+    G = Delta @ inv2(I2 + S @ Delta)
+    xnew = xpred + (G @ (y_info - (S @ xpred[..., None])[..., 0])[..., None])[..., 0]
+    Omega = I2 - gamma_inv2 * Lbar @ Delta + S @ Delta
+    Sig = sym2(Delta @ inv2(Omega))
+    info_eig = min_eig2(hinf_information(Delta, S, gamma_inv2, Lbar))
+    if check and not np.all(info_eig > 0):
+        raise FilterDoesNotExist(
+            f"Sigma^-1 not positive definite (min eigenvalue {np.min(info_eig):.3g}): gamma below gamma_0")
+    return xnew, Sig, Delta, info_eig
+
+
+def decentralized_update(xhat, Sigma, y_tilde, C_tilde, n_agents: int, A, BWB, gamma_inv2, Lbar, check=True):
+    """One step of the decentralized H-infinity filter of agent i, eq (9).
+
+    .. math::
+
+        \\tilde K_k &= \\Delta_k (I + N \\tilde C \\Delta_k)^{-1} \\\\
+        \\hat x_k &= A \\hat x_{k-1} + N \\tilde K_k (\\tilde y_k - \\tilde C A \\hat x_{k-1}) \\\\
+        \\Sigma_k &= \\Delta_k (I - \\gamma^{-2} L_k^T Q_k L_k \\Delta_k + N \\tilde C \\Delta_k)^{-1}
+
+    with ``C_tilde`` and ``y_tilde`` the consensus estimates of the averages (7)-(8).
+    It is eq (6) with ``S = N C_tilde`` and ``y_info = N y_tilde``: with exact
+    consensus it equals the centralized filter.
+
+    Parameters
+    ----------
+    xhat, Sigma : ndarray, shapes ``(..., 2)``, ``(..., 2, 2)``
+    y_tilde, C_tilde : ndarray, shapes ``(..., 2)``, ``(..., 2, 2)``
+        Consensus estimates of the averages (8) and (7).
+    n_agents : int
+        ``N``.
+    A, BWB, Lbar : ndarray, shape ``(2, 2)``
+    gamma_inv2 : float
+    check : bool
+
+    Returns
+    -------
+    xhat, Sigma, Delta, min_info_eig : ndarray
+        As :func:`hinf_update`.
+
+    Raises
+    ------
+    FilterDoesNotExist
+        If ``check`` and the filter does not exist at this step.
+    """
+    return hinf_update(xhat, Sigma, n_agents * y_tilde, n_agents * C_tilde, A, BWB, gamma_inv2, Lbar, check)
+
+
+def kalman_update(xhat, P, y, M, A, BWB):
+    """Textbook Kalman filter with stacked measurements ``y_i = x + m_i``, written independently of (6).
+
+    Used by the tests and the filter checks as the reference for the ``gamma -> infinity`` limit.
+
+    Parameters
+    ----------
+    xhat, P : ndarray, shapes ``(..., 2)``, ``(..., 2, 2)``
+        Previous estimate and covariance.
+    y : ndarray, shape ``(..., N, 2)``
+        Measurements; stacked ``C = [I; ...; I]``.
+    M : ndarray, shape ``(..., N, 2, 2)``
+        Their noise covariances.
+    A, BWB : ndarray, shape ``(2, 2)``
+
+    Returns
+    -------
+    xhat, P : ndarray
+        Updated estimate and covariance.
+    """
+    n = y.shape[-2]
+    Delta = A @ P @ A.T + BWB
+    xpred = xhat @ A.T
+    C = np.tile(I2, (n, 1))
+    lead = M.shape[:-3]
+    Mbig = np.zeros(lead + (2 * n, 2 * n))
+    for i in range(n):
+        Mbig[..., 2 * i:2 * i + 2, 2 * i:2 * i + 2] = M[..., i, :, :]
+    Sinn = C @ Delta @ C.T + Mbig
+    K = Delta @ C.T @ np.linalg.inv(Sinn)
+    innov = y.reshape(lead + (2 * n,)) - (C @ xpred[..., None])[..., 0]
+    xnew = xpred + (K @ innov[..., None])[..., 0]
+    Pnew = (np.eye(2) - K @ C) @ Delta
+    return xnew, sym2(Pnew)
+
+
+def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6):
+    """Minimum attenuation level ``gamma_0`` of eq (6) along a sequence of informations.
+
+    ``gamma_0`` is the infimum of the ``gamma`` for which ``Sigma_k^{-1} > 0`` for every step
+    (the existence condition of the a-posteriori H-infinity filter). Feasibility is
+    monotone in ``gamma``; found by bisection on ``log gamma``.
+
+    Parameters
+    ----------
+    S_seq : ndarray, shape ``(K, ..., 2, 2)``
+        ``C^T M_k^{-1} C`` for each step (leading axes after time are batched; gamma_0 is the max).
+    Sigma0 : ndarray, shape ``(2, 2)``
+    A, BWB, Lbar : ndarray, shape ``(2, 2)``
+    lo, hi : float
+        Bracket of the bisection.
+    tol : float
+        Tolerance on ``log gamma``.
+
+    Returns
+    -------
+    float
+        ``gamma_0`` (``lo`` if the filter exists at ``lo``, inf if not even at ``hi``).
+    """
+    S_seq = np.asarray(S_seq, dtype=float)
+
+    def exists(gamma):
+        g2 = gamma ** -2.0
+        Sig = np.broadcast_to(np.asarray(Sigma0, dtype=float), S_seq.shape[1:]).copy()
+        for S in S_seq:
+            Delta = A @ Sig @ A.T + BWB
+            info = hinf_information(Delta, S, g2, Lbar)
+            if not np.all(min_eig2(info) > 0):
+                return False
+            Sig = sym2(inv2(info))
+        return True
+
+    if exists(lo):
+        return lo
+    if not exists(hi):
+        return np.inf
+    a, b = np.log(lo), np.log(hi)
+    while b - a > tol:
+        m = 0.5 * (a + b)
+        if exists(np.exp(m)):
+            b = m
+        else:
+            a = m
+    return float(np.exp(b))

@@ -1,0 +1,258 @@
+"""The multi-agent system of Section VI of the `hinf` paper: scenarios and their Monte Carlo simulation.
+
+A target (random walk, stationary or evasive) is measured by ``N`` agents through the noise
+model (2)-(4); each agent runs the local, decentralized (PI consensus (5) + eq (9)) and
+centralized (eq (6)) H-infinity filters and their Kalman counterparts (gamma = infinity);
+mobile agents follow the gradient law (12). Everything is vectorised over runs and agents.
+
+Scenarios (``config['hinf']['scenarios']``): ``fig2`` / ``fig3``: ten stationary agents,
+random-walk target, W = 0.01 I / 0.001 I (Figs 2-3); ``static_fixed`` / ``static_mobile``:
+stationary target, stationary / mobile agents (Figs 4-5); ``evasive_hinf`` / ``evasive_kalman``:
+four mobile agents, evasive target, driven by decentralized H-infinity / Kalman filters (Fig 6).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...errors import InputError
+from .algebra import I2, min_eig2, sym2
+from .consensus import adjacency, laplacian, pi_consensus_step
+from .evader import evader_move, min_fused_trace
+from .filters import FilterDoesNotExist, decentralized_update, hinf_update
+from .motion import control_law, sigma_gradient
+from .noise import NoiseModel, geometry, noise_information, sample_noise
+
+__all__ = ["FILTER_KINDS", "SCENARIOS", "layout_positions", "resolve_scenario", "simulate", "FilterDoesNotExist"]
+
+FILTER_KINDS = {
+    "local": ("local", False), "decentralized": ("decentralized", False), "centralized": ("centralized", False),
+    "kalman_local": ("local", True), "kalman_decentralized": ("decentralized", True),
+    "kalman_centralized": ("centralized", True),
+}
+SCENARIOS = ("fig2", "fig3", "static_fixed", "static_mobile", "evasive_hinf", "evasive_kalman")
+
+
+def layout_positions(spec: dict) -> np.ndarray:
+    """Agent positions on an arc around the origin.
+
+    Parameters
+    ----------
+    spec : dict
+        ``n`` agents, arc ``radius``, angular ``spacing_deg`` and ``start_deg`` (degrees).
+
+    Returns
+    -------
+    ndarray, shape ``(n, 2)``
+    """
+    ang = np.deg2rad(spec["start_deg"] + spec["spacing_deg"] * np.arange(spec["n"]))
+    return np.stack([spec["radius"] * np.cos(ang), spec["radius"] * np.sin(ang)], -1)
+
+
+def resolve_scenario(cfg: dict, name: str, **overrides) -> dict:
+    """The dict :func:`simulate` takes, from the config section and a scenario name.
+
+    Parameters
+    ----------
+    cfg : dict
+        The ``hinf`` configuration section.
+    name : str
+        A key of ``cfg['scenarios']``.
+    **overrides
+        Scenario keys (``runs``, ``horizon``, ``seed``, ...) and the sub-dicts ``filter``,
+        ``consensus``, ``control`` whose entries replace the configured ones.
+
+    Returns
+    -------
+    dict
+        The resolved scenario (arrays, :class:`NoiseModel`, gains); see :func:`simulate`.
+    """
+    sc = dict(cfg["scenarios"][name])
+    sc.update({k: v for k, v in overrides.items() if k in sc or k in ("runs", "horizon", "seed")})
+    f = dict(cfg["filter"])
+    f.update(overrides.get("filter", {}))
+    cons = dict(cfg["consensus"])
+    cons.update(overrides.get("consensus", {}))
+    ctrl = dict(cfg["control"])
+    ctrl.update(overrides.get("control", {}))
+    L = np.asarray(f["L"], dtype=float)
+    W = float(sc["W"])
+    return {
+        "agents0": layout_positions(cfg["layouts"][sc["layout"]]), "target0": np.zeros(2), "target": sc["target"],
+        "W_true": W * np.eye(2), "W_filter": float(sc["W_filter"]) * np.eye(2), "A": np.asarray(f["A"], dtype=float),
+        "gamma": float(f["gamma"]), "Lbar": L.T @ np.asarray(f["Q"], dtype=float) @ L, "P0": float(f["P0"]),
+        "psd_floor": float(f["psd_floor"]), "model": NoiseModel.from_config(cfg["noise"]),
+        "radius": float(cfg["comm_radius"]), "consensus": cons, "control": ctrl, "mobile": bool(sc["mobile"]),
+        "driver": sc.get("driver", "decentralized"),
+        "evader": {"n_headings": cfg["evader"]["n_headings"], "n_iter": cfg["evader"]["n_iter"],
+                   "step": cfg["evader"]["step_scale"] * math.sqrt(2 * W)},
+        "filters": list(sc["filters"]), "horizon": int(sc["horizon"]), "runs": int(sc["runs"]), "seed": int(sc["seed"]),
+    }
+
+
+def _psd_floor(C, floor):
+    """Shift 2x2 symmetric matrices up so their smallest eigenvalue is at least ``floor``; count the shifts."""
+    C = sym2(C)
+    low = min_eig2(C)
+    shift = np.maximum(floor - low, 0.0)
+    return C + shift[..., None, None] * I2, int(np.count_nonzero(shift))
+
+
+def _connected(adj):
+    lam = np.linalg.eigvalsh(laplacian(adj))
+    return lam[..., 1] > 1e-9
+
+
+def simulate(sc: dict) -> dict:
+    """Monte Carlo simulation of one scenario of Section VI, vectorised over runs and agents.
+
+    Parameters
+    ----------
+    sc : dict
+        Resolved scenario: ``agents0 (N, 2)``, ``target0 (2,)``, ``target`` in
+        {``random``, ``stationary``, ``evasive``}, ``W_true``, ``W_filter``, ``A`` (2x2),
+        ``gamma``, ``Lbar`` (= L^T Q L), ``P0``, ``model`` (:class:`NoiseModel`), ``radius``,
+        ``consensus`` (``gamma_c, h, K_p, K_i, iters``), ``mobile``, ``driver``, ``control``
+        (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``), ``filters``,
+        ``horizon``, ``runs``, ``seed``, ``psd_floor``.
+
+    Returns
+    -------
+    dict
+        ``errors[name]``: ``(runs, n, horizon + 1)`` position-error norms ``|xhat - x|``
+        (``n = N`` for local/decentralized, 1 for centralized); ``target (runs, K+1, 2)``;
+        ``agents (runs, K+1, N, 2)``; ``connected (K+1,)`` fraction of runs with a connected
+        graph; ``max_degree``; ``fused_trace (runs, K+1)`` (min over lambda of tr Q_fused, eq (22));
+        ``trace_sigma[name] (runs, K+1)`` mean over agents of ``tr Sigma``; ``n_psd_fix``.
+
+    Raises
+    ------
+    FilterDoesNotExist
+        If an H-infinity filter does not exist (gamma below gamma_0) at some step.
+    InputError
+        If a filter name, the driver or the target mode is unknown.
+    """
+    R, K = int(sc["runs"]), int(sc["horizon"])
+    P = np.broadcast_to(np.asarray(sc["agents0"], dtype=float), (R,) + np.shape(sc["agents0"])).copy()
+    N = P.shape[1]
+    A = np.asarray(sc["A"], dtype=float)
+    BWB = np.asarray(sc["W_filter"], dtype=float)
+    Wt = np.asarray(sc["W_true"], dtype=float)
+    Lbar = np.asarray(sc["Lbar"], dtype=float)
+    g2 = float(sc["gamma"]) ** -2.0
+    model = sc["model"]
+    cons = sc["consensus"]
+    ctrl = sc.get("control", {})
+    ev = sc.get("evader", {})
+    names = list(sc["filters"])
+    for name in names:
+        if name not in FILTER_KINDS:
+            raise InputError(f"unknown filter {name!r}; expected one of {sorted(FILTER_KINDS)}")
+    mobile = bool(sc.get("mobile", False))
+    driver = sc.get("driver", "decentralized")
+    if mobile and driver not in names:
+        raise InputError(f"driver filter {driver!r} must be among the filters {names}")
+    ss = np.random.SeedSequence(int(sc["seed"]))
+    rng0, rng_t, rng_m = (np.random.default_rng(s) for s in ss.spawn(3))
+
+    x = np.broadcast_to(np.asarray(sc["target0"], dtype=float), (R, 2)).copy()
+    x0hat = x + np.sqrt(float(sc["P0"])) * rng0.standard_normal((R, 2))
+    Sig0 = float(sc["P0"]) * I2
+    est, cov = {}, {}
+    for name in names:
+        kind, _ = FILTER_KINDS[name]
+        shape = (R,) if kind == "centralized" else (R, N)
+        est[name] = np.broadcast_to(x0hat[:, None, :] if kind != "centralized" else x0hat, shape + (2,)).copy()
+        cov[name] = np.broadcast_to(Sig0, shape + (2, 2)).copy()
+    errors = {n: np.empty((R, 1 if FILTER_KINDS[n][0] == "centralized" else N, K + 1)) for n in names}
+    trace_sigma = {n: np.empty((R, K + 1)) for n in names}
+    for n in names:
+        e = np.linalg.norm(est[n] - (x if FILTER_KINDS[n][0] == "centralized" else x[:, None, :]), axis=-1)
+        errors[n][..., 0] = e if e.ndim == 2 else e[:, None]
+        trace_sigma[n][:, 0] = 2 * float(sc["P0"])
+    tgt = np.empty((R, K + 1, 2))
+    tgt[:, 0] = x
+    ags = np.empty((R, K + 1, N, 2))
+    ags[:, 0] = P
+    fused = np.full((R, K + 1), np.nan)
+    connected = np.empty(K + 1)
+    adj = adjacency(P, sc["radius"])
+    lap = laplacian(adj)
+    connected[0] = _connected(adj).mean()
+    max_degree = int(adj.sum(-1).max())
+    need_cons = any(FILTER_KINDS[n][0] == "decentralized" for n in names)
+    v = w = None
+    dsig = np.zeros((2, R, N, 2, 2))  # local copies of Sigma^r_i, Sigma^theta_i (eq (14))
+    n_psd_fix = 0
+    for k in range(1, K + 1):
+        # 1. target motion
+        if sc["target"] == "random":
+            x = x @ A.T + rng_t.multivariate_normal(np.zeros(2), Wt, size=R) if np.any(Wt) else x @ A.T
+        elif sc["target"] == "evasive":
+            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]))
+            fused[:, k] = fz
+        elif sc["target"] != "stationary":
+            raise InputError(f"unknown target mode {sc['target']!r}")
+        # 2. measurements (2)-(4) from the true geometry
+        r, th = geometry(x, P)
+        Minv = noise_information(r, th, model)
+        y = x[:, None, :] + sample_noise(rng_m, r, th, model)
+        yinfo = (Minv @ y[..., None])[..., 0]
+        # 3. PI consensus (5) on u_i = (C_i^T M_i^-1 C_i, C_i^T M_i^-1 y_i), eqs (7)-(8)
+        if need_cons:
+            u = np.concatenate([Minv.reshape(R, N, 4), yinfo], -1)
+            if v is None:
+                v, w = u.copy(), np.zeros_like(u)
+            for _ in range(int(cons["iters"])):
+                v, w = pi_consensus_step(v, w, u, lap, cons["gamma_c"], cons["h"], cons["K_p"], cons["K_i"])
+            Ct, nfix = _psd_floor(v[..., :4].reshape(R, N, 2, 2), float(sc.get("psd_floor", 1e-9)))
+            n_psd_fix += nfix
+            yt = v[..., 4:]
+        # 4. filters (6), (9) and their Kalman counterparts
+        deltas = {}
+        for n in names:
+            kind, is_kf = FILTER_KINDS[n]
+            gi = 0.0 if is_kf else g2
+            if kind == "local":
+                out = hinf_update(est[n], cov[n], yinfo, Minv, A, BWB, gi, Lbar)
+            elif kind == "centralized":
+                out = hinf_update(est[n], cov[n], yinfo.sum(1), Minv.sum(1), A, BWB, gi, Lbar)
+            else:
+                out = decentralized_update(est[n], cov[n], yt, Ct, N, A, BWB, gi, Lbar)
+            est[n], cov[n], deltas[n] = out[0], out[1], out[2]
+            if kind == "centralized":
+                errors[n][:, 0, k] = np.linalg.norm(est[n] - x, axis=-1)
+                trace_sigma[n][:, k] = cov[n][..., 0, 0] + cov[n][..., 1, 1]
+            else:
+                errors[n][:, :, k] = np.linalg.norm(est[n] - x[:, None, :], axis=-1)
+                trace_sigma[n][:, k] = (cov[n][..., 0, 0] + cov[n][..., 1, 1]).mean(1)
+        # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
+        if mobile:
+            gi = 0.0 if FILTER_KINDS[driver][1] else g2
+            xh = est[driver]  # (R, N, 2)
+            d = xh - P
+            rh, thh = np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])
+            rh = np.maximum(rh, 1e-6)
+            _, dMr, dMt = noise_information(rh, thh, model, derivatives=True)
+            Delta = deltas[driver]
+            S_hat = N * Ct if FILTER_KINDS[driver][0] == "decentralized" else Minv
+            grads = []
+            for z, dM in enumerate((dMr, dMt)):
+                dDelta = A @ dsig[z] @ A.T if ctrl.get("recursion", True) else np.zeros_like(Delta)
+                _, dS = sigma_gradient(Delta, dDelta, S_hat, dM, gi, Lbar)
+                dsig[z] = dS
+                grads.append(dS[..., 0, 0] + dS[..., 1, 1])
+            P = P + control_law(grads[0], grads[1], rh, thh, float(ctrl["Gamma"]), float(ctrl["v_max"]))
+            adj = adjacency(P, sc["radius"])
+            lap = laplacian(adj)
+            max_degree = max(max_degree, int(adj.sum(-1).max()))
+        connected[k] = _connected(adj).mean() if mobile else connected[0]
+        tgt[:, k] = x
+        ags[:, k] = P
+    if sc["target"] == "evasive" or sc.get("fused_all", True):
+        r, th = geometry(tgt[:, 0], ags[:, 0])
+        fused[:, 0] = min_fused_trace(noise_information(r, th, model), int(ev.get("n_iter", 40)))[0]
+    return {"errors": errors, "target": tgt, "agents": ags, "connected": connected, "max_degree": max_degree,
+            "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix}

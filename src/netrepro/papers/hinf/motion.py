@@ -1,0 +1,117 @@
+"""Gradient motion control of the `hinf` paper, eqs (10)-(16) and (12).
+
+Each agent moves along the steepest descent of ``J = tr Sigma_k`` with respect to its own
+position, using the gradient recursion (14) for ``Sigma_k^z``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .algebra import I2, inv2, rotation
+
+__all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law"]
+
+
+def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
+    """Covariance ``Sigma_k`` and its derivative w.r.t. one sensor coordinate, eqs (14)-(16) corrected.
+
+    With ``Omega = I + S Delta - gamma^{-2} L^T Q L Delta`` (eq (11); the paper's (16) prints
+    ``- C^T M^{-1} C Delta``, erratum E2) and ``Sigma = Delta Omega^{-1}``:
+
+    .. math::
+
+        \\Sigma^z = \\Delta^z \\Omega^{-1}
+            - \\Delta \\Omega^{-1} C^T \\frac{\\partial M^{-1}}{\\partial z} C \\Delta \\Omega^{-1}
+            - \\Delta \\Omega^{-1} (C^T M^{-1} C \\Delta^z - \\gamma^{-2} L^T Q L \\Delta^z) \\Omega^{-1}
+
+    (the paper's (15) prints ``+`` on the middle term, erratum E3). ``dDelta = A Sigma^z_{k-1} A^T``
+    is eq (14).
+
+    Parameters
+    ----------
+    Delta, dDelta, S, dS : ndarray, shape ``(..., 2, 2)``
+        ``Delta_k``, ``Delta_k^z``, ``C^T M^{-1} C``, ``C^T (dM^{-1}/dz) C``.
+    gamma_inv2 : float
+        ``gamma^{-2}``.
+    Lbar : ndarray, shape ``(2, 2)``
+        ``L^T Q L``.
+
+    Returns
+    -------
+    Sigma, dSigma : ndarray, shape ``(..., 2, 2)``
+    """
+    Omega = I2 + S @ Delta - gamma_inv2 * Lbar @ Delta
+    Oi = inv2(Omega)
+    DOi = Delta @ Oi
+    dSigma = dDelta @ Oi - DOi @ dS @ DOi - DOi @ (S @ dDelta - gamma_inv2 * Lbar @ dDelta) @ Oi
+    return Delta @ Oi, dSigma
+
+
+def printed_sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
+    """Eqs (15)-(16) exactly as printed (``Omega = I - g L Delta - S Delta``, ``+`` middle term).
+
+    Parameters
+    ----------
+    Delta, dDelta, S, dS : ndarray, shape ``(..., 2, 2)``
+    gamma_inv2 : float
+    Lbar : ndarray, shape ``(2, 2)``
+
+    Returns
+    -------
+    ndarray, shape ``(..., 2, 2)``
+        The printed ``Sigma^z`` (wrong: errata E2, E3).
+    """
+    Omega = I2 - gamma_inv2 * Lbar @ Delta - S @ Delta
+    Oi = inv2(Omega)
+    DOi = Delta @ Oi
+    return dDelta @ Oi + DOi @ dS @ DOi - DOi @ (S @ dDelta - gamma_inv2 * Lbar @ dDelta) @ Oi
+
+
+def control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float, v_max: float = np.inf):
+    """Gradient motion control law, eq (12) corrected, with a speed limit.
+
+    With ``theta_i = angle(x - p_i)`` (Section II), ``grad_{p_i} J = -T_i [dJ/dr; dJ/dtheta / r]``,
+    so steepest descent is
+
+    .. math:: u_i = \\Gamma\\, T_i \\begin{bmatrix} \\partial J/\\partial r_i \\\\
+              r_i^{-1} \\partial J / \\partial \\theta_i \\end{bmatrix}
+
+    (the paper prints ``-Gamma T_i^T [...]``, erratum E5). The step is then scaled down to
+    length ``v_max`` if longer (the agents' "limited motion capabilities", a reconstruction).
+
+    Parameters
+    ----------
+    dJ_dr, dJ_dtheta, r, theta : ndarray, same shape
+        Derivatives of ``J`` w.r.t. range and bearing, range and bearing.
+    Gamma : float
+        Control gain of eq (12).
+    v_max : float
+        Largest step length.
+
+    Returns
+    -------
+    ndarray, shape ``r.shape + (2,)``
+        The steps ``u_i``.
+    """
+    local = np.stack([dJ_dr, dJ_dtheta / r], -1)
+    u = Gamma * (rotation(theta) @ local[..., None])[..., 0]
+    norm = np.linalg.norm(u, axis=-1, keepdims=True)
+    scale = np.where(norm > v_max, v_max / np.maximum(norm, 1e-300), 1.0)
+    return u * scale
+
+
+def printed_control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float):
+    """Eq (12) as printed: ``u_i = -Gamma T_i^T [dJ/dr; dJ/dtheta / r]`` (no speed limit).
+
+    Parameters
+    ----------
+    dJ_dr, dJ_dtheta, r, theta : ndarray, same shape
+    Gamma : float
+
+    Returns
+    -------
+    ndarray, shape ``r.shape + (2,)``
+    """
+    local = np.stack([dJ_dr, dJ_dtheta / r], -1)
+    return -Gamma * (np.swapaxes(rotation(theta), -1, -2) @ local[..., None])[..., 0]

@@ -1,0 +1,71 @@
+"""A tiny run of every `hinf` step, shared by the step, claims and figure tests."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from netrepro.papers.hinf import claims, steps
+from netrepro.papers.hinf.model import SCENARIOS
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def tiny_section() -> dict:
+    """config/test.yaml's hinf section, shrunk further (few runs, short horizons, small sweeps)."""
+    sec = copy.deepcopy(yaml.safe_load((ROOT / "config" / "test.yaml").read_text())["hinf"])
+    for sc in sec["scenarios"].values():
+        sc["runs"], sc["horizon"] = 6, 40
+    sec["noise_check"]["n_samples"] = 20000
+    sec["errata"]["n_samples"] = 20000
+    sec["attenuation"].update(horizon=30, runs=3)
+    sv = sec["sensitivity"]
+    sv.update(runs=4, horizon=30, gamma=[1.5, 3.0], gamma_c=[0.5], K_p=[0.4], K_i=[0.2], h=[0.5], iters=[1])
+    sec["claims"]["late_start"] = 20
+    return sec
+
+
+def _write(tables: dict, outputs: dict) -> None:
+    for key, path in outputs.items():
+        tables[key].to_csv(path, index=False)
+
+
+@pytest.fixture(scope="session")
+def hinf_run(tmp_path_factory):
+    """``(section, {name: path})`` of every table of a tiny run."""
+    cfg = tiny_section()
+    d = tmp_path_factory.mktemp("hinf")
+    files = {}
+
+    def run(fn, params, inputs, names):
+        outs = {n: d / f"{fn.__name__}_{n}.csv" for n in names}
+        _write(fn(params, inputs, outs), outs)
+        files.update(outs)
+
+    run(steps.noise_model_step, cfg, {}, ["table", "fit"])
+    files["noise_model"], files["noise_fit"] = files.pop("table"), files.pop("fit")
+    run(steps.consensus_check_step, cfg, {}, ["table"])
+    files["consensus"] = files.pop("table")
+    run(steps.attenuation_step, cfg, {}, ["table", "checks"])
+    files["attenuation"] = files.pop("table")
+    pieces = {}
+    for scen in SCENARIOS:
+        tabs = steps.simulate_step({"scenario": scen, "cfg": cfg}, {}, {})
+        for kind in ("errors", "single", "trajectories", "summary", "per_run"):
+            p = d / f"sim_{scen}_{kind}.csv"
+            tabs[kind].to_csv(p, index=False)
+            pieces[f"{kind}_{scen}"] = p
+    run(steps.tables_step, {}, pieces, ["errors", "single", "trajectories", "summary", "paired"])
+    run(steps.sensitivity_step, cfg, {}, ["table"])
+    files["sensitivity"] = files.pop("table")
+    run(steps.sensitivity_evasive_step, cfg, {}, ["table"])
+    files["sensitivity_evasive"] = files.pop("table")
+    return cfg, files
+
+
+def read(files, name) -> pd.DataFrame:
+    return pd.read_csv(files[name])
