@@ -12,7 +12,8 @@ plain_hi, plain_max, n_paths, exact_mean, cond_se, cond_z, plain_se, plain_z``.
 mean_method`` (mean exact at every k, lo = hi = mean) plus ``mean_rel_error_bound, lam_label,
 report_estimate_printed, plain_mean, plain_lo, plain_hi, cond_mean, cond_z``.
 ``results/intermittent/two_sensor_region.csv``: ``lambda1, lambda2c_lower, lambda2c_upper`` plus
-``bracket_lower, n_solves, status_at_threshold, certified_radius, statuses_seen``.
+``bracket_lower, certified, upper_certified_by, lower_certified_by, upper_slack, n_solves, n_undecided,
+status_at_threshold, statuses_seen`` (both bracket ends certified: see two_sensor.two_sensor_upper_bound).
 ``results/intermittent/two_sensor_simulation.csv``: ``lambda1, lambda2, side, k, mean, mean_lo, mean_hi,
 predicted_growth`` (mean exact) plus ``mean_method, mean_rel_error_bound, stationary_mean, mc_mean, mc_lo, mc_hi,
 mc_z``.
