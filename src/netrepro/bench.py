@@ -37,6 +37,11 @@ Benchmarks
 ``fisher_1bit``
     The expected 1-bit Fisher information (eq. (29)-(30) of the ``onebit`` paper) on a full SNR
     grid, vectorised against per-point adaptive quadrature, with their agreement.
+``exact_mean``
+    The exact E(p_k) of the ``intermittent`` paper (:func:`netrepro.papers.intermittent.exact.exact_mean`,
+    every k of the horizon) against the conditional Monte Carlo estimator it replaces, at the
+    pipeline's sample size; the ratio is the time ratio, with the estimator's largest relative 95%
+    half-width (what the exact method removes) and the exact method's error bound.
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
     rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
@@ -74,6 +79,7 @@ __all__ = [
     "bench_channels",
     "bench_lmi",
     "bench_fisher",
+    "bench_exact_mean",
     "bench_pipeline",
     "blas_peak",
     "run_all",
@@ -185,6 +191,35 @@ def blas_peak(native: bool = True, size: int = 2048, repeats: int = 5) -> dict:
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     out["env"] = {k: env.get(k) for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE")}
     return out
+
+
+# ============================================================================ exact E(p_k) (intermittent)
+def bench_exact_mean(n_paths: int, horizon: int, repeats: int) -> list[dict]:
+    """Exact E(p_k), k <= horizon (both configured lambdas), against the conditional Monte Carlo it replaces."""
+    from .engines.montecarlo import run_monte_carlo
+    from .papers.intermittent.exact import exact_mean
+    from .papers.intermittent.model import critical_probability
+    from .papers.intermittent.steps import _scalar_simulator
+
+    a, R1, R2, p0 = 1.5, 0.1, 0.5, 10.0
+    lams = [critical_probability(a) + off for off in (0.1, -0.1)]
+    params = dict(a=a, R1=R1, R2=R2, Ep0=p0, horizon=horizon)
+    results = {}
+
+    def ours():
+        results["exact"] = [exact_mean(p0, a, R1, [R2], [lam], horizon) for lam in lams]
+
+    def estimator():
+        results["mc"] = [run_monte_carlo(_scalar_simulator(params, lam), n_paths, 20000, 7).ci("cond") for lam in lams]
+
+    t_ours = median_time(ours, repeats)
+    t_ref = median_time(estimator, max(1, repeats // 2))
+    half = max(float(np.max((hi - m) / m)) for m, _, hi in results["mc"])
+    bound = max(float(r.rel_error_bound.max()) for r in results["exact"])
+    return [
+        BenchRow("exact_mean", f"time_s_{len(lams)}x{horizon + 1}_values", t_ours, t_ref, t_ref / t_ours, "s"),
+        BenchRow("exact_mean", "max_rel_error", bound, half, half / bound, "1 (exact bound vs MC 95% half-width)"),
+    ]
 
 
 # ============================================================================ (a) Riccati recursions
@@ -639,9 +674,9 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 # ============================================================================ driver
 SIZES = {
     "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
-                 repeats=5, peak_size=2048),
+                 repeats=5, peak_size=2048, exact_mean=(400000, 60)),
     "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
-                  repeats=2, peak_size=256),
+                  repeats=2, peak_size=256, exact_mean=(20000, 60)),
 }
 
 
@@ -683,6 +718,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
         _progress("fisher: vectorised expected 1-bit Fisher information vs adaptive quadrature")
         fisher_rows, info["fisher_source"] = bench_fisher(*sizes["fisher"], reps)
         rows += fisher_rows
+    if want("exact_mean"):
+        _progress("exact_mean: exact E(p_k) vs the conditional Monte Carlo estimator")
+        rows += bench_exact_mean(*sizes["exact_mean"], reps)
     if pipeline and not quick and want("pipeline"):
         _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
         pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
@@ -697,7 +735,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
     parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")
     parser.add_argument("--only", default=None,
-                        help="comma-separated subset of riccati,channels,lmi,fisher,pipeline")
+                        help="comma-separated subset of riccati,channels,lmi,fisher,exact_mean,pipeline")
     parser.add_argument("--scratch", default=None, help="folder for the pipeline's scratch copy (default: tmp)")
     parser.add_argument("--keep-scratch", action="store_true", help="keep the pipeline's scratch copy")
     args = parser.parse_args(argv)

@@ -18,11 +18,37 @@ rule intermittent_exact_mean:
         CONDA_ENV
     params:
         cfg=as_json(
-            pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "exact_horizon")
+            pick(
+                ICFG.get("scalar", {}),
+                "a",
+                "R1",
+                "R2",
+                "Ep0",
+                "lambda_offsets",
+                "horizon",
+                "exact_horizon",
+            )
         ),
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:exact_mean_step")
+
+
+rule intermittent_stationary_mean:
+    input:
+        code=code("netrepro.papers.intermittent.steps:stationary_mean_step"),
+    output:
+        table="results/intermittent/stationary_mean.csv",
+    log:
+        "logs/intermittent/stationary_mean.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.intermittent.steps:stationary_mean_step")
 
 
 rule intermittent_monte_carlo_shard:
@@ -56,6 +82,7 @@ rule intermittent_monte_carlo_shard:
 rule intermittent_monte_carlo:
     input:
         code=code("netrepro.papers.intermittent.steps:monte_carlo_merge_step"),
+        exact=rules.intermittent_exact_mean.output.table,
         shards=expand(
             rules.intermittent_monte_carlo_shard.output.sums,
             shard=range(ICFG.get("scalar", {}).get("n_shards", 1)),
@@ -222,6 +249,7 @@ rule intermittent_claims:
         bounds=rules.intermittent_scalar_bounds.output.table,
         region=rules.intermittent_two_sensor_region.output.table,
         simulation=rules.intermittent_two_sensor_simulation.output.table,
+        stationary=rules.intermittent_stationary_mean.output.table,
     output:
         table="results/claims/intermittent.csv",
     log:
@@ -245,6 +273,7 @@ if enabled("intermittent"):
     PAPER_TABLES["intermittent"] = [
         rules.intermittent_scalar_bounds.output.table,
         rules.intermittent_exact_mean.output.table,
+        rules.intermittent_stationary_mean.output.table,
         rules.intermittent_monte_carlo.output.table,
         rules.intermittent_two_sensor_region.output.table,
         rules.intermittent_two_sensor_simulation.output.table,

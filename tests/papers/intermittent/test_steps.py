@@ -22,11 +22,16 @@ def test_region_shards_give_identical_tables_whatever_the_split():
 
 def test_scalar_pipeline_on_a_tiny_config(tmp_path):
     exact = steps.exact_mean_step(SCALAR, {}, {})["table"]
-    assert list(exact.columns) == ["lam", "k", "mean_exact"] and len(exact) == 2 * 7
+    assert list(exact.columns) == ["lam", "k", "mean_exact", "rel_error_bound", "mean_enumeration",
+                                   "enumeration_rel_diff"] and len(exact) == 2 * 13
+    assert exact["mean_enumeration"].notna().sum() == 2 * 7 and exact["enumeration_rel_diff"].max() < 1e-12
     shard = tmp_path / "s0.npz"
     steps.monte_carlo_shard_step({**SCALAR, "n_shards": 1, "shard": 0}, {}, {"sums": str(shard)})
-    mc = steps.monte_carlo_merge_step(SCALAR, {"shards": [str(shard)]}, {})["table"]
     write_table(exact, tmp_path / "exact.csv")
+    mc = steps.monte_carlo_merge_step(SCALAR, {"shards": [str(shard)], "exact": str(tmp_path / "exact.csv")},
+                                      {})["table"]
+    assert {"exact_mean", "cond_z", "plain_z", "cond_se"} <= set(mc.columns)
+    assert np.isfinite(mc["cond_z"]).all()
     write_table(mc, tmp_path / "mc.csv")
     bounds = steps.scalar_bounds_step(SCALAR, {"exact": str(tmp_path / "exact.csv"), "mc": str(tmp_path / "mc.csv")},
                                       {})["table"]
@@ -34,7 +39,17 @@ def test_scalar_pipeline_on_a_tiny_config(tmp_path):
         assert col in bounds.columns
     assert len(bounds) == 2 * 13
     assert (bounds["s"] <= bounds["r"] + 1e-12).all()
-    assert (bounds["mean_lo"] <= bounds["mean_hi"]).all()
+    assert (bounds["mean_lo"] == bounds["mean"]).all() and (bounds["mean_hi"] == bounds["mean"]).all()
+    assert set(bounds["mean_method"]) == {"exact"}
+    # the exact mean lies between the bounds (eq. 7)
+    assert (bounds["s"] <= bounds["mean"] * (1 + 1e-12)).all() and (bounds["mean"] <= bounds["r"] * (1 + 1e-12)).all()
+
+
+def test_stationary_table():
+    table = steps.stationary_mean_step(SCALAR, {}, {})["table"]
+    stable, unstable = table.iloc[0], table.iloc[1]
+    assert stable["s_limit"] < stable["stationary_lo"] <= stable["stationary_hi"] < stable["r_limit"]
+    assert np.isinf(unstable["stationary_mean"]) and unstable["loss_growth"] > 1
 
 
 def test_simulation_step_columns():
@@ -43,3 +58,5 @@ def test_simulation_step_columns():
     table = steps.two_sensor_simulation_step(params, {}, {})["table"]
     assert set(table["side"]) == {"stable", "unstable"} and len(table) == 22
     assert np.isfinite(table["mean"]).all()
+    assert np.isfinite(table[table["side"] == "stable"]["stationary_mean"]).all()
+    assert np.isinf(table[table["side"] == "unstable"]["stationary_mean"]).all()

@@ -26,3 +26,5 @@ Modules
 ``checks``
     ``check_config``: configuration checks beyond the schema.
 """
+
+__all__ = []  # the modules are imported by name (netrepro.papers.intermittent.model, ...)

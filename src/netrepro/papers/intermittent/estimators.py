@@ -10,7 +10,7 @@ import numpy as np
 
 from ...engines.channels import arrival_patterns
 
-__all__ = ["loss_propagation", "conditional_mean_weights", "conditional_mean_paths"]
+__all__ = ["loss_propagation", "conditional_mean_weights", "conditional_mean_paths", "loss_path_terms"]
 
 
 def loss_propagation(x, m, a, R1):
@@ -115,9 +115,41 @@ def conditional_mean_paths(p_paths, p0, a, R1, sensor_vars, probs):
             post = 1.0 / (1.0 / p + inv_vars[pattern].sum())
             mixed += weight * (a * a * post + R1)
     W = conditional_mean_weights(T, a, pi0)  # (T, T+1)
-    ks = np.arange(T + 1)
-    # deterministic part: the R1 terms of L^m weighted by pi0^m, and the no-arrival-at-all path.
-    # Written with (pi0 a^2)^m and pi0^m separately so that no 0 * inf can occur.
+    with np.errstate(over="ignore", invalid="ignore"):
+        return mixed @ W + loss_path_terms(T, p0, a, R1, pi0)[None, :]
+
+
+def loss_path_terms(horizon, p0, a, R1, pi_loss):
+    """The part of E(p_k) that needs no expectation: R1 terms of the loss runs and the all-loss path.
+
+    In the last-arrival decomposition (eqs. (6), (14))
+
+    .. math::
+
+        E(p_k) = \\sum_{j<k} \\pi_0^{m} \\big(a^{2m} \\mu_j + (1-\\pi_0) c_m\\big) + \\pi_0^k (a^{2k} p_0 + c_k),
+        \\quad m = k-1-j,\\ c_m = R_1 (a^{2m}-1)/(a^2-1),
+
+    with mu_j = E[sum_{S != {}} pi_S phi_S(p_j)], this returns everything but the mu_j terms.
+    Written with (pi0 a^2)^m and pi0^m separately so that no 0 * inf can occur.
+
+    Parameters
+    ----------
+    horizon : int
+        T, the last time.
+    p0 : float
+        Deterministic p_0.
+    a, R1 : float
+        System coefficient and process noise variance.
+    pi_loss : float
+        pi_0, probability that no packet arrives in one step.
+
+    Returns
+    -------
+    ndarray (horizon + 1,)
+        The deterministic terms for k = 0..T.
+    """
+    pi0 = pi_loss
+    ks = np.arange(horizon + 1)
     with np.errstate(over="ignore", invalid="ignore"):
         grow = (pi0 * a * a) ** ks.astype(float)  # (pi0 a^2)^k
         shrink = pi0 ** ks.astype(float)  # pi0^k
@@ -126,5 +158,4 @@ def conditional_mean_paths(p_paths, p0, a, R1, sensor_vars, probs):
         else:
             r1_terms = R1 * (grow - shrink) / (a * a - 1.0)  # pi0^m R1 (a^{2m} - 1)/(a^2 - 1)
         cumulative = np.concatenate([[0.0], np.cumsum(r1_terms[:-1])])  # sum over m = 0..k-1
-        const = (1.0 - pi0) * cumulative + p0 * grow + r1_terms
-        return mixed @ W + const[None, :]
+        return (1.0 - pi0) * cumulative + p0 * grow + r1_terms

@@ -11,7 +11,7 @@ __all__ = ["figure_bounds", "figure_region", "figure_estimators"]
 
 
 def figure_bounds(params, inputs, outputs):
-    """Figs 1 and 2: s_k, r_k, the report's estimate and the true E(p_k) with its 95% band."""
+    """Figs 1 and 2: s_k, r_k, the report's estimate and the exact E(p_k) (its band collapses: lo = hi)."""
     table = read_table(inputs["bounds"])
     stable = params["which"] == "stable"
     lam_c = table["lam"].min() + (table["lam"].max() - table["lam"].min()) / 2
@@ -22,7 +22,7 @@ def figure_bounds(params, inputs, outputs):
     ax.plot(k, data["s"], "-", color="C0", label="lower bound $s_k$ (10)")
     ax.plot(k, data["report_estimate"], "--", color="C2", label="report's estimate (corrected)")
     ax.fill_between(k, data["mean_lo"], data["mean_hi"], color="k", alpha=0.2, lw=0)
-    ax.plot(k, data["mean"], ":", color="k", label="true $E(p_k)$ (exact / conditional MC, 95% band)")
+    ax.plot(k, data["mean"], ":", color="k", label="true $E(p_k)$ (exact)")
     ax.set_xlabel("k")
     ax.set_ylabel("prediction error variance")
     lam = data["lam"].iloc[0]
@@ -66,7 +66,7 @@ def figure_estimators(params, inputs, outputs):
         ax.plot(d["k"], d["cond_mean"], "-", color="C0", label="conditional estimator (95% band)")
         ax.fill_between(d["k"], d["plain_lo"], d["plain_hi"], color="C3", alpha=0.2, lw=0)
         ax.plot(d["k"], d["plain_mean"], "--", color="C3", label="plain sample mean (95% band)")
-        ax.plot(e["k"], e["mean_exact"], "k.", ms=4, label="exact (enumeration)")
+        ax.plot(e["k"], e["mean_exact"], "k.", ms=4, label="exact")
         ax.set_yscale("log")
         ax.set_xlabel("k")
         ax.set_title(f"$\\lambda = {lam:.4f}$, {int(d['n_paths'].iloc[0])} paths")

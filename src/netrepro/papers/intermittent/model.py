@@ -18,6 +18,7 @@ __all__ = [
     "report_estimate_sequence",
     "exact_mean_enumeration",
     "sinopoli_operator",
+    "mare_fixed_point",
 ]
 
 
@@ -223,3 +224,28 @@ def sinopoli_operator(K, p, lam, a, R1, R2):
         phi(K, p).
     """
     return (1 - lam) * (a * a * p + R1) + lam * ((a + K) ** 2 * p + R1 + K * R2 * K)
+
+
+def mare_fixed_point(a, R1, R2, lam) -> float:
+    """The fixed point r* of the modified Riccati iteration (9), i.e. the positive root of the MARE.
+
+    r = a^2 r + R1 - lambda a^2 r^2/(r + R2) is, times (r + R2),
+    (1 - (1 - lambda) a^2) r^2 + (R2 - a^2 R2 - R1) r - R1 R2 = 0.
+
+    Parameters
+    ----------
+    a, R1, R2 : float
+        System coefficient, process and measurement noise variances.
+    lam : float
+        Arrival probability lambda.
+
+    Returns
+    -------
+    float
+        r*, or inf when (1 - lambda) a^2 >= 1 (lambda <= lambda_c: the iteration diverges).
+    """
+    c = 1.0 - (1.0 - lam) * a * a
+    if c <= 0.0:
+        return float(np.inf)
+    b = R2 - a * a * R2 - R1
+    return float((-b + np.sqrt(b * b + 4.0 * c * R1 * R2)) / (2.0 * c))

@@ -2,15 +2,21 @@
 
 Tables
 ------
-``results/intermittent/exact_mean.csv``: ``lam, k, mean_exact``.
+``results/intermittent/exact_mean.csv``: ``lam, k, mean_exact, rel_error_bound, mean_enumeration,
+enumeration_rel_diff`` (exact at every k; enumeration for k <= exact_horizon as a validation).
+``results/intermittent/stationary_mean.csv``: ``lam, lam_label, loss_growth, stationary_mean, stationary_lo,
+stationary_hi, bracket_rel_width, method, s_limit, r_limit, report_estimate_limit, n_iter``.
 ``results/intermittent/monte_carlo.csv``: ``lam, k, cond_mean, cond_lo, cond_hi, plain_mean, plain_lo,
-plain_hi, plain_max, n_paths``.
+plain_hi, plain_max, n_paths, exact_mean, cond_se, cond_z, plain_se, plain_z``.
 ``results/intermittent/scalar_bounds.csv``: ``lam, k, s, r, report_estimate, mean, mean_lo, mean_hi,
-mean_method`` plus ``lam_label, report_estimate_printed, plain_mean, plain_lo, plain_hi``.
+mean_method`` (mean exact at every k, lo = hi = mean) plus ``mean_rel_error_bound, lam_label,
+report_estimate_printed, plain_mean, plain_lo, plain_hi, cond_mean, cond_z``.
 ``results/intermittent/two_sensor_region.csv``: ``lambda1, lambda2c_lower, lambda2c_upper`` plus
-``bracket_lower, n_solves, status_at_threshold, certified_radius, statuses_seen``.
+``bracket_lower, certified, upper_certified_by, lower_certified_by, upper_slack, n_solves, n_undecided,
+status_at_threshold, statuses_seen`` (both bracket ends certified: see two_sensor.two_sensor_upper_bound).
 ``results/intermittent/two_sensor_simulation.csv``: ``lambda1, lambda2, side, k, mean, mean_lo, mean_hi,
-predicted_growth``.
+predicted_growth`` (mean exact) plus ``mean_method, mean_rel_error_bound, stationary_mean, mc_mean, mc_lo, mc_hi,
+mc_z``.
 """
 
 from __future__ import annotations
@@ -24,12 +30,14 @@ from ...engines.riccati import Sensor, covariance_paths
 from ...errors import InputError
 from ...io import read_table
 from .estimators import conditional_mean_paths
-from .model import (critical_probability, exact_mean_enumeration, lower_bound_sequence, report_estimate_sequence,
-                    upper_bound_sequence)
+from .exact import exact_mean, stationary_mean
+from .model import (critical_probability, exact_mean_enumeration, lower_bound_sequence, mare_fixed_point,
+                    report_estimate_sequence, upper_bound_sequence)
 from .two_sensor import two_sensor_lower_bound, two_sensor_upper_bound
 
 __all__ = [
     "exact_mean_step",
+    "stationary_mean_step",
     "monte_carlo_shard_step",
     "monte_carlo_merge_step",
     "scalar_bounds_step",
@@ -46,13 +54,50 @@ def _lambdas(cfg):
 
 
 def exact_mean_step(params, inputs, outputs):
-    """Step: exact E(p_k), k <= exact_horizon, for each lambda."""
+    """Step: exact E(p_k) at every k <= horizon (exact.exact_mean), validated against enumeration for k <= exact_horizon."""
     frames = []
+    worst = 0.0
     for lam, _ in _lambdas(params):
-        means = exact_mean_enumeration(params["Ep0"], params["a"], params["R1"], params["R2"], lam,
-                                       params["exact_horizon"])
-        frames.append(pd.DataFrame({"lam": lam, "k": np.arange(len(means)), "mean_exact": means}))
-    return {"table": pd.concat(frames, ignore_index=True)}
+        a, R1, R2, p0 = params["a"], params["R1"], params["R2"], params["Ep0"]
+        res = exact_mean(p0, a, R1, [R2], [lam], params["horizon"])
+        enum = exact_mean_enumeration(p0, a, R1, R2, lam, params["exact_horizon"])
+        k = np.arange(params["horizon"] + 1)
+        enumerated = np.full(len(k), np.nan)
+        enumerated[:len(enum)] = enum
+        rel = np.abs(res.mean / enumerated - 1.0)
+        worst = max(worst, float(np.nanmax(rel)))
+        frames.append(pd.DataFrame({"lam": lam, "k": k, "mean_exact": res.mean,
+                                    "rel_error_bound": res.rel_error_bound, "mean_enumeration": enumerated,
+                                    "enumeration_rel_diff": rel}))
+    return {"table": pd.concat(frames, ignore_index=True),
+            "provenance": {"max_rel_diff_vs_enumeration": worst}}
+
+
+def stationary_mean_step(params, inputs, outputs):
+    """Step: lim E(p_k) for each lambda (exact bracket where pi_0 a^2 < 1), next to the limits of s_k, r_k and
+    the report's estimate."""
+    a, R1, R2, p0 = params["a"], params["R1"], params["R2"], params["Ep0"]
+    rows = []
+    for lam, label in _lambdas(params):
+        growth = (1.0 - lam) * a * a
+        s = lower_bound_sequence(p0, a, R1, lam, 2000)
+        r = upper_bound_sequence(p0, a, R1, R2, lam, 2000)
+        est = report_estimate_sequence(p0, s, r, a, R1, R2, lam)
+        row = {"lam": lam, "lam_label": label, "loss_growth": growth}
+        if growth < 1.0:
+            st = stationary_mean(a, R1, [R2], [lam], p0=p0)
+            row.update({"stationary_mean": st["mean"], "stationary_lo": st["lo"], "stationary_hi": st["hi"],
+                        "bracket_rel_width": (st["hi"] - st["lo"]) / st["mean"],
+                        "method": "exact (Chebyshev backward recursion, rigorous bracket)",
+                        "s_limit": R1 / (1.0 - growth), "r_limit": mare_fixed_point(a, R1, R2, lam),
+                        "report_estimate_limit": est[-1], "n_iter": st["n_iter"]})
+        else:
+            row.update({"stationary_mean": np.inf, "stationary_lo": np.inf, "stationary_hi": np.inf,
+                        "bracket_rel_width": np.nan,
+                        "method": "unbounded: E(p_k) >= s_k and (1 - lambda) a^2 >= 1",
+                        "s_limit": np.inf, "r_limit": np.inf, "report_estimate_limit": np.inf, "n_iter": 0})
+        rows.append(row)
+    return {"table": pd.DataFrame(rows)}
 
 
 def _scalar_simulator(params, lam):
@@ -81,22 +126,32 @@ def monte_carlo_shard_step(params, inputs, outputs):
 
 def monte_carlo_merge_step(params, inputs, outputs):
     """Step: merge the shards (in block order, so any shard count gives identical results) into the
-    plain and conditional Monte Carlo estimates of E(p_k) with 95% bands."""
+    plain and conditional Monte Carlo estimates of E(p_k) with 95% bands, and their z-scores against the
+    exact E(p_k) (a cross-check of the estimators)."""
     shards = [load_sums(path) for path in inputs["shards"]]
+    exact = read_table(inputs["exact"])
     frames = []
     for i, (lam, _) in enumerate(_lambdas(params)):
         mc = merge_block_sums(shard[f"lam{i}"] for shard in shards)
         cm, clo, chi = mc.ci("cond")
         pm, plo, phi = mc.ci("plain")
+        k = np.arange(params["horizon"] + 1)
+        ex = exact[np.isclose(exact["lam"], lam)].set_index("k")["mean_exact"].reindex(k).to_numpy()
+        cse = mc.std("cond") / np.sqrt(mc.n)
+        pse = mc.std("plain") / np.sqrt(mc.n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cz = np.where(cse > 0, (cm - ex) / cse, 0.0)
+            pz = np.where(pse > 0, (pm - ex) / pse, 0.0)
         frames.append(pd.DataFrame({
-            "lam": lam, "k": np.arange(params["horizon"] + 1), "cond_mean": cm, "cond_lo": clo, "cond_hi": chi,
+            "lam": lam, "k": k, "cond_mean": cm, "cond_lo": clo, "cond_hi": chi,
             "plain_mean": pm, "plain_lo": plo, "plain_hi": phi, "plain_max": mc.maximum("plain"), "n_paths": mc.n,
+            "exact_mean": ex, "cond_se": cse, "cond_z": cz, "plain_se": pse, "plain_z": pz,
         }))
     return {"table": pd.concat(frames, ignore_index=True)}
 
 
 def scalar_bounds_step(params, inputs, outputs):
-    """Step: the Figs 1-2 table (bounds, report estimate, true mean with its method)."""
+    """Step: the Figs 1-2 table (bounds, report estimate, exact E(p_k) at every k, the Monte Carlo cross-check)."""
     exact = read_table(inputs["exact"])
     mc = read_table(inputs["mc"])
     a, R1, R2, p0, T = params["a"], params["R1"], params["R2"], params["Ep0"], params["horizon"]
@@ -106,19 +161,17 @@ def scalar_bounds_step(params, inputs, outputs):
         r = upper_bound_sequence(p0, a, R1, R2, lam, T)
         est = report_estimate_sequence(p0, s, r, a, R1, R2, lam)
         est_printed = report_estimate_sequence(p0, s, r, a, R1, R2, lam, printed=True)
-        ex = exact[np.isclose(exact["lam"], lam)].set_index("k")["mean_exact"]
+        ex = exact[np.isclose(exact["lam"], lam)].set_index("k")
         m = mc[np.isclose(mc["lam"], lam)].set_index("k")
         k = np.arange(T + 1)
-        use_exact = np.isin(k, ex.index)
-        mean = np.where(use_exact, ex.reindex(k).to_numpy(), m["cond_mean"].reindex(k).to_numpy())
-        lo = np.where(use_exact, mean, m["cond_lo"].reindex(k).to_numpy())
-        hi = np.where(use_exact, mean, m["cond_hi"].reindex(k).to_numpy())
+        mean = ex["mean_exact"].reindex(k).to_numpy()
         frames.append(pd.DataFrame({
-            "lam": lam, "k": k, "s": s, "r": r, "report_estimate": est, "mean": mean, "mean_lo": lo, "mean_hi": hi,
-            "mean_method": np.where(use_exact, "exact enumeration", "conditional Monte Carlo"),
+            "lam": lam, "k": k, "s": s, "r": r, "report_estimate": est, "mean": mean, "mean_lo": mean,
+            "mean_hi": mean, "mean_method": "exact", "mean_rel_error_bound": ex["rel_error_bound"].reindex(k).to_numpy(),
             "lam_label": label, "report_estimate_printed": est_printed,
             "plain_mean": m["plain_mean"].reindex(k).to_numpy(), "plain_lo": m["plain_lo"].reindex(k).to_numpy(),
             "plain_hi": m["plain_hi"].reindex(k).to_numpy(),
+            "cond_mean": m["cond_mean"].reindex(k).to_numpy(), "cond_z": m["cond_z"].reindex(k).to_numpy(),
         }))
     return {"table": pd.concat(frames, ignore_index=True)}
 
@@ -144,7 +197,8 @@ def two_sensor_region_merge_step(params, inputs, outputs):
 
 
 def two_sensor_simulation_step(params, inputs, outputs):
-    """Step: E(p_k) with the two-sensor recursion (14) on both sides of the boundary at lambda1 = check_lambda1."""
+    """Step: E(p_k) of the two-sensor recursion (14) on both sides of the boundary at lambda1 = check_lambda1:
+    exact (exact.exact_mean) with the conditional Monte Carlo as a cross-check (z-scores)."""
     a, R1 = params["a"], params["R1"]
     var1, var2 = params["sigma2"]
     lam1 = params["check_lambda1"]
@@ -162,9 +216,17 @@ def two_sensor_simulation_step(params, inputs, outputs):
             return {"cond": conditional_mean_paths(paths, 1.0, a, R1, [var1, var2], [lam1, lam2])}
 
         mc = run_monte_carlo(simulate, params["check_paths"], params["block_size"], params["seed"] + i)
-        mean, lo, hi = mc.ci("cond")
+        mc_mean, mc_lo, mc_hi = mc.ci("cond")
+        mc_se = mc.std("cond") / np.sqrt(mc.n)
+        ex = exact_mean(1.0, a, R1, [var1, var2], [lam1, lam2], T)
+        growth = (1 - lam1) * (1 - lam2) * a * a
+        stationary = stationary_mean(a, R1, [var1, var2], [lam1, lam2], p0=1.0)["mean"] if growth < 1 else np.inf
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.where(mc_se > 0, (mc_mean - ex.mean) / mc_se, 0.0)
         frames.append(pd.DataFrame({
-            "lambda1": lam1, "lambda2": lam2, "side": side, "k": np.arange(T + 1), "mean": mean, "mean_lo": lo,
-            "mean_hi": hi, "predicted_growth": (1 - lam1) * (1 - lam2) * a * a,
+            "lambda1": lam1, "lambda2": lam2, "side": side, "k": np.arange(T + 1), "mean": ex.mean,
+            "mean_lo": ex.mean, "mean_hi": ex.mean, "predicted_growth": growth, "mean_method": "exact",
+            "mean_rel_error_bound": ex.rel_error_bound, "stationary_mean": stationary,
+            "mc_mean": mc_mean, "mc_lo": mc_lo, "mc_hi": mc_hi, "mc_z": z,
         }))
     return {"table": pd.concat(frames, ignore_index=True)}

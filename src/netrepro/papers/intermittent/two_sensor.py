@@ -51,14 +51,18 @@ def two_sensor_modes():
 def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5) -> list[dict]:
     """lambda2c_upper(lambda1) = inf{lambda2 : exists K, K1, K2, X > 0 with X > phi(K, K1, K2, X)} (eq. 16).
 
-    Feasibility of eq. (16) is decided by the LMI of
-    :class:`~netrepro.engines.lmi.MareStabilizabilityLMI` (one parametrised
-    problem for the whole sweep) and certified by the spectral radius of the
-    closed-loop second-moment operator; lambda2 is found by a bisection at each grid
-    point bracketed from the closed-form lower bound of that point (so sharding the grid
-    cannot change any answer, and a plain bisection would return the same lattice point).
-    The noise terms of phi do not affect feasibility (the condition is
-    homogeneous in X), so the bound depends on a and the C_i only.
+    Feasibility of eq. (16) is decided by the shared solve-and-certify path
+    (:meth:`~netrepro.engines.lmi.MareStabilizabilityLMI.certify`, one parametrised problem for the
+    whole sweep): ``feasible`` only when our own eigenvalue check of the returned point passes
+    (whatever the solver status), ``infeasible`` only with a certificate (a checked dual
+    certificate, or the necessary condition (1 - lambda1)(1 - lambda2) a^2 >= 1 computed without
+    the LMI), else ``undecided`` (never counted either way). lambda2 is found by
+    :func:`~netrepro.engines.certify.bisect_certified` at each grid point, started from the
+    closed-form lower bound of that point (a guess only: it changes the number of solves, never
+    the answer, so sharding the grid cannot change any answer). Both ends of each bracket are
+    certified; where lambda2 = 0 is already certified feasible (one sensor suffices), the
+    threshold is 0 and there is no infeasible end. The noise terms of phi do not affect
+    feasibility (the condition is homogeneous in X), so the bound depends on a and the C_i only.
 
     Parameters
     ----------
@@ -67,54 +71,57 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5) -> list[dict]:
     a : float
         System coefficient.
     tol : float
-        Bisection tolerance on lambda2.
+        Bisection lattice spacing on lambda2.
 
     Returns
     -------
     list of dict
-        One row per lambda1 with ``lambda1, lambda2c_upper, bracket_lower, n_solves,
-        status_at_threshold, certified_radius, statuses_seen`` (every solver status met in
-        the bisection).
+        One row per lambda1: ``lambda1, lambda2c_upper`` (the certified-feasible end),
+        ``bracket_lower`` (the certified-infeasible end, nan if lambda2 = 0 is feasible),
+        ``certified`` (the threshold is bracketed by certified ends, or is 0 with lambda2 = 0
+        certified feasible), ``upper_certified_by``, ``lower_certified_by`` (the evidence of each
+        end), ``upper_slack`` (smallest eigenvalue margin of the point at the feasible end),
+        ``n_solves``, ``n_undecided``, ``status_at_threshold`` (the solver's status at the feasible
+        end, information only) and ``statuses_seen`` (every solver status met).
     """
-    from ...engines.lmi import MareStabilizabilityLMI, bisect_bracketed  # cvxpy: only the steps that solve LMIs
+    from ...engines.certify import bisect_certified  # cvxpy: only the steps that solve LMIs
+    from ...engines.lmi import MareStabilizabilityLMI
 
     lmi = MareStabilizabilityLMI([[a]], two_sensor_modes())
     grid = np.asarray(lambda1_grid, dtype=float)
-    outcomes = {float(lam1): {} for lam1 in grid}
 
-    def make_predicate(lam1):
-        def feasible(lam2):
+    def make_decide(lam1):
+        def decide(lam2):
             _, weights = arrival_patterns([lam1, lam2])
-            out = lmi.solve(weights)
-            outcomes[float(lam1)][lam2] = out
-            return out.certified
+            return lmi.certify(weights)  # necessary condition: w_loss a^2 >= 1 (+1e-9) -> infeasible
 
-        return feasible
+        return decide
 
-    # each point's bisection starts from its own closed-form lower bound (a guess only: the LMI still
-    # decides both ends of the final bracket, and for a monotone predicate the answer is the plain
-    # bisection's, engines.lmi.bisect_bracketed); nothing depends on the neighbours, so no shard
-    # split can change an answer
     guesses = two_sensor_lower_bound(grid, a)
-    results = [bisect_bracketed(make_predicate(lam1), 0.0, 1.0, guess, 0.0, tol=tol)  # one lattice cell each side
-               for lam1, guess in zip(grid, guesses)]
     rows = []
-    for lam1, res in zip(grid, results):
-        seen_outcomes = outcomes[float(lam1)]
-        at = seen_outcomes.get(res.threshold)
-        seen = Counter(o.status for o in seen_outcomes.values()).most_common()
-        if at is None:  # nothing certified: say what the solver said at the feasible end of the bracket
-            end = seen_outcomes.get(1.0)
-            status = f"not certified at lambda2 = 1 ({end.status if end else 'not solved'})"
+    for lam1, guess in zip(grid, guesses):
+        br = bisect_certified(make_decide(lam1), 0.0, 1.0, tol=tol, feasible_above=True, guess=guess)
+        up = br.verdicts.get(br.feasible_end) if np.isfinite(br.feasible_end) else None
+        low = br.verdicts.get(br.infeasible_end) if np.isfinite(br.infeasible_end) else None
+        seen = Counter(v.solver_status for v in br.verdicts.values()).most_common()
+        at_zero = up is not None and br.feasible_end == 0.0
+        if up is None:  # nothing certified feasible: say what the solver said at the feasible end of the range
+            end = br.verdicts.get(1.0)
+            status = f"not certified at lambda2 = 1 ({end.solver_status if end else 'not solved'})"
         else:
-            status = at.status
+            status = up.solver_status
         rows.append({
             "lambda1": lam1,
-            "lambda2c_upper": res.threshold,
-            "bracket_lower": res.lower,
-            "n_solves": res.n_evals,
+            "lambda2c_upper": br.feasible_end,
+            "bracket_lower": br.infeasible_end,
+            "certified": bool(br.certified or at_zero),
+            "upper_certified_by": up.evidence if up else "none",
+            "lower_certified_by": (low.evidence if low else
+                                   "none needed: lambda2 = 0 is certified feasible" if at_zero else "none"),
+            "upper_slack": up.point.slack if up is not None and up.point is not None else np.nan,
+            "n_solves": br.n_evals,
+            "n_undecided": len(br.undecided),
             "status_at_threshold": status,
-            "certified_radius": at.certificate_value if at else np.nan,
             "statuses_seen": "; ".join(f"{k}: {v}" for k, v in seen),
         })
     return rows
