@@ -37,6 +37,9 @@ Benchmarks
 ``fisher_1bit``
     The expected 1-bit Fisher information (eq. (29)-(30) of the ``onebit`` paper) on a full SNR
     grid, vectorised against per-point adaptive quadrature, with their agreement.
+``onebit_grid_smoother``
+    The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
+    transition against the dense one (same estimates to rounding).
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
     rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
@@ -472,6 +475,29 @@ def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: in
     return rows, source
 
 
+def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]:
+    """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded sparse vs dense transition."""
+    from .papers.onebit.estimators import grid_smoother_at, simulate_block, state_grid
+    from .papers.onebit.model import sigma_z2_from_snr, stationary_variance
+
+    eps = 1e-3
+    s = float(sigma_z2_from_snr(0.0, eps))
+    _, _, r = simulate_block(np.random.default_rng(1), n_runs, horizon, eps, s, 1.0)
+    ev = np.arange(horizon // 2, horizon, 5)
+    t_band = median_time(lambda: grid_smoother_at(r, eps, s, 1.0, ev), repeats)
+    t_dense = median_time(lambda: grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None), max(1, repeats // 2))
+    fb, sb = grid_smoother_at(r, eps, s, 1.0, ev)
+    fd, sd_ = grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None)
+    diff = float(max(np.abs(fb - fd).max(), np.abs(sb - sd_).max()) / math.sqrt(float(stationary_variance(eps, s))))
+    steps = n_runs * horizon
+    n_grid = len(state_grid(eps, s))
+    return [
+        BenchRow("onebit_grid_smoother", f"run_steps_per_s_banded_vs_dense_{n_grid}pts", steps / t_band,
+                 steps / t_dense, t_dense / t_band, "run-steps/s"),
+        BenchRow("onebit_grid_smoother", "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf, "1"),
+    ]
+
+
 # ============================================================================ (d) pipeline
 _IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
                                  "*.egg-info", ".pytest_cache", ".hypothesis", "tmp")
@@ -639,9 +665,9 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 # ============================================================================ driver
 SIZES = {
     "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
-                 repeats=5, peak_size=2048),
+                 repeats=5, peak_size=2048, grid=(500, 400)),
     "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
-                  repeats=2, peak_size=256),
+                  repeats=2, peak_size=256, grid=(20, 60)),
 }
 
 
@@ -683,6 +709,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
         _progress("fisher: vectorised expected 1-bit Fisher information vs adaptive quadrature")
         fisher_rows, info["fisher_source"] = bench_fisher(*sizes["fisher"], reps)
         rows += fisher_rows
+    if want("grid"):
+        _progress("grid: onebit grid filter/smoother, banded vs dense transition")
+        rows += bench_grid_transition(*sizes["grid"], reps)
     if pipeline and not quick and want("pipeline"):
         _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
         pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
@@ -697,7 +726,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
     parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")
     parser.add_argument("--only", default=None,
-                        help="comma-separated subset of riccati,channels,lmi,fisher,pipeline")
+                        help="comma-separated subset of riccati,channels,lmi,fisher,grid,pipeline")
     parser.add_argument("--scratch", default=None, help="folder for the pipeline's scratch copy (default: tmp)")
     parser.add_argument("--keep-scratch", action="store_true", help="keep the pipeline's scratch copy")
     args = parser.parse_args(argv)
