@@ -41,7 +41,9 @@ def _lag():
 
 def _estimator_ratios():
     return pd.DataFrame([dict(alpha=0.999, snr_db=x, quantity=q, estimate_db=0.5, lo_db=0.3, hi_db=0.7, bound_db=1.0,
-                              n_runs=10) for q in ("rho_F", "rho_S", "rho_SL") for x in (-10.0, 0.0)])
+                              n_runs=10) for q in ("rho_F", "rho_S", "rho_SL") for x in (-10.0, 0.0)]
+                        + [dict(alpha=0.9, snr_db=x, quantity="rho_S", estimate_db=0.1, lo_db=0.0, hi_db=0.2, bound_db=0.1,
+                                n_runs=10) for x in (-10.0, 0.0)])
 
 
 @pytest.mark.parametrize("func,name,table,params", [

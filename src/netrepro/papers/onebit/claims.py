@@ -245,7 +245,12 @@ def claims_step(params, inputs, outputs):
       bool(thr["single_sign_change"].all() and (thr["one_minus_alpha_max"] > 0).all()), 0, "qualitative",
       note="largest 1 - alpha with rho_S > 0 dB (results/onebit/alpha_threshold.csv): " + ", ".join(
           f"{x:g} dB: {v:.3g} (alpha > {1 - v:.3f})" for x, v in thr["one_minus_alpha_max"].items())
-      + "; rho_S changes sign once along the scanned alphas at each SNR")
+      + "; rho_S changes sign once along the scanned alphas at each SNR. Achievable (grid smoother vs Kalman filter, "
+      "results/onebit/estimator_ratios.csv) at the lowest simulated SNR: " + "; ".join(
+          f"alpha = {a:g}: {g['estimate_db'].iloc[0]:.2f} dB [{g['lo_db'].iloc[0]:.2f}, {g['hi_db'].iloc[0]:.2f}] "
+          f"(bound {g['bound_db'].iloc[0]:.2f} dB)"
+          for a, g in est_ratios[(est_ratios["quantity"] == "rho_S")
+                                 & (est_ratios["snr_db"] == est_ratios["snr_db"].min())].groupby("alpha", sort=False)))
     return {"table": claims_frame(rows)}
 
 

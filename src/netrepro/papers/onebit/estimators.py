@@ -46,6 +46,13 @@ def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, 
         Transition noise variance.
     sigma_eta : float
         Measurement noise standard deviation.
+
+    Returns
+    -------
+    theta : ndarray (n_runs, horizon+1)
+        States, k = 0..K.
+    y, r : ndarray (n_runs, horizon)
+        Unquantized measurements (20) and their signs (28), k = 1..K, from one noise draw.
     """
     alpha = 1.0 - eps
     sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
