@@ -42,6 +42,9 @@ Benchmarks
     every k of the horizon) against the conditional Monte Carlo estimator it replaces, at the
     pipeline's sample size; the ratio is the time ratio, with the estimator's largest relative 95%
     half-width (what the exact method removes) and the exact method's error bound.
+``onebit_grid_smoother``
+    The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
+    transition against the dense one (same estimates to rounding).
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
     rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
@@ -507,6 +510,29 @@ def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: in
     return rows, source
 
 
+def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]:
+    """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded sparse vs dense transition."""
+    from .papers.onebit.estimators import grid_smoother_at, simulate_block, state_grid
+    from .papers.onebit.model import sigma_z2_from_snr, stationary_variance
+
+    eps = 1e-3
+    s = float(sigma_z2_from_snr(0.0, eps))
+    _, _, r = simulate_block(np.random.default_rng(1), n_runs, horizon, eps, s, 1.0)
+    ev = np.arange(horizon // 2, horizon, 5)
+    t_band = median_time(lambda: grid_smoother_at(r, eps, s, 1.0, ev), repeats)
+    t_dense = median_time(lambda: grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None), max(1, repeats // 2))
+    fb, sb = grid_smoother_at(r, eps, s, 1.0, ev)
+    fd, sd_ = grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None)
+    diff = float(max(np.abs(fb - fd).max(), np.abs(sb - sd_).max()) / math.sqrt(float(stationary_variance(eps, s))))
+    steps = n_runs * horizon
+    n_grid = len(state_grid(eps, s))
+    return [
+        BenchRow("onebit_grid_smoother", f"run_steps_per_s_banded_vs_dense_{n_grid}pts", steps / t_band,
+                 steps / t_dense, t_dense / t_band, "run-steps/s"),
+        BenchRow("onebit_grid_smoother", "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf, "1"),
+    ]
+
+
 # ============================================================================ (d) pipeline
 _IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
                                  "*.egg-info", ".pytest_cache", ".hypothesis", "tmp")
@@ -674,9 +700,9 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 # ============================================================================ driver
 SIZES = {
     "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
-                 repeats=5, peak_size=2048, exact_mean=(400000, 60)),
+                 repeats=5, peak_size=2048, exact_mean=(400000, 60), grid=(500, 400)),
     "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
-                  repeats=2, peak_size=256, exact_mean=(20000, 60)),
+                  repeats=2, peak_size=256, exact_mean=(20000, 60), grid=(20, 60)),
 }
 
 
@@ -721,6 +747,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
     if want("exact_mean"):
         _progress("exact_mean: exact E(p_k) vs the conditional Monte Carlo estimator")
         rows += bench_exact_mean(*sizes["exact_mean"], reps)
+    if want("grid"):
+        _progress("grid: onebit grid filter/smoother, banded vs dense transition")
+        rows += bench_grid_transition(*sizes["grid"], reps)
     if pipeline and not quick and want("pipeline"):
         _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
         pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
@@ -735,7 +764,7 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
     parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")
     parser.add_argument("--only", default=None,
-                        help="comma-separated subset of riccati,channels,lmi,fisher,exact_mean,pipeline")
+                        help="comma-separated subset of riccati,channels,lmi,fisher,exact_mean,grid,pipeline")
     parser.add_argument("--scratch", default=None, help="folder for the pipeline's scratch copy (default: tmp)")
     parser.add_argument("--keep-scratch", action="store_true", help="keep the pipeline's scratch copy")
     args = parser.parse_args(argv)

@@ -23,6 +23,7 @@ ONEBIT_KEYS = {
         "snr_definition",
     ),
     "estimator": ("estimator", "sigma_eta", "snr_definition"),
+    "alpha_scan": ("alpha_scan", "sigma_eta", "snr_definition"),
     "vector_check": ("vector_check",),
     "errata": ("vector_check", "sigma_theta0"),
     "reconstructions": (
@@ -125,7 +126,7 @@ rule onebit_estimator_shard:
     input:
         code=code("netrepro.papers.onebit.steps:estimator_shard_step"),
     output:
-        sums="results/onebit/shards/estimator_{shard}.npz",
+        runs="results/onebit/shards/estimator_{shard}.npz",
     log:
         "logs/onebit/estimator_{shard}.log",
     wildcard_constraints:
@@ -152,9 +153,11 @@ rule onebit_estimator_shard:
 rule onebit_estimator:
     input:
         code=code("netrepro.papers.onebit.steps:estimator_step"),
-        shards=expand(rules.onebit_estimator_shard.output.sums, shard=range(ONEBIT_SHARDS)),
+        shards=expand(rules.onebit_estimator_shard.output.runs, shard=range(ONEBIT_SHARDS)),
     output:
         table="results/onebit/estimator_mse.csv",
+        ratios="results/onebit/estimator_ratios.csv",
+        crossing="results/onebit/estimator_crossing.csv",
     log:
         "logs/onebit/estimator.log",
     localrule: True
@@ -169,6 +172,27 @@ rule onebit_estimator:
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:estimator_step")
+
+
+rule onebit_alpha_scan:
+    input:
+        code=code("netrepro.papers.onebit.steps:alpha_scan_step"),
+    output:
+        table="results/onebit/alpha_scan.csv",
+        threshold="results/onebit/alpha_threshold.csv",
+    log:
+        "logs/onebit/alpha_scan.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    params:
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["alpha_scan"])),
+        io=io_json,
+    shell:
+        step("netrepro.papers.onebit.steps:alpha_scan_step")
 
 
 rule onebit_vector_check:
@@ -239,6 +263,9 @@ rule onebit_claims:
         lag=rules.onebit_lag.output.table,
         efq=rules.onebit_efq.output.table,
         estimator=rules.onebit_estimator.output.table,
+        estimator_ratios=rules.onebit_estimator.output.ratios,
+        crossing=rules.onebit_estimator.output.crossing,
+        alpha_threshold=rules.onebit_alpha_scan.output.threshold,
     output:
         table="results/claims/onebit.csv",
     log:
@@ -266,4 +293,8 @@ if enabled("onebit"):
         rules.onebit_convergence.output.transient,
         rules.onebit_estimator.output.table,
         rules.onebit_vector_check.output.table,
+        rules.onebit_estimator.output.ratios,
+        rules.onebit_estimator.output.crossing,
+        rules.onebit_alpha_scan.output.table,
+        rules.onebit_alpha_scan.output.threshold,
     ]

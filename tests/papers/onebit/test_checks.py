@@ -22,8 +22,8 @@ def cfg():
 def test_check_config_rejects_bad_sections(cfg):
     checks.check_config(cfg)
     bad = copy.deepcopy(cfg)
-    bad["estimator"]["window"] = [50, 10]
-    with pytest.raises(ConfigError, match="window"):
+    bad["estimator"]["snr_db"] = [0.0, -10.0]
+    with pytest.raises(ConfigError, match="estimator.snr_db"):
         checks.check_config(bad)
     bad = copy.deepcopy(cfg)
     bad["vector_check"]["Q"] = [[1.0, 2.0], [2.0, 1.0]]
@@ -46,3 +46,16 @@ def test_config_sections_validate(name):
     schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents
     jsonschema.Draft202012Validator(schema).validate(section)
     checks.check_config(section)
+
+
+def test_schema_requires_five_time_constants_before_the_window(cfg):
+    import jsonschema
+
+    from netrepro.config import load_schemas
+
+    _, registry = load_schemas()
+    schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents
+    bad = copy.deepcopy(cfg)
+    bad["estimator"]["burn_in_taus"] = 4.0
+    with pytest.raises(jsonschema.ValidationError, match="burn_in_taus|4.0"):
+        jsonschema.Draft202012Validator(schema).validate(bad)

@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from netrepro.papers.onebit import estimators
 from netrepro.papers.onebit import model
@@ -29,3 +30,90 @@ def test_grid_filter_reproduces_kalman_on_unquantized_data():
     sd = math.sqrt(float(model.stationary_variance(eps, s)))
     assert np.max(np.abs(filt - kf)) < 1e-6 * sd
     assert np.max(np.abs(smooth - rts)) < 1e-6 * sd
+
+
+def _kalman_rts_means(y, a, s, r_var, P0):
+    """Textbook scalar Kalman filter and RTS smoother (independent of the module)."""
+    n, K = y.shape
+    mf, Pf = np.zeros((n, K + 1)), np.zeros(K + 1)
+    mp, Pp = np.zeros((n, K + 1)), np.zeros(K + 1)
+    Pf[0] = P0
+    for k in range(1, K + 1):
+        mp[:, k], Pp[k] = a * mf[:, k - 1], a * a * Pf[k - 1] + s
+        G = Pp[k] / (Pp[k] + r_var)
+        mf[:, k], Pf[k] = mp[:, k] + G * (y[:, k - 1] - mp[:, k]), (1 - G) * Pp[k]
+    ms = mf.copy()
+    for k in range(K - 1, -1, -1):
+        C = Pf[k] * a / Pp[k + 1]
+        ms[:, k] = mf[:, k] + C * (ms[:, k + 1] - mp[:, k + 1])
+    return mf, ms
+
+
+@pytest.mark.parametrize("snr_db", [-20.0, 0.0, 10.0])
+def test_banded_grid_smoother_equals_kalman_rts_on_unquantized_data(snr_db):
+    """The estimator of issue 17 (banded transition, evaluation steps only) in the unquantized case = Kalman/RTS."""
+    eps = 1e-3
+    s = float(model.sigma_z2_from_snr(snr_db, eps))
+    theta, y, r = estimators.simulate_block(np.random.default_rng(2), 30, 300, eps, s, 1.0)
+    ev = np.arange(40, 300, 7)
+    filt, smooth = estimators.grid_smoother_at(y, eps, s, 1.0, ev, quantized=False)
+    kf, rts = _kalman_rts_means(y, 1 - eps, s, 1.0, s / (eps * (2 - eps)))
+    sd = math.sqrt(s / (eps * (2 - eps)))
+    assert np.max(np.abs(filt - kf[:, ev])) < 1e-6 * sd
+    assert np.max(np.abs(smooth - rts[:, ev])) < 1e-6 * sd
+
+
+def test_banded_transition_equals_dense_on_one_bit_data():
+    eps = 1e-3
+    s = float(model.sigma_z2_from_snr(5.0, eps))
+    _, _, r = estimators.simulate_block(np.random.default_rng(4), 10, 200, eps, s, 1.0)
+    ev = np.arange(0, 201, 10)
+    fb, sb = estimators.grid_smoother_at(r, eps, s, 1.0, ev)
+    fd, sd_ = estimators.grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None)
+    assert np.max(np.abs(fb - fd)) < 1e-10 and np.max(np.abs(sb - sd_)) < 1e-10
+    # a finer and wider grid changes the estimates by far less than their errors (the grid has converged)
+    ff, sf = estimators.grid_smoother_at(r, eps, s, 1.0, ev, grid_half_width=7.0, points_per_sigma_z=2.0)
+    assert np.max(np.abs(sf - sb)) < 1e-5 and np.max(np.abs(ff - fb)) < 1e-5
+
+
+def test_banded_transition_rows_are_gaussian_moments():
+    eps, s = 1e-3, 2e-3
+    x = estimators.state_grid(eps, s, 6.0, 1.0)
+    T = estimators.transition_matrix(x, 1 - eps, math.sqrt(s), 8.0)
+    assert T.nnz < 20 * len(x)                                        # banded: ~2 * 8 * 1 + 1 entries per row
+    T = T.toarray()
+    np.testing.assert_allclose(T.sum(axis=1), 1.0, rtol=1e-14)
+    inner = np.abs(x) < 5.0 * math.sqrt(s / (eps * (2 - eps)))
+    mean = T @ x
+    var = T @ x**2 - mean**2
+    np.testing.assert_allclose(mean[inner], (1 - eps) * x[inner], atol=1e-9 * math.sqrt(s))   # (21): E = alpha x
+    # Var = sigma_z^2 up to the aliasing of sampling a Gaussian at spacing h = sigma_z / p (Poisson summation:
+    # leading relative term 4 pi^2 p^2 exp(-2 pi^2 p^2) times 2 cos(.); we allow twice that)
+    p = 1.0
+    np.testing.assert_allclose(var[inner], s, rtol=8 * math.pi**2 * p**2 * math.exp(-2 * math.pi**2 * p**2))
+    with pytest.raises(ValueError, match="uniform"):
+        estimators.transition_matrix(np.array([0.0, 1.0, 3.0]), 0.9, 1.0, 8.0)
+
+
+def test_paired_bootstrap_collapses_for_proportional_runs_and_is_narrower_than_unpaired():
+    rng = np.random.default_rng(0)
+    common = rng.exponential(1.0, 500)
+    a = 2.0 * common
+    est, lo, hi = estimators.paired_ratio_interval(a, common, 500, 1)
+    assert est == pytest.approx(10 * math.log10(2.0), abs=1e-12)
+    assert lo == pytest.approx(est, abs=1e-9) and hi == pytest.approx(est, abs=1e-9)   # same runs resampled together
+    b = common * rng.uniform(0.9, 1.1, 500)
+    est, lo, hi = estimators.paired_ratio_interval(b, common, 2000, 2)
+    # independent resampling of the two arms (what an unpaired design would give) is much wider
+    i1, i2 = rng.integers(0, 500, (2, 2000, 500))
+    unpaired = 10 * np.log10(b[i1].mean(axis=1) / common[i2].mean(axis=1))
+    assert (hi - lo) < 0.3 * np.subtract(*np.percentile(unpaired, [97.5, 2.5]))
+    # against the delta method for the log of a ratio of paired means
+    d = b / b.mean() - common / common.mean()
+    half = 1.959964 * (10 / math.log(10)) * d.std(ddof=1) / math.sqrt(500)
+    assert (hi - lo) / 2 == pytest.approx(half, rel=0.15)
+
+
+def test_db_zero_crossing_linear():
+    assert estimators.db_zero_crossing([0.0, 1.0, 2.0], [2.0, 1.0, -1.0]) == pytest.approx(1.5)
+    assert math.isnan(estimators.db_zero_crossing([0.0, 1.0], [1.0, 2.0]))

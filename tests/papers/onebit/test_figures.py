@@ -35,7 +35,15 @@ def _transient():
 
 
 def _lag():
-    return pd.DataFrame(dict(alpha=[0.999, 0.999], snr_db=[-10.0, 0.0], delta_needed=[10, 30], tol_db=0.01))
+    return pd.DataFrame(dict(alpha=[0.999, 0.999], snr_db=[-10.0, 0.0], delta_needed=[10, 30], tol_db=0.01,
+                             delta_break_even=[5.0, np.nan]))
+
+
+def _estimator_ratios():
+    return pd.DataFrame([dict(alpha=0.999, snr_db=x, quantity=q, estimate_db=0.5, lo_db=0.3, hi_db=0.7, bound_db=1.0,
+                              n_runs=10) for q in ("rho_F", "rho_S", "rho_SL") for x in (-10.0, 0.0)]
+                        + [dict(alpha=0.9, snr_db=x, quantity="rho_S", estimate_db=0.1, lo_db=0.0, hi_db=0.2, bound_db=0.1,
+                                n_runs=10) for x in (-10.0, 0.0)])
 
 
 @pytest.mark.parametrize("func,name,table,params", [
@@ -44,6 +52,7 @@ def _lag():
     ("figure_estimator", "estimator", _estimator, {}),
     ("figure_convergence", "transient", _transient, {}),
     ("figure_lag", "lag", _lag, {}),
+    ("figure_estimator_ratios", "ratios", _estimator_ratios, {}),
 ])
 def test_every_figure_is_written(tmp_path, func, name, table, params):
     path = tmp_path / f"{name}.csv"

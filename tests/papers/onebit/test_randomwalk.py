@@ -112,3 +112,72 @@ def test_compiled_bim_steps_equal_numpy_loop_and_general_recursion_7():
         s = s2[lane]
         general = model.filtering_bims(j0[lane], a2 / s, -a / s, 1.0 / s, F[:, lane].reshape(-1, 1, 1), len(F))
         assert np.allclose(general[1:, 0, 0], J[:, lane], rtol=1e-12)
+
+
+def _break_even_by_hand(F, eps, s, max_steps=100_000):
+    """J_{k|k,q} + kappa_Delta > J_{k|k,inf}: long iterations of the printed (24) and (27), no module helper."""
+    a = 1 - eps
+    jq = ji = 1.0
+    for _ in range(200_000):
+        jq = 1 / s + F - (a / s) ** 2 / (jq + a * a / s)
+        ji = 1 / s + 1.0 - (a / s) ** 2 / (ji + a * a / s)
+    kap = 0.0
+    for n in range(1, max_steps + 1):
+        kap = a * a / s - (a / s) ** 2 / (1 / s + F + kap)
+        if jq + kap > ji:
+            return n
+    return -1
+
+
+@pytest.mark.parametrize("eps", [1e-2, 1e-3])
+def test_break_even_lag_against_direct_iteration(eps):
+    snr_db = np.array([-30.0, -20.0, -10.0, -3.0, 0.0, 4.0, 10.0, 20.0])
+    s = model.sigma_z2_from_snr(snr_db, eps)
+    Fq = fisher.expected_fisher_1bit(model.stationary_variance(eps, s))
+    closed = randomwalk.rw_break_even_lag(Fq, 1.0, eps, s)
+    np.testing.assert_array_equal(closed, randomwalk.rw_break_even_iterated(Fq, 1.0, eps, s))
+    for i in range(len(s)):
+        assert closed[i] == _break_even_by_hand(float(Fq[i]), eps, float(s[i])), snr_db[i]
+    # it exists exactly where rho_S > 0 dB (49)
+    rho_s = randomwalk.information_ratios(snr_db, eps)["rho_s_db"]
+    np.testing.assert_array_equal(closed < 0, rho_s <= 0)
+
+
+def test_filter_time_constant_from_dare_gain():
+    eps, s, F = 1e-3, 2e-4, 0.6
+    a = 1 - eps
+    M = linalg.solve_discrete_are(np.array([[a]]), np.array([[1.0]]), np.array([[s]]), np.array([[1 / F]]))[0, 0]
+    G = M * F / (1 + M * F)                         # steady-state Kalman gain with noise variance 1/F
+    assert float(randomwalk.rw_filter_time_constant(F, eps, s)) == pytest.approx(-1 / math.log(a * (1 - G)), rel=1e-8)
+
+
+def test_bound_paths_and_design_are_in_steady_state_inside_the_window():
+    eps, s = 1e-3, float(model.sigma_z2_from_snr(0.0, 1e-3))
+    Fq = float(fisher.expected_fisher_1bit(model.stationary_variance(eps, s)))
+    d = randomwalk.estimator_design((Fq, 1.0), eps, s, 5.0, 3.0, 5.0, 4.0)
+    assert d["start"] >= 5 * d["tau"] and d["horizon"] - d["stop"] >= 5 * d["tau"]
+    assert np.all((d["eval_idx"] >= d["start"]) & (d["eval_idx"] < d["stop"]))
+    v = float(model.stationary_variance(eps, s))
+    for F in (Fq, 1.0):
+        Jf, Js = randomwalk.bound_paths(F, eps, s, v, d["horizon"])
+        jf = float(randomwalk.rw_filtering_fixed_point(F, eps, s))
+        js = jf + float(randomwalk.rw_smoothing_gain_fixed_point(F, eps, s))
+        ev = d["eval_idx"]
+        assert np.max(np.abs(Jf[ev] / jf - 1)) < 1e-3 and np.max(np.abs(Js[ev] / js - 1)) < 1e-3
+        assert abs(Jf[1] / jf - 1) > 1e-2          # while the start of the record is not
+    # J_s over the record = RTS smoothing variances (covariance form, another algorithm)
+    _, _, Ps = model.kalman_covariances(np.array([[1 - eps]]), np.array([[s]]), np.array([[1.0]]), np.array([[1.0]]),
+                                        np.array([[v]]), 200)
+    _, Js = randomwalk.bound_paths(1.0, eps, s, v, 200)
+    np.testing.assert_allclose(1 / Js, Ps[:, 0, 0], rtol=1e-10)
+
+
+def test_rho_s_crossings_and_alpha_threshold():
+    near_limit = randomwalk.rho_s_zero_crossing(1e-9)
+    assert near_limit == pytest.approx(fisher.rho_s_zero_crossing_limit(), abs=0.05)   # alpha -> 1: E[F_q] = 1/4
+    x = randomwalk.rho_s_zero_crossing(1e-3)
+    r = randomwalk.information_ratios(np.array([x - 1e-3, x + 1e-3]), 1e-3)["rho_s_db"]
+    assert r[0] > 0 >= r[1]
+    e = randomwalk.rho_s_threshold_eps(-20.0)
+    r = [float(randomwalk.information_ratios(np.array([-20.0]), v)["rho_s_db"][0]) for v in (e * 0.999, e * 1.001)]
+    assert r[0] > 0 >= r[1]

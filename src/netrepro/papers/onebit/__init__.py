@@ -20,3 +20,5 @@ Modules
 ``steps``, ``claims``, ``figures``, ``checks``
     Pipeline steps, the paper's claims/errata/reconstructions, plotting, configuration checks.
 """
+
+__all__: list[str] = []

@@ -22,10 +22,9 @@ def check_config(section: dict) -> None:
             raise ConfigError(f"config key 'onebit.convergence.{key}' = {conv[key]!r} needs one entry per "
                               f"onebit.one_minus_alpha ({len(section['one_minus_alpha'])})")
     est = section["estimator"]
-    w0, w1 = est["window"]
-    if not 0 <= w0 < w1 <= est["horizon"]:
-        raise ConfigError(f"config key 'onebit.estimator.window' = {est['window']!r}: expected "
-                          f"0 <= start < stop <= horizon ({est['horizon']})")
+    if any(b <= a for a, b in zip(est["snr_db"], est["snr_db"][1:])):
+        raise ConfigError(f"config key 'onebit.estimator.snr_db' = {est['snr_db']!r} must be strictly increasing "
+                          "(the 0 dB crossing is interpolated along it)")
     vec = section["vector_check"]
     A = require_matrix("onebit.vector_check.A", vec["A"], square=True)
     n = A.shape[0]

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from scipy.special import ndtri
 
 from ...claims import claim_row, claims_frame, errata_frame, reconstructions_frame
 from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
@@ -118,13 +119,20 @@ def reconstructions_step(params, inputs, outputs):
         dict(key="snr_grid_db", value=f"{params['snr_grid_db']}",
              reason="Figure axes are lost in extraction; -30..20 dB covers the low-SNR asymptote and the high-SNR loss.",
              sensitivity="none (pointwise values)"),
-        dict(key="estimator", value=f"grid filter/smoother, alpha = 1 - {est['one_minus_alpha']:g}, "
-                                    f"SNR {est['snr_db']} dB, {est['n_runs']} runs, K = {est['horizon']}, "
-                                    f"window {est['window']}",
-             reason="Beyond the paper: an (almost exact) MMSE estimator for comparison with the bound. alpha is "
-                    "further from 1 than in the figures so that runs are short (time constants ~1/sqrt(E[F_q] "
-                    "sigma_z^2)) and the grid (spacing sigma_z/points_per_sigma_z over +-6 sigma_theta_inf) is small.",
-             sensitivity="MSE/bound ratios are reported with 95% confidence intervals over runs"),
+        dict(key="estimator", value=f"banded grid filter/smoother (1-bit) and Kalman/RTS (unquantized) on the same "
+                                    f"paths and noise, 1 - alpha in {est['one_minus_alpha']}, SNR {est['snr_db']} dB, "
+                                    f"{est['n_runs']} runs, window after {est['burn_in_taus']:g} filter time constants, "
+                                    f"{est['window_taus']:g} long, record {est['tail_taus']:g} beyond it",
+             reason="Beyond the paper (issue 17): an almost exact MMSE estimator in the paper's regime. The grid "
+                    f"(spacing sigma_z/{est['points_per_sigma_z']:g} over +-{est['grid_half_width']:g} sigma_theta_inf, "
+                    f"transition kept within {est['band_sigmas']:g} sigma_z: sparse) is a point-mass approximation of the "
+                    "exact Bayesian recursions; a particle smoother would add Monte Carlo error and cost O(N^2) per "
+                    "step for backward smoothing. Per SNR the record length follows the slowest filter time constant "
+                    "tau = -1/ln(alpha/(1 + M F)) (columns tau, window_start, horizon; steady_dev = distance of the "
+                    "finite-record bound from its steady state over the window). alpha = 1 - 1e-5 is not simulated: "
+                    "its grid is 10x larger and its time constants 10x longer (~100x the cost).",
+             sensitivity="grid spacing sigma_z/2 and +-7 sigma_theta_inf change the per-run MSEs by < 1e-6 relative; "
+                         "dense vs banded transition by < 1e-12 (tests); intervals: paired bootstrap over runs"),
     ]
     return {"table": reconstructions_frame([dict(r, paper=PAPER) for r in rows])}
 
@@ -136,6 +144,9 @@ def claims_step(params, inputs, outputs):
     lag = pd.read_csv(inputs["lag"])
     efq = pd.read_csv(inputs["efq"])
     est = pd.read_csv(inputs["estimator"])
+    est_ratios = pd.read_csv(inputs["estimator_ratios"])
+    crossing = pd.read_csv(inputs["crossing"])
+    alpha_thr = pd.read_csv(inputs["alpha_threshold"])
     eps5 = params["fig1_one_minus_alpha"]
     a5 = 1.0 - eps5
     lo = rat["snr_db"].min()
@@ -189,14 +200,57 @@ def claims_step(params, inputs, outputs):
       "the paper states an integer number of dB; the limit 10 log10(2 sqrt(2/pi)) = 2.03 dB is exact, so we hold it to 0.05",
       note=f"alpha -> 1 at SNR = {lo:g} dB; at alpha = 1 - {eps5:g} the maximum over SNR is "
            f"{r5['rho_s_db'].max():.3f} dB (at {_idxmax(r5['rho_s_db']):g} dB): 2 dB holds only in the limit")
-    # beyond-the-paper sanity claim: the bound is a bound (estimator MSE >= bound within CI)
-    ok = bool((est["mse_hi"] >= est["bound"] * (1 - 1e-9)).all())
-    C("bound_below_mse", "BCRB (6)/(15) lies below the MSE of a near-optimal estimator (our check)", True, ok, 0,
-      "qualitative", note="grid filter/smoother on 1-bit data and Kalman/RTS on unquantized data; upper 95% CI >= bound")
-    lagmax = int(lag.loc[np.isclose(lag["alpha"], a5, rtol=0, atol=1e-15), "delta_needed"].max())
-    C("lag_finite", f"A finite smoothing delay Delta reaches the asymptotic gain (alpha = 1 - {eps5:g}, 0.01 dB)", True,
-      bool(lagmax < np.iinfo(np.int64).max), 0, "qualitative",
-      note=f"largest Delta on the grid: {lagmax} blocks (results/onebit/lag.csv)")
+    # beyond the paper: the bound is a bound. Kalman/RTS meet it exactly in expectation, so 2.5 % of plain 95 %
+    # intervals would fall below it by chance; the family of all rows is tested at 5 % (Bonferroni, one-sided).
+    m_rows = len(est)
+    z_family = float(ndtri(1.0 - 0.05 / m_rows))
+    se = (est["mse_hi"] - est["mse"]) / float(ndtri(0.975))
+    zs = (est["bound"] - est["mse"]) / se
+    worst = est.loc[zs.idxmax()]
+    C("bound_below_mse", "BCRB (6)/(15) lies below the MSE of a near-optimal estimator (our check)", True,
+      bool((zs <= z_family).all()), 0, "qualitative",
+      note=f"grid filter/smoother on 1-bit data and Kalman/RTS on unquantized data (alpha = {est['alpha'].iloc[0]:g}, "
+           f"{m_rows} estimator x SNR rows, {int(est['n_runs'].min())} runs each): no row's MSE lies below its bound by "
+           f"more than z = {z_family:.2f} standard errors (5 % family-wise, one-sided, Bonferroni; Kalman/RTS meet "
+           f"the bound exactly in expectation). Largest z = {zs.max():.2f} ({worst['kind']}, {worst['snr_db']:g} dB)")
+    # beyond the paper (issue 17): the break-even lag replaces "a finite lag reaches the asymptotic gain"
+    be5 = lag[np.isclose(lag["alpha"], a5, rtol=0, atol=1e-15)].set_index("snr_db")["delta_break_even"]
+    low = be5.loc[:0.0]
+    lag_notes = []
+    for alpha, g in lag.groupby("alpha"):
+        g = g.set_index("snr_db")["delta_break_even"]
+        lag_notes.append(f"alpha = {alpha:g}: " + ", ".join(
+            f"{x:g} dB: {'never' if np.isnan(g.get(x, np.nan)) else int(g[x])}" for x in (-30.0, -20.0, -10.0, 0.0, 10.0)))
+    C("break_even_lag", f"'The quantization loss can be completely compensated by smoothing' (Sec. 6): a finite lag "
+      f"Delta gives J_{{k|k+Delta,q}} > J_{{k|k,inf}} for every SNR <= 0 dB (alpha = 1 - {eps5:g})", True,
+      bool(low.notna().all()), 0, "qualitative",
+      note="smallest such Delta (results/onebit/lag.csv, delta_break_even; empty where the 1-bit smoother never "
+           "reaches the unquantized filter): " + "; ".join(lag_notes))
+    # beyond the paper (issue 17): a real 1-bit smoother against the real Kalman filter
+    rs = est_ratios[est_ratios["quantity"] == "rho_S"]
+    a_est = float(rs["alpha"].iloc[0])
+    rs = rs[np.isclose(rs["alpha"], a_est, rtol=0, atol=1e-15)].set_index("snr_db")
+    cr = crossing[np.isclose(crossing["alpha"], a_est, rtol=0, atol=1e-15)].set_index("curve")["snr_db_crossing"]
+    lowest = rs.index.min()
+    C("achievable_rho_s_positive", f"(our check) a real 1-bit smoother beats the unquantized Kalman filter at low SNR: "
+      f"rho_S from the MSEs > 0 dB with 95 % confidence for every simulated SNR <= 0 dB (alpha = {a_est:g})", True,
+      bool((rs.loc[:0.0, "lo_db"] > 0).all()), 0, "qualitative",
+      note=f"rho_S = MSE(Kalman filter)/MSE(1-bit grid smoother), paired bootstrap: {rs.loc[lowest, 'estimate_db']:.2f} dB "
+           f"[{rs.loc[lowest, 'lo_db']:.2f}, {rs.loc[lowest, 'hi_db']:.2f}] at {lowest:g} dB (bound "
+           f"{rs.loc[lowest, 'bound_db']:.2f} dB). The achievable rho_S crosses 0 dB at {cr['estimate']:.2f} dB "
+           f"(pointwise-interval curves: {cr['lo']:.2f} to {cr['hi']:.2f} dB), the bound at {cr['bound']:.2f} dB: above "
+           f"about 0 dB the 1-bit MSE leaves the bound (results/onebit/estimator_mse.csv)")
+    thr = alpha_thr.set_index("snr_db")
+    C("rho_s_alpha_close_to_one", "rho_S > 0 'for alpha close to one' (Fig 2, Sec. 5): how close, at low SNR", True,
+      bool(thr["single_sign_change"].all() and (thr["one_minus_alpha_max"] > 0).all()), 0, "qualitative",
+      note="largest 1 - alpha with rho_S > 0 dB (results/onebit/alpha_threshold.csv): " + ", ".join(
+          f"{x:g} dB: {v:.3g} (alpha > {1 - v:.3f})" for x, v in thr["one_minus_alpha_max"].items())
+      + "; rho_S changes sign once along the scanned alphas at each SNR. Achievable (grid smoother vs Kalman filter, "
+      "results/onebit/estimator_ratios.csv) at the lowest simulated SNR: " + "; ".join(
+          f"alpha = {a:g}: {g['estimate_db'].iloc[0]:.2f} dB [{g['lo_db'].iloc[0]:.2f}, {g['hi_db'].iloc[0]:.2f}] "
+          f"(bound {g['bound_db'].iloc[0]:.2f} dB)"
+          for a, g in est_ratios[(est_ratios["quantity"] == "rho_S")
+                                 & (est_ratios["snr_db"] == est_ratios["snr_db"].min())].groupby("alpha", sort=False)))
     return {"table": claims_frame(rows)}
 
 

@@ -9,11 +9,23 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import sparse
 from scipy.special import ndtr
 
+from ...errors import InputError
 from .model import stationary_variance
 
-__all__ = ["simulate_block", "grid_filter_smoother", "kalman_rts"]
+__all__ = [
+    "simulate_block",
+    "grid_filter_smoother",
+    "kalman_rts",
+    "state_grid",
+    "transition_matrix",
+    "grid_smoother_at",
+    "window_mse",
+    "paired_ratio_interval",
+    "db_zero_crossing",
+]
 
 
 def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, sigma_eta: float):
@@ -34,6 +46,13 @@ def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, 
         Transition noise variance.
     sigma_eta : float
         Measurement noise standard deviation.
+
+    Returns
+    -------
+    theta : ndarray (n_runs, horizon+1)
+        States, k = 0..K.
+    y, r : ndarray (n_runs, horizon)
+        Unquantized measurements (20) and their signs (28), k = 1..K, from one noise draw.
     """
     alpha = 1.0 - eps
     sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
@@ -64,45 +83,29 @@ def grid_filter_smoother(r, eps: float, sigma_z2: float, sigma_eta: float, grid_
         1-bit measurements (+-1) at k = 1..K, or, with ``quantized=False``,
         unquantized measurements (20) (Gaussian likelihood; the grid then
         reproduces the Kalman filter / RTS smoother, which tests the grid).
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float
+        Transition noise variance.
+    sigma_eta : float
+        Measurement noise standard deviation.
+    grid_half_width, points_per_sigma_z : float
+        Grid, see :func:`state_grid`.
+    quantized : bool
+        1-bit (28) or Gaussian (20) likelihood.
 
     Returns
     -------
     filt, smooth : ndarray (n_runs, K+1)
         Estimates for k = 0..K (k = 0: prior mean, smoothed).
+
+    Notes
+    -----
+    :func:`grid_smoother_at` at every step with the dense transition (small problems, tests).
     """
-    alpha = 1.0 - eps
-    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
-    sz = math.sqrt(sigma_z2)
-    n_half = int(math.ceil(grid_half_width * sd_inf / (sz / points_per_sigma_z)))
-    x = np.linspace(-grid_half_width * sd_inf, grid_half_width * sd_inf, 2 * n_half + 1)
-    # T[j, i] = p(theta_k = x_i | theta_{k-1} = x_j), rows normalised
-    T = np.exp(-0.5 * ((x[None, :] - alpha * x[:, None]) / sz) ** 2)
-    T /= T.sum(axis=1, keepdims=True)
-    lik_pos = ndtr(x / sigma_eta)
-
-    def likelihood(k):
-        if quantized:
-            return np.where(r[:, k : k + 1] > 0, lik_pos, 1.0 - lik_pos)
-        return np.exp(-0.5 * ((r[:, k : k + 1] - x) / sigma_eta) ** 2)
-
-    n, K = r.shape
-    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
-    prior /= prior.sum()
-    post = np.empty((n, K + 1, len(x)))
-    post[:, 0] = prior
-    for k in range(K):
-        p = (post[:, k] @ T) * likelihood(k)
-        post[:, k + 1] = p / p.sum(axis=1, keepdims=True)
-    filt = post @ x
-    beta = np.ones((n, len(x)))
-    smooth = np.empty((n, K + 1))
-    smooth[:, K] = filt[:, K]
-    for k in range(K, 0, -1):
-        beta = (beta * likelihood(k - 1)) @ T.T
-        beta /= beta.sum(axis=1, keepdims=True)
-        g = post[:, k - 1] * beta
-        smooth[:, k - 1] = (g @ x) / g.sum(axis=1)
-    return filt, smooth
+    K = np.asarray(r).shape[1]
+    return grid_smoother_at(r, eps, sigma_z2, sigma_eta, np.arange(K + 1), grid_half_width, points_per_sigma_z,
+                            band_sigmas=None, quantized=quantized)
 
 
 def kalman_rts(y, eps, sigma_z2, sigma_eta):
@@ -141,3 +144,247 @@ def kalman_rts(y, eps, sigma_z2, sigma_eta):
         ms[:, k] = mf[:, k] + C * (ms[:, k + 1] - mp[:, k + 1])
     return mf, ms
 
+
+
+# ============================================================================ banded grid smoother (issue 17)
+def state_grid(eps: float, sigma_z2: float, grid_half_width: float = 6.0, points_per_sigma_z: float = 1.0):
+    r"""The uniform grid of the point-mass filter: ``grid_half_width`` stationary standard deviations (33).
+
+    Parameters
+    ----------
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float
+        Transition noise variance of (21).
+    grid_half_width : float
+        Half width in units of :math:`\sigma_{\theta,\infty}`.
+    points_per_sigma_z : float
+        Grid points per :math:`\sigma_z` (the spacing is ``sigma_z / points_per_sigma_z``).
+
+    Returns
+    -------
+    ndarray
+        Symmetric grid ``x`` with an odd number of points, ``x[n//2] = 0``.
+    """
+    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
+    sz = math.sqrt(sigma_z2)
+    n_half = int(math.ceil(grid_half_width * sd_inf / (sz / points_per_sigma_z)))
+    return np.linspace(-grid_half_width * sd_inf, grid_half_width * sd_inf, 2 * n_half + 1)
+
+
+def transition_matrix(x, alpha: float, sigma_z: float, band_sigmas: float | None = None):
+    r"""Row-normalised transition of (21) on the grid: :math:`T_{ji} \propto \exp(-(x_i - \alpha x_j)^2 / 2\sigma_z^2)`.
+
+    Row ``j`` is :math:`p(\theta_k = x_i | \theta_{k-1} = x_j)`. With ``band_sigmas`` only the entries
+    with :math:`|x_i - \alpha x_j| \le` ``band_sigmas`` :math:`\sigma_z` are kept (a band of about
+    ``2 band_sigmas points_per_sigma_z + 1`` entries per row) and the matrix is sparse (CSR); the
+    dropped Gaussian mass is below ``exp(-band_sigmas^2 / 2)`` per row before renormalisation.
+
+    Parameters
+    ----------
+    x : ndarray (n,)
+        Uniform grid.
+    alpha : float
+        Transition coefficient of (21).
+    sigma_z : float
+        Transition noise standard deviation.
+    band_sigmas : float, optional
+        Band half width in units of ``sigma_z``; ``None`` gives the dense matrix.
+
+    Returns
+    -------
+    ndarray (n, n) or scipy.sparse.csr_matrix
+        The transition, rows summing to one.
+
+    Raises
+    ------
+    InputError
+        If the grid is not uniform or ``band_sigmas`` is not positive.
+    """
+    x = np.asarray(x, dtype=float)
+    if band_sigmas is None:
+        T = np.exp(-0.5 * ((x[None, :] - alpha * x[:, None]) / sigma_z) ** 2)
+        return T / T.sum(axis=1, keepdims=True)
+    if band_sigmas <= 0:
+        raise InputError(f"band_sigmas must be positive, got {band_sigmas}")
+    h = x[1] - x[0]
+    if not np.allclose(np.diff(x), h, rtol=1e-9, atol=0):
+        raise InputError("transition_matrix: the grid x must be uniform")
+    n = len(x)
+    m = int(math.ceil(band_sigmas * sigma_z / h)) + 1
+    centre = np.rint((alpha * x - x[0]) / h).astype(np.int64)
+    rows = np.repeat(np.arange(n), 2 * m + 1)
+    cols = (centre[:, None] + np.arange(-m, m + 1)[None, :]).ravel()
+    d = (x[np.clip(cols, 0, n - 1)] - alpha * x[rows]) / sigma_z
+    keep = (cols >= 0) & (cols < n) & (np.abs(d) <= band_sigmas)
+    rows, cols, d = rows[keep], cols[keep], d[keep]
+    vals = np.exp(-0.5 * d * d)
+    vals /= np.bincount(rows, weights=vals, minlength=n)[rows]
+    return sparse.csr_matrix((vals, (rows, cols)), shape=(n, n))
+
+
+def grid_smoother_at(r, eps: float, sigma_z2: float, sigma_eta: float, eval_idx, grid_half_width: float = 6.0,
+                     points_per_sigma_z: float = 1.0, band_sigmas: float | None = 8.0, quantized: bool = True):
+    r"""Grid filter and smoother means at selected steps only (memory ``len(eval_idx) x grid x runs``).
+
+    The same point-mass recursions as :func:`grid_filter_smoother` (forward: Chapman-Kolmogorov
+    with the transition (21) and Bayes with :math:`p(r|\theta) = \Phi(r\theta/\sigma_\eta)`, (28);
+    backward: :math:`\beta_{k-1} = T(p(r_k|\cdot)\beta_k)`), started from the stationary prior
+    :math:`N(0, \sigma^2_{\theta,\infty})`, with the banded transition of
+    :func:`transition_matrix` (or the dense one, ``band_sigmas=None``). Arrays are laid out
+    grid-major ``(n_grid, n_runs)`` so that each step is one sparse-times-dense product.
+
+    Parameters
+    ----------
+    r : ndarray (n_runs, K)
+        1-bit measurements (+-1) at k = 1..K, or unquantized ones (20) with ``quantized=False``.
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float
+        Transition noise variance.
+    sigma_eta : float
+        Measurement noise standard deviation.
+    eval_idx : array_like of int
+        Steps ``k`` in ``0..K`` at which the estimates are returned (sorted, unique).
+    grid_half_width, points_per_sigma_z : float
+        Grid, see :func:`state_grid`.
+    band_sigmas : float or None
+        Band of the transition, see :func:`transition_matrix`.
+    quantized : bool
+        1-bit (28) or Gaussian (20) likelihood.
+
+    Returns
+    -------
+    filt, smooth : ndarray (n_runs, len(eval_idx))
+        :math:`E[\theta_k | r_{1:k}]` and :math:`E[\theta_k | r_{1:K}]` at ``eval_idx``.
+
+    Raises
+    ------
+    InputError
+        If ``eval_idx`` is not sorted, unique and within ``0..K``.
+    """
+    r = np.asarray(r, dtype=float)
+    n, K = r.shape
+    ev = np.asarray(eval_idx, dtype=np.int64)
+    if ev.ndim != 1 or len(ev) == 0 or np.any(np.diff(ev) <= 0) or ev[0] < 0 or ev[-1] > K:
+        raise InputError(f"eval_idx must be sorted, unique and within 0..{K}")
+    alpha = 1.0 - eps
+    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
+    T = transition_matrix(x, alpha, math.sqrt(sigma_z2), band_sigmas)
+    TT = T.T.tocsr() if sparse.issparse(T) else np.ascontiguousarray(T.T)
+    lik_pos = ndtr(x / sigma_eta)[:, None]
+    rT = np.ascontiguousarray(r.T)
+
+    def likelihood(k):  # p(r_{k+1} | x), (n_grid, n_runs)
+        if quantized:
+            return np.where(rT[k] > 0, lik_pos, 1.0 - lik_pos)
+        return np.exp(-0.5 * ((rT[k][None, :] - x[:, None]) / sigma_eta) ** 2)
+
+    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
+    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
+    prior /= prior.sum()
+    post = np.repeat(prior[:, None], n, axis=1)
+    slot = {int(k): i for i, k in enumerate(ev)}
+    stored = np.empty((len(ev), len(x), n))
+    filt = np.empty((n, len(ev)))
+    if 0 in slot:
+        stored[0] = post
+        filt[:, 0] = x @ post
+    for k in range(K):
+        p = (TT @ post) * likelihood(k)
+        post = p / p.sum(axis=0)
+        if k + 1 in slot:
+            i = slot[k + 1]
+            stored[i] = post
+            filt[:, i] = x @ post
+    smooth = np.empty((n, len(ev)))
+    beta = np.ones((len(x), n))
+    if K in slot:
+        smooth[:, slot[K]] = filt[:, slot[K]]
+    for k in range(K, int(ev[0]), -1):
+        beta = T @ (beta * likelihood(k - 1))
+        beta /= beta.sum(axis=0)
+        if k - 1 in slot:
+            i = slot[k - 1]
+            g = stored[i] * beta
+            smooth[:, i] = (x @ g) / g.sum(axis=0)
+    return filt, smooth
+
+
+def window_mse(estimates, theta):
+    r"""Per-run mean squared error over the evaluation steps.
+
+    Parameters
+    ----------
+    estimates, theta : ndarray (n_runs, E)
+        Estimates and true states at the same ``E`` evaluation steps.
+
+    Returns
+    -------
+    ndarray (n_runs,)
+        :math:`E^{-1}\sum_e (\hat\theta_e - \theta_e)^2` per run.
+    """
+    return np.mean((np.asarray(estimates) - np.asarray(theta)) ** 2, axis=1)
+
+
+def paired_ratio_interval(num, den, n_boot: int, seed: int, level: float = 0.95):
+    r"""Ratio of mean MSEs in dB with a paired percentile bootstrap interval.
+
+    The estimate is :math:`10\log_{10}(\bar a / \bar b)` for per-run values ``a = num``, ``b = den``
+    from the *same* runs (same states and noise). Each bootstrap replicate resamples runs with
+    replacement and uses the same run indices for ``a`` and ``b``, so the interval reflects the
+    variance of the paired difference, not of each mean alone.
+
+    Parameters
+    ----------
+    num, den : ndarray (n_runs,)
+        Per-run values of the numerator and denominator estimators (paired by run).
+    n_boot : int
+        Bootstrap replicates.
+    seed : int
+        Seed of the resampling generator.
+    level : float
+        Coverage of the percentile interval.
+
+    Returns
+    -------
+    tuple of float
+        ``(estimate_db, lo_db, hi_db)``.
+
+    Raises
+    ------
+    InputError
+        If ``num`` and ``den`` differ in length or are empty.
+    """
+    a, b = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
+    if a.shape != b.shape or a.ndim != 1 or len(a) == 0:
+        raise InputError(f"num and den must be 1-D of the same length, got {a.shape} and {b.shape}")
+    n = len(a)
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, size=(n_boot, n))
+    ratio = a[idx].mean(axis=1) / b[idx].mean(axis=1)
+    q = 100.0 * (1.0 - level) / 2.0
+    lo, hi = np.percentile(10.0 * np.log10(ratio), [q, 100.0 - q])
+    return float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)
+
+
+def db_zero_crossing(x, y) -> float:
+    r"""First downward crossing of 0 by ``y(x)``, linearly interpolated between grid points.
+
+    Parameters
+    ----------
+    x : array_like
+        Increasing abscissae (SNR in dB).
+    y : array_like
+        Values (dB) at ``x``.
+
+    Returns
+    -------
+    float
+        The ``x`` at which ``y`` first goes from > 0 to <= 0; NaN if it does not on the grid.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    for i in range(len(x) - 1):
+        if y[i] > 0 >= y[i + 1]:
+            return float(x[i] + (x[i + 1] - x[i]) * y[i] / (y[i] - y[i + 1]))
+    return float("nan")

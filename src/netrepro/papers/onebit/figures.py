@@ -9,7 +9,8 @@ import pandas as pd
 
 from ...plotting import new_figure, save_figure
 
-__all__ = ["figure_rho_sl", "figure_rho_s_f", "figure_estimator", "figure_convergence", "figure_lag"]
+__all__ = ["figure_rho_sl", "figure_rho_s_f", "figure_estimator", "figure_convergence", "figure_lag",
+           "figure_estimator_ratios"]
 
 
 def _db(x):
@@ -70,6 +71,7 @@ def figure_rho_s_f(params, inputs, outputs):
 def figure_estimator(params, inputs, outputs):
     """Fig S1: MSE of the grid filter/smoother (1-bit) and Kalman/RTS with 95% CIs next to the bounds."""
     est = pd.read_csv(inputs["estimator"])
+    est = est[est["alpha"] == est["alpha"].max()]  # the simulated alpha closest to one
     fig, (ax, ax2) = new_figure(1, 2, figsize=(10.0, 4.0))
     styles = {"filter_1bit": ("C3", "o"), "smoother_1bit": ("C0", "s"), "kalman_filter": ("C1", "^"),
               "rts_smoother": ("C2", "v")}
@@ -119,11 +121,43 @@ def figure_lag(params, inputs, outputs):
     """Fig S3: smoothing lag Delta needed (0.01 dB) vs SNR."""
     lag = pd.read_csv(inputs["lag"])
     fig, ax = _new_fig()
-    for alpha, g in lag.groupby("alpha"):
-        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", label=_alpha_label(alpha))
+    for i, (alpha, g) in enumerate(lag.groupby("alpha")):
+        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", color=f"C{i}", label=_alpha_label(alpha))
+        if "delta_break_even" in g:
+            ax.semilogy(g["snr_db"], g["delta_break_even"], ls="--", color=f"C{i}",
+                        label=rf"break-even $\Delta$ ($J_{{k|k+\Delta,q}} > J_{{k|k,\infty}}$), {_alpha_label(alpha)}")
     ax.set_xlabel("SNR [dB]")
     ax.set_ylabel(r"lag $\Delta$ for %g dB" % lag["tol_db"].iloc[0])
-    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed")
+    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed (solid) and break-even lag (dashed)")
     ax.legend()
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_estimator_ratios(params, inputs, outputs):
+    """Fig S4: rho_F, rho_S, rho_SL from the estimators' MSEs (paired-bootstrap 95 % intervals) next to the bound."""
+    allrat = pd.read_csv(inputs["ratios"])
+    a_main = allrat["alpha"].max()
+    rat = allrat[allrat["alpha"] == a_main]
+    fig, ax = _new_fig()
+    colors = {"rho_F": "C3", "rho_S": "C0", "rho_SL": "C2"}
+    others = allrat[(allrat["alpha"] != a_main) & (allrat["quantity"] == "rho_S")]
+    for j, (alpha, g) in enumerate(others.groupby("alpha", sort=False)):
+        g = g.sort_values("snr_db")
+        ax.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
+                    color=f"C{4 + j}", marker="s", mfc="none", ls="none", label=rf"$\rho_S$ from MSEs, $\alpha = {alpha:g}$")
+        ax.plot(g["snr_db"], g["bound_db"], color=f"C{4 + j}", lw=0.8, ls=":", label=rf"$\rho_S$ bound, $\alpha = {alpha:g}$")
+    names = {"rho_F": r"$\rho_F$", "rho_S": r"$\rho_S$", "rho_SL": r"$\rho_{SL}$"}
+    for i, (qty, g) in enumerate(rat.groupby("quantity", sort=False)):
+        g = g.sort_values("snr_db")
+        x = g["snr_db"] + 0.15 * (i - 1)
+        ax.errorbar(x, g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
+                    color=colors[qty], marker="o", ls="none", label=f"{names[qty]} from MSEs")
+        ax.plot(g["snr_db"], g["bound_db"], color=colors[qty], lw=1.0, label=f"{names[qty]} bound (47)-(49)")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
+    ax.set_ylabel("ratio [dB]")
+    ax.set_title(rf"Fig S4: achievable ratios vs the bound ($\alpha = {a_main:g}$)")
+    ax.legend(fontsize=7)
     save_figure(fig, outputs["figure"])
     return {}

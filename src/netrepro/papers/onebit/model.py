@@ -552,6 +552,21 @@ def kalman_covariances(A, Q, C, R, P0, K):
 
 
 def vector_check(vec):
+    """The general recursions (7), (14), (16), (17)-(19), corrected and as printed, against Kalman/RTS.
+
+    For a linear-Gaussian model the BIMs are the inverse Kalman/RTS covariances, so each form is
+    compared with :func:`kalman_covariances` (errata E1-E3).
+
+    Parameters
+    ----------
+    vec : dict
+        ``A, Q, C, R, P0`` (nested lists) and ``horizon`` (config ``onebit.vector_check``).
+
+    Returns
+    -------
+    dict
+        ``(quantity, form) -> max relative Frobenius error`` of the inverse BIMs over all steps.
+    """
     A, Q, C, R, P0 = (np.asarray(vec[k], dtype=float) for k in ("A", "Q", "C", "R", "P0"))
     K = int(vec["horizon"])
     D11, D12, D22 = linear_gaussian_blocks(A, Q)
@@ -593,18 +608,14 @@ def prior_check(P0):
 
     Parameters
     ----------
-    vec : dict
-        ``A, Q, C, R, P0`` (nested lists) and ``horizon`` (config ``onebit.vector_check``).
-
-    Parameters
-    ----------
     P0 : ndarray (M, M)
         Prior covariance.
 
     Returns
     -------
-    dict
-        ``(quantity, form) -> max relative error`` of the inverse BIMs (7), (14), (16), (17)-(19), corrected and as printed, against :func:`kalman_covariances`.
+    tuple of float
+        Relative error of ``inv(J_{0|0})`` against ``P0`` with (12) read elementwise (the square of
+        each score component) and as the outer product.
     """
     Pi = np.linalg.inv(P0)
     outer = Pi @ P0 @ Pi

@@ -27,9 +27,15 @@ __all__ = [
     "information_ratios",
     "information_ratios_limit",
     "iterate_transient",
-    "window_bounds",
     "rw_scalar_check",
     "variance_sum_check",
+    "rw_filter_time_constant",
+    "bound_paths",
+    "estimator_design",
+    "rw_break_even_lag",
+    "rw_break_even_iterated",
+    "rho_s_threshold_eps",
+    "rho_s_zero_crossing",
 ]
 
 
@@ -432,40 +438,6 @@ def iterate_transient(snr_db, eps: float, sigma0: float, mu0: float, sigma_eta: 
                 var_final=theta_variance(n_steps, eps, sigma0, s), var_inf=var_inf, trace=trace, record=record)
 
 
-def window_bounds(F, eps, s, sigma0_2, horizon, window):
-    """Average over the window of 1/J_{k|k} and 1/J_{k|K} (time-varying, exact horizon).
-
-    Parameters
-    ----------
-    F : float or ndarray
-        Information per measurement: ``1/sigma_eta^2`` (unquantized) or :math:`E[F_q]` (1-bit).
-    eps : float
-        ``1 - alpha`` of the random walk (21).
-    s : float
-        Transition noise variance.
-    sigma0_2 : float
-        Prior variance.
-    horizon : int
-        Last step K.
-    window : tuple of int
-        ``(start, stop)`` of the averaging window.
-
-    Returns
-    -------
-    tuple of float
-        Window means of the filtering bound :math:`1/J_{k|k}` ((24)/(34)) and the smoothing bound :math:`1/J_{k|K}` ((26)-(27)/(36)-(38)).
-    """
-    J = np.empty(horizon + 1)
-    J[0] = 1.0 / sigma0_2
-    for k in range(1, horizon + 1):
-        J[k] = rw_filtering_step(J[k - 1], F, eps, s)
-    kap = np.zeros(horizon + 1)
-    for l in range(horizon - 1, -1, -1):
-        kap[l] = rw_smoothing_gain_step(kap[l + 1], F, eps, s)
-    w = slice(window[0], window[1])
-    return float(np.mean(1.0 / J[w])), float(np.mean(1.0 / (J + kap)[w]))
-
-
 def rw_scalar_check(eps, s, F, K):
     """Smoothing variances of the scalar random walk with information F per step, three ways, vs RTS.
 
@@ -546,3 +518,288 @@ def variance_sum_check(eps: float, sigma_z2: float, sigma0: float, n_steps: int 
     printed = np.array([a ** (2 * k) * sigma0**2 + sum(a ** (2 * (k - i)) for i in range(1, k)) * sigma_z2 for k in ks])
     corrected = theta_variance(ks, eps, sigma0, sigma_z2)
     return float(np.max(np.abs(printed / rec[1:] - 1))), float(np.max(np.abs(corrected / rec[1:] - 1)))
+
+
+# ============================================================================ beyond the paper (issue 17)
+def rw_filter_time_constant(F, eps: float, sigma_z2):
+    r"""Time constant of the steady-state filter: :math:`\tau = -1/\ln\lambda`, :math:`\lambda = \alpha/(1 + MF)`.
+
+    With the steady-state predicted variance :math:`M = 1/(\tilde J_{k|k} - F)` of (41)/(42), the
+    filter's error obeys :math:`e_k = \lambda e_{k-1} + \dots` with the pole
+    :math:`\lambda = \alpha(1 - G)`, :math:`G = MF/(1 + MF)`; the RTS smoother's backward gain
+    :math:`\tilde P_{k|k}\alpha/M` is the same number, so :math:`\tau` also sets how far from the
+    end of the record the smoother is in steady state. For 1-bit data ``F`` is :math:`E[F_q]`
+    (the linearised information filter).
+
+    Parameters
+    ----------
+    F : float or ndarray
+        Information per measurement.
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float or ndarray
+        Transition noise variance.
+
+    Returns
+    -------
+    ndarray
+        :math:`\tau` in steps.
+    """
+    F = np.asarray(F, dtype=float)
+    J = rw_filtering_fixed_point(F, eps, sigma_z2)
+    M = 1.0 / (J - F)
+    return -1.0 / (math.log1p(-eps) - np.log1p(M * F))
+
+
+def bound_paths(F, eps: float, sigma_z2: float, sigma0_2: float, horizon: int):
+    r"""Filtering and smoothing BIMs over a finite record, (24)/(34) forward and (26)-(27)/(36)-(38) backward.
+
+    Parameters
+    ----------
+    F : float
+        Information per measurement (constant: stationary start).
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float
+        Transition noise variance.
+    sigma0_2 : float
+        Prior variance, :math:`J_{0|0} = 1/\sigma_0^2`, (12).
+    horizon : int
+        Last step K.
+
+    Returns
+    -------
+    J_f, J_s : ndarray (K+1,)
+        :math:`J_{k|k}` and :math:`J_{k|K}`, k = 0..K.
+    """
+    J = np.empty(horizon + 1)
+    J[0] = 1.0 / sigma0_2
+    for k in range(1, horizon + 1):
+        J[k] = rw_filtering_step(J[k - 1], F, eps, sigma_z2)
+    kap = np.zeros(horizon + 1)
+    for l in range(horizon - 1, -1, -1):
+        kap[l] = rw_smoothing_gain_step(kap[l + 1], F, eps, sigma_z2)
+    return J, J + kap
+
+
+def estimator_design(F_list, eps: float, sigma_z2: float, burn_in_taus: float, window_taus: float,
+                     tail_taus: float, evals_per_tau: float) -> dict:
+    r"""Record length and evaluation window of a Monte Carlo run in steady state.
+
+    :math:`\tau` is the largest :func:`rw_filter_time_constant` over ``F_list`` (the slowest of the
+    compared filters). The window starts after ``burn_in_taus`` time constants (the filter has
+    forgotten its prior to :math:`e^{-\text{burn\_in}}`), lasts ``window_taus`` of them, and the
+    record continues ``tail_taus`` of them after the window (the smoother has forgotten the end of
+    the record). Estimates are evaluated every ``stride`` steps inside the window.
+
+    Parameters
+    ----------
+    F_list : sequence of float
+        Information per measurement of each filter compared.
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float
+        Transition noise variance.
+    burn_in_taus, window_taus, tail_taus : float
+        Lengths in time constants.
+    evals_per_tau : float
+        Evaluation steps per time constant.
+
+    Returns
+    -------
+    dict
+        ``tau`` (float), ``start``, ``stop`` (window ``start <= k < stop``), ``horizon`` (K),
+        ``stride`` (ints) and ``eval_idx`` (ndarray).
+    """
+    tau = float(max(float(rw_filter_time_constant(F, eps, sigma_z2)) for F in F_list))
+    start = int(math.ceil(burn_in_taus * tau))
+    stop = start + int(math.ceil(window_taus * tau))
+    horizon = stop + int(math.ceil(tail_taus * tau))
+    stride = max(1, int(math.floor(tau / evals_per_tau)))
+    return dict(tau=tau, start=start, stop=stop, horizon=horizon, stride=stride,
+                eval_idx=np.arange(start, stop, stride))
+
+
+def rw_break_even_lag(Fq, Finf, eps: float, sigma_z2):
+    r"""Smallest lag Delta with :math:`J_{k|k+\Delta,q} > \tilde J_{k|k,\infty}` in steady state (-1: never).
+
+    :math:`J_{k|k+\Delta,q} = \tilde J_{k|k,q} + \kappa_\Delta` with :math:`\kappa_\Delta` the
+    Delta-th iterate of (37)-(38) from :math:`\kappa_0 = 0`, increasing to :math:`\kappa_\infty`
+    (:func:`rw_smoothing_gain_fixed_point`). The lag exists iff
+    :math:`\tilde J_{k|k,q} + \kappa_\infty > \tilde J_{k|k,\infty}`, i.e. iff :math:`\rho_S > 1`, (49).
+    The iteration is the Moebius map of :func:`rw_lag_needed`, so
+    :math:`w_n = (\kappa_n - x_+)/(\kappa_n - x_-) = w_0 K^n`; with the target
+    :math:`t = \tilde J_{k|k,\infty} - \tilde J_{k|k,q}`, the answer is the smallest ``n`` with
+    :math:`w_0K^n < w(t)` (``w`` decreasing in ``|.|``), checked and corrected by one step of the map
+    on each side against rounding.
+
+    Parameters
+    ----------
+    Fq : float or ndarray
+        :math:`E[F_q]` (1-bit information per measurement).
+    Finf : float or ndarray
+        ``1/sigma_eta^2`` (unquantized information per measurement).
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float or ndarray
+        Transition noise variance.
+
+    Returns
+    -------
+    ndarray of int64
+        Delta, or -1 where the 1-bit smoother never reaches the unquantized filter.
+    """
+    Fq, Finf, s = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (Fq, Finf, sigma_z2)))
+    Jq = rw_filtering_fixed_point(Fq, eps, s)
+    Ji = rw_filtering_fixed_point(Finf, eps, s)
+    xp = rw_smoothing_gain_fixed_point(Fq, eps, s)
+    a2 = (1.0 - eps) ** 2
+    xm = -a2 * Fq / (s * xp)
+    target = Ji - Jq
+    ok = Jq + xp > Ji
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w0 = xp / xm
+        wt = (target - xp) / (target - xm)
+        logK = np.log1p(-eps * (2.0 - eps) - s * xp) - np.log1p(s * (Fq + xp))
+        n = np.where(ok, np.floor(np.log(wt / w0) / logK) + 1, -1)
+    n = np.where(ok, np.maximum(n, 1), -1).astype(np.int64)
+    # guard against rounding: kappa_n > target and kappa_{n-1} <= target, by the recursion itself
+    for i in np.flatnonzero(ok.ravel()):
+        idx = np.unravel_index(i, n.shape)
+        n[idx] = _break_even_fix(int(n[idx]), float(Fq[idx]), eps, float(s[idx]), float(target[idx]))
+    return n
+
+
+def _break_even_fix(n: int, F: float, eps: float, s: float, target: float) -> int:
+    """Move ``n`` by at most a few steps so that kappa_n > target >= kappa_{n-1} (exact by iteration near n)."""
+    def kappa(m):  # closed form of the m-th iterate would round the same way; iterate from a nearby start
+        k = 0.0
+        for _ in range(m):
+            k = rw_smoothing_gain_step(k, F, eps, s)
+        return k
+
+    if n > 200_000:  # too long to iterate: trust the closed form
+        return n
+    while n > 1 and kappa(n - 1) > target:
+        n -= 1
+    while kappa(n) <= target:
+        n += 1
+    return n
+
+
+def rw_break_even_iterated(Fq, Finf, eps: float, sigma_z2, max_steps: int = 10_000_000):
+    r"""The lag of :func:`rw_break_even_lag` by iterating (37)-(38) directly (vectorised; -1: never).
+
+    Parameters
+    ----------
+    Fq, Finf : float or ndarray
+        1-bit and unquantized information per measurement.
+    eps : float
+        ``1 - alpha``.
+    sigma_z2 : float or ndarray
+        Transition noise variance.
+    max_steps : int
+        Iteration limit.
+
+    Returns
+    -------
+    ndarray of int64
+        Delta, or -1 where :math:`\tilde J_{k|k,q} + \kappa_\infty \le \tilde J_{k|k,\infty}`.
+
+    Raises
+    ------
+    ModelError
+        If a reachable lag is not reached within ``max_steps``.
+    """
+    Fq, Finf, s = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (Fq, Finf, sigma_z2)))
+    Jq = rw_filtering_fixed_point(Fq, eps, s)
+    Ji = rw_filtering_fixed_point(Finf, eps, s)
+    reach = Jq + rw_smoothing_gain_fixed_point(Fq, eps, s) > Ji
+    lag = np.where(reach, 0, -1).astype(np.int64)
+    kappa = np.zeros_like(Fq)
+    todo = reach.copy()
+    n = 0
+    while np.any(todo):
+        n += 1
+        if n > max_steps:
+            raise ModelError(f"rw_break_even_iterated: no break-even within {max_steps} steps")
+        kappa = rw_smoothing_gain_step(kappa, Fq, eps, s)
+        hit = todo & (Jq + kappa > Ji)
+        lag[hit] = n
+        todo &= ~hit
+    return lag
+
+
+def rho_s_threshold_eps(snr_db: float, sigma_eta: float = 1.0, eps_lo: float = 1e-9, eps_hi: float = 0.5,
+                        definition: str = "stationary") -> float:
+    r"""Largest ``eps = 1 - alpha`` at which :math:`\rho_S`, (49), still exceeds 0 dB at a given SNR.
+
+    Bisection in :math:`\log\varepsilon` on the sign of :math:`\rho_S` from
+    :func:`information_ratios`; the bracket must hold one sign change (checked).
+
+    Parameters
+    ----------
+    snr_db : float
+        SNR in dB.
+    sigma_eta : float
+        Noise standard deviation.
+    eps_lo, eps_hi : float
+        Bracket; :math:`\rho_S(\varepsilon_{lo}) > 0 \ge \rho_S(\varepsilon_{hi})` is required.
+    definition : str
+        SNR convention.
+
+    Returns
+    -------
+    float
+        The threshold, NaN if :math:`\rho_S > 0` on the whole bracket, 0.0 if nowhere.
+    """
+    from scipy import optimize
+
+    def f(le):
+        return float(information_ratios(np.array([snr_db]), 10.0**le, sigma_eta, definition)["rho_s_db"][0])
+
+    a, b = math.log10(eps_lo), math.log10(eps_hi)
+    fa, fb = f(a), f(b)
+    if fa <= 0:
+        return 0.0
+    if fb > 0:
+        return float("nan")
+    return float(10.0 ** optimize.brentq(f, a, b, xtol=1e-12))
+
+
+def rho_s_zero_crossing(eps: float, sigma_eta: float = 1.0, definition: str = "stationary", lo_db: float = -40.0,
+                        hi_db: float = 40.0) -> float:
+    r"""SNR (dB) at which the steady-state :math:`\rho_S`, (49), first falls to 0 dB.
+
+    A grid of 0.5 dB brackets the first sign change, then Brent's method solves
+    :math:`\rho_S(\mathrm{SNR}) = 0` to 1e-10 dB.
+
+    Parameters
+    ----------
+    eps : float
+        ``1 - alpha`` (> 0).
+    sigma_eta : float
+        Noise standard deviation.
+    definition : str
+        SNR convention.
+    lo_db, hi_db : float
+        Search range.
+
+    Returns
+    -------
+    float
+        The crossing, NaN if :math:`\rho_S` does not change sign on the range.
+    """
+    from scipy import optimize
+
+    grid = np.arange(lo_db, hi_db + 0.25, 0.5)
+    r = information_ratios(grid, eps, sigma_eta, definition)["rho_s_db"]
+    idx = np.flatnonzero((r[:-1] > 0) & (r[1:] <= 0))
+    if len(idx) == 0:
+        return float("nan")
+    i = int(idx[0])
+
+    def f(d):
+        return float(information_ratios(np.array([d]), eps, sigma_eta, definition)["rho_s_db"][0])
+
+    return float(optimize.brentq(f, grid[i], grid[i + 1], xtol=1e-10))

@@ -14,11 +14,12 @@ Tables written (``results/onebit/``)
     (``one_minus_alpha = 0``, BIM columns empty).
 ``lag.csv``
     ``alpha, snr_db, delta_needed`` then ``delta_q, delta_inf, delta_q_iterated,
-    delta_inf_iterated, tol_db, delta_scaled`` -- smallest smoothing lag at which
+    delta_inf_iterated, tol_db, delta_scaled, delta_break_even`` -- smallest smoothing lag at which
     both the 1-bit and the unquantized smoothing BIM are within ``tol_db`` of
     their Delta -> infinity values (closed form of the Moebius iteration,
     checked by iterating (27)/(37)-(38)); ``delta_scaled = delta_q *
-    sqrt(E[F_q] sigma_z^2)`` tends to a constant as alpha -> 1.
+    sqrt(E[F_q] sigma_z^2)`` tends to a constant as alpha -> 1; ``delta_break_even`` is the
+    smallest lag with J_{k|k+Delta,q} > J_{k|k,inf} in steady state (empty: never).
 ``convergence.csv``
     ``alpha, snr_db, quantity, fixed_point, iterated, rel_diff, n_steps,
     k_converged`` -- each steady state (variance (33), filtering (24)/(34)
@@ -32,13 +33,23 @@ Tables written (``results/onebit/``)
     ``alpha, snr_db, k, var_ratio, efq_ratio, j_f_q_ratio, j_f_inf_ratio`` --
     trajectories (iterate / fixed point) at log-spaced steps (Fig S2).
 ``shards/estimator_<i>.npz``
-    Monte Carlo block sums of shard ``i`` (merged in block order).
+    Per-run window MSEs of shard ``i``'s Monte Carlo blocks (merged in block order).
 ``estimator_mse.csv``
     ``alpha, snr_db, kind, mse, mse_lo, mse_hi, bound`` then ``bound_steady,
-    mse_over_bound, n_runs`` -- ``kind`` in ``filter_1bit, smoother_1bit,
-    kalman_filter, rts_smoother``; grid filter/smoother on 1-bit data and
-    Kalman/RTS on unquantized data, 95 % confidence intervals over runs,
-    ``bound`` = BCRB averaged over the evaluation window.
+    mse_over_bound, n_runs, steady_dev, tau, window_start, window_stop, horizon, stride,
+    n_eval, start_over_tau`` -- ``kind`` in ``filter_1bit, smoother_1bit, kalman_filter,
+    rts_smoother``; banded grid filter/smoother on 1-bit data and Kalman/RTS on the
+    unquantized data of the same paths and noise, 95 % intervals over runs, ``bound`` = BCRB
+    over the evaluation steps, ``steady_dev`` its largest relative distance from the steady
+    state there.
+``estimator_ratios.csv``
+    ``alpha, snr_db, quantity, estimate_db, lo_db, hi_db, bound_db, n_runs`` then the design
+    columns -- rho_F, rho_S, rho_SL from the MSEs with paired-bootstrap 95 % intervals, next to
+    the steady-state bound (47)-(49).
+``estimator_crossing.csv``
+    ``alpha, curve, snr_db_crossing`` -- where rho_S crosses 0 dB (estimate, lo, hi, bound).
+``alpha_scan.csv``, ``alpha_threshold.csv``
+    rho_S and the break-even lag over alpha; the largest 1 - alpha with rho_S > 0 per SNR.
 ``vector_check.csv``
     ``quantity, form, max_rel_err`` -- general vector recursions on a 2-D
     non-symmetric model against the Kalman filter / RTS smoother.
@@ -51,19 +62,25 @@ import math
 import numpy as np
 import pandas as pd
 
-from .estimators import grid_filter_smoother, kalman_rts, simulate_block
+from scipy.special import ndtri
+
+from .estimators import db_zero_crossing, grid_smoother_at, kalman_rts, paired_ratio_interval, simulate_block, window_mse
 from .fisher import expected_fisher_1bit, expected_fisher_1bit_quad
 from .model import sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
 from .randomwalk import (
+    bound_paths,
+    estimator_design,
     information_ratios,
     information_ratios_limit,
     iterate_transient,
+    rho_s_threshold_eps,
+    rho_s_zero_crossing,
+    rw_break_even_lag,
     rw_filtering_fixed_point,
     rw_lag_iterated,
     rw_lag_needed,
     rw_smoothing_gain_fixed_point,
     rw_smoothing_gain_step,
-    window_bounds,
 )
 
 __all__ = [
@@ -74,6 +91,7 @@ __all__ = [
     "estimator_shard_step",
     "estimator_step",
     "run_estimator",
+    "alpha_scan_step",
     "vector_check_step",
 ]
 
@@ -129,13 +147,15 @@ def lag_step(params, inputs, outputs):
         Fq = expected_fisher_1bit(stationary_variance(eps, s) / se**2) / se**2
         Fi = np.full_like(s, 1.0 / se**2)
         dq, di = rw_lag_needed(Fq, eps, s, tol), rw_lag_needed(Fi, eps, s, tol)
+        be = rw_break_even_lag(Fq, Fi, eps, s)
         if max(dq.max(), di.max()) <= params["lag_iterate_max"]:
             dq_it, di_it = rw_lag_iterated(Fq, eps, s, tol), rw_lag_iterated(Fi, eps, s, tol)
         else:
             dq_it = di_it = np.full(len(s), -1)
         frames.append(pd.DataFrame(dict(alpha=1.0 - eps, snr_db=snr_db, delta_needed=np.maximum(dq, di),
                                         delta_q=dq, delta_inf=di, delta_q_iterated=dq_it, delta_inf_iterated=di_it,
-                                        tol_db=tol, delta_scaled=dq * np.sqrt(Fq * s))))
+                                        tol_db=tol, delta_scaled=dq * np.sqrt(Fq * s),
+                                        delta_break_even=np.where(be < 0, np.nan, be.astype(float)))))
     return {"table": pd.concat(frames, ignore_index=True)}
 
 
@@ -187,84 +207,173 @@ def convergence_step(params, inputs, outputs):
             "provenance": {"n_filter_steps": int(n_total)}}
 
 
-def _estimator_simulator(params, j):
-    """``fn(rng, n)`` for the Monte Carlo engine: per-run window-mean squared errors of the four estimators."""
+def _estimator_cases(params):
+    """``(key, eps, snr_db, seed)`` of every simulated (alpha, SNR) pair; alpha ``i``, SNR ``j`` use ``seed + 1000 i + j``."""
     est = params["estimator"]
-    eps, se = est["one_minus_alpha"], params["sigma_eta"]
-    K, (w0, w1) = est["horizon"], est["window"]
-    s = float(sigma_z2_from_snr(est["snr_db"][j], eps, se, params["snr_definition"]))
+    return [(f"a{i}s{j}", float(eps), float(snr), est["seed"] + 1000 * i + j)
+            for i, eps in enumerate(est["one_minus_alpha"]) for j, snr in enumerate(est["snr_db"])]
+
+
+def _estimator_design(params, eps, snr):
+    """Noise variance, 1-bit information and run design (window after >= burn_in_taus time constants)."""
+    est, se = params["estimator"], params["sigma_eta"]
+    s = float(sigma_z2_from_snr(snr, eps, se, params["snr_definition"]))
+    Fq = float(expected_fisher_1bit(float(stationary_variance(eps, s)) / se**2)) / se**2
+    design = estimator_design((Fq, 1.0 / se**2), eps, s, est["burn_in_taus"], est["window_taus"], est["tail_taus"],
+                              est["evals_per_tau"])
+    return s, Fq, design
+
+
+def _estimator_simulator(params, eps, snr):
+    """``fn(rng, n)``: per-run MSEs over the evaluation steps of the four estimators, on the same paths and noise."""
+    est, se = params["estimator"], params["sigma_eta"]
+    s, _, design = _estimator_design(params, eps, snr)
+    ev = design["eval_idx"]
 
     def fn(rng, n):
-        theta, y, r = simulate_block(rng, n, K, eps, s, se)
-        filt, smooth = grid_filter_smoother(r, eps, s, se, est["grid_half_width"], est["points_per_sigma_z"])
+        theta, y, r = simulate_block(rng, n, design["horizon"], eps, s, se)   # r = sign(y): one noise draw
+        filt, smooth = grid_smoother_at(r, eps, s, se, ev, est["grid_half_width"], est["points_per_sigma_z"],
+                                        est["band_sigmas"])
         kf, rts = kalman_rts(y, eps, s, se)
-        w = slice(w0, w1)
-
-        def mse(x):
-            return np.mean((x[:, w] - theta[:, w]) ** 2, axis=1)
-
-        return {"filter_1bit": mse(filt), "smoother_1bit": mse(smooth), "kalman_filter": mse(kf),
-                "rts_smoother": mse(rts)}
+        th = theta[:, ev]
+        return {"filter_1bit": window_mse(filt, th), "smoother_1bit": window_mse(smooth, th),
+                "kalman_filter": window_mse(kf[:, ev], th), "rts_smoother": window_mse(rts[:, ev], th)}
 
     return fn
 
 
 def estimator_shard_step(params, inputs, outputs):
-    """Step: Monte Carlo block sums of one shard (all SNRs; SNR ``j`` uses root seed ``seed + j``)."""
-    from ...engines.montecarlo import run_blocks, save_sums, shard_blocks
+    """Step: per-run window MSEs of one shard's blocks, for every (alpha, SNR); block ``b`` has its own generator."""
+    from ...engines.montecarlo import block_rng, shard_blocks
+    from ...io import atomic_path
 
     est = params["estimator"]
     blocks = shard_blocks(est["n_runs"], est["block_size"], params["n_shards"], params["shard"])
-    named = {f"snr{j}": run_blocks(_estimator_simulator(params, j), est["n_runs"], est["block_size"],
-                                   est["seed"] + j, blocks=blocks) for j in range(len(est["snr_db"]))}
-    save_sums(outputs["sums"], named)
+    sizes = [min(est["block_size"], est["n_runs"] - b * est["block_size"]) for b in blocks]
+    arrays = {}
+    for key, eps, snr, seed in _estimator_cases(params):
+        fn = _estimator_simulator(params, eps, snr)
+        per_block = [fn(block_rng(seed, b), n) for b, n in zip(blocks, sizes)]
+        arrays[f"{key}|blocks"] = np.asarray(blocks, dtype=np.int64)
+        arrays[f"{key}|counts"] = np.asarray(sizes, dtype=np.int64)
+        for kind in ESTIMATOR_KINDS:
+            arrays[f"{key}|{kind}"] = np.concatenate([v[kind] for v in per_block]) if per_block else np.empty(0)
+    with atomic_path(outputs["runs"]) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
     return {"provenance": {"blocks": [int(b) for b in blocks], "seed": est["seed"]}}
 
 
+def _merged_runs(paths, key):
+    """Per-run values of case ``key`` from all shards, in block order (identical for any sharding)."""
+    parts = []
+    for path in paths:
+        with np.load(path) as data:
+            blocks, counts = data[f"{key}|blocks"], data[f"{key}|counts"]
+            offsets = np.concatenate([[0], np.cumsum(counts)])
+            for i, b in enumerate(blocks):
+                parts.append((int(b), {k: data[f"{key}|{k}"][offsets[i]:offsets[i + 1]] for k in ESTIMATOR_KINDS}))
+    parts.sort(key=lambda p: p[0])
+    if len({b for b, _ in parts}) != len(parts):
+        raise ValueError(f"estimator shards: a block of {key} appears twice")
+    return {k: np.concatenate([v[k] for _, v in parts]) for k in ESTIMATOR_KINDS}
+
+
+ESTIMATOR_KINDS = ("filter_1bit", "smoother_1bit", "kalman_filter", "rts_smoother")
+# rho = MSE of the reference / MSE of the 1-bit estimator (information ratio), (47)-(49)
+RATIO_DEFS = {"rho_F": ("kalman_filter", "filter_1bit", "rho_f_db"),
+              "rho_S": ("kalman_filter", "smoother_1bit", "rho_s_db"),
+              "rho_SL": ("rts_smoother", "smoother_1bit", "rho_sl_db")}
+
+
 def estimator_step(params, inputs, outputs):
-    """Step: table ``estimator_mse.csv`` -- merged shards (block order) next to the bounds.
+    """Step: tables ``estimator_mse.csv``, ``estimator_ratios.csv`` and ``estimator_crossing.csv`` from the shards.
 
-    ``bound`` is the BCRB (34)/(36) (1-bit) or (24)/(26) (unquantized) for the
-    simulated horizon, started from the stationary prior, averaged over the
-    evaluation window; ``bound_steady`` is the steady-state fixed point.
+    ``estimator_mse.csv``: each estimator's MSE (95 % normal interval over runs) next to the BCRB
+    (34)/(36) or (24)/(26) over the same evaluation steps of the finite record (``bound``) and its
+    steady state (``bound_steady``); ``steady_dev`` is the largest relative distance of the
+    finite-record bound from its steady state over the evaluation steps (the window is in steady
+    state when it is small). ``estimator_ratios.csv``: rho_F, rho_S, rho_SL from the MSEs with a
+    paired bootstrap interval, next to the bound (49)-(47). ``estimator_crossing.csv``: the SNR at
+    which the achievable rho_S (estimate, lo, hi) and the bound cross 0 dB.
     """
-    from ...engines.montecarlo import load_sums, merge_block_sums
-
-    est = params["estimator"]
-    eps, se = est["one_minus_alpha"], params["sigma_eta"]
-    K, (w0, w1) = est["horizon"], est["window"]
-    shards = [load_sums(path) for path in inputs["shards"]]
-    rows = []
-    for j, snr in enumerate(est["snr_db"]):
-        mc = merge_block_sums(shard[f"snr{j}"] for shard in shards)
-        s = float(sigma_z2_from_snr(snr, eps, se, params["snr_definition"]))
+    est, se = params["estimator"], params["sigma_eta"]
+    mse_rows, ratio_rows, cross_rows = [], [], []
+    z = float(ndtri(0.975))
+    for key, eps, snr, seed in _estimator_cases(params):
+        runs = _merged_runs(inputs["shards"], key)
+        s, Fq, d = _estimator_design(params, eps, snr)
+        ev = d["eval_idx"]
         var_inf = float(stationary_variance(eps, s))
-        Fq = float(expected_fisher_1bit(var_inf / se**2)) / se**2
-        bounds, steady = {}, {}
-        for label, F in (("1bit", Fq), ("unq", 1.0 / se**2)):
-            bf, bs = window_bounds(F, eps, s, var_inf, K, (w0, w1))
+        bounds, steady, dev = {}, {}, {}
+        for F, kf, ks in ((Fq, "filter_1bit", "smoother_1bit"), (1.0 / se**2, "kalman_filter", "rts_smoother")):
+            Jf, Js = bound_paths(F, eps, s, var_inf, d["horizon"])
             jf = float(rw_filtering_fixed_point(F, eps, s))
-            kap = float(rw_smoothing_gain_fixed_point(F, eps, s))
-            kf, ks = ("filter_1bit", "smoother_1bit") if label == "1bit" else ("kalman_filter", "rts_smoother")
-            bounds[kf], bounds[ks] = bf, bs
-            steady[kf], steady[ks] = 1.0 / jf, 1.0 / (jf + kap)
-        for kind in ("filter_1bit", "smoother_1bit", "kalman_filter", "rts_smoother"):
-            m, lo, hi = mc.ci(kind)
-            rows.append(dict(alpha=1.0 - eps, snr_db=float(snr), kind=kind, mse=float(m), mse_lo=float(lo),
-                             mse_hi=float(hi), bound=bounds[kind], bound_steady=steady[kind],
-                             mse_over_bound=float(m) / bounds[kind], n_runs=mc.n))
-    return {"table": pd.DataFrame(rows)}
+            js = jf + float(rw_smoothing_gain_fixed_point(F, eps, s))
+            for kind, J, jss in ((kf, Jf, jf), (ks, Js, js)):
+                bounds[kind], steady[kind] = float(np.mean(1.0 / J[ev])), 1.0 / jss
+                dev[kind] = float(np.max(np.abs(jss / J[ev] - 1.0)))
+        design_cols = dict(tau=d["tau"], window_start=d["start"], window_stop=d["stop"], horizon=d["horizon"],
+                           stride=d["stride"], n_eval=len(ev), start_over_tau=d["start"] / d["tau"])
+        for kind in ESTIMATOR_KINDS:
+            v = runs[kind]
+            m, half = float(v.mean()), z * float(v.std(ddof=1)) / math.sqrt(len(v))
+            mse_rows.append(dict(alpha=1.0 - eps, snr_db=snr, kind=kind, mse=m, mse_lo=m - half, mse_hi=m + half,
+                                 bound=bounds[kind], bound_steady=steady[kind], mse_over_bound=m / bounds[kind],
+                                 n_runs=len(v), steady_dev=dev[kind], **design_cols))
+        bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
+        for qty, (ref, onebit, col) in RATIO_DEFS.items():
+            e, lo, hi = paired_ratio_interval(runs[ref], runs[onebit], est["n_boot"], seed)
+            ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
+                                   bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
+                                   steady_dev=max(dev[ref], dev[onebit]), **design_cols))
+    ratios = pd.DataFrame(ratio_rows)
+    for eps in est["one_minus_alpha"]:
+        sub = ratios[(ratios["quantity"] == "rho_S") & np.isclose(ratios["alpha"], 1.0 - eps, rtol=0, atol=1e-15)]
+        snr = sub["snr_db"].to_numpy()
+        for curve, col in (("estimate", "estimate_db"), ("lo", "lo_db"), ("hi", "hi_db")):
+            cross_rows.append(dict(alpha=1.0 - eps, curve=curve, snr_db_crossing=db_zero_crossing(snr, sub[col])))
+        cross_rows.append(dict(alpha=1.0 - eps, curve="bound",
+                               snr_db_crossing=rho_s_zero_crossing(eps, se, params["snr_definition"])))
+    return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": pd.DataFrame(cross_rows)}
 
 
 def run_estimator(params):
-    """Shard and merge in one process (tests, notebooks): the same table as the two pipeline steps."""
+    """Shard and merge in one process (tests, notebooks): the same tables as the two pipeline steps."""
     import tempfile
     from pathlib import Path
 
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "sums.npz"
-        estimator_shard_step(dict(params, shard=0, n_shards=1), {}, {"sums": path})
-        return estimator_step(params, {"shards": [path]}, {})["table"]
+        path = Path(tmp) / "runs.npz"
+        estimator_shard_step(dict(params, shard=0, n_shards=1), {}, {"runs": path})
+        return estimator_step(params, {"shards": [path]}, {})
+
+
+def alpha_scan_step(params, inputs, outputs):
+    """Tables ``alpha_scan.csv`` and ``alpha_threshold.csv``: rho_S (49) and the break-even lag over alpha.
+
+    ``alpha_scan.csv``: ``alpha, one_minus_alpha, snr_db, rho_s_db, rho_f_db, delta_break_even``
+    on the configured grid. ``alpha_threshold.csv``: per SNR the largest ``1 - alpha`` with
+    rho_S > 0 dB (bisection), and ``single_sign_change``: whether rho_S changes sign once along the
+    grid (the bisection's premise).
+    """
+    sc, se = params["alpha_scan"], params["sigma_eta"]
+    snr = np.asarray(sc["snr_db"], dtype=float)
+    rows = []
+    for eps in sc["one_minus_alpha"]:
+        res = information_ratios(snr, eps, se, params["snr_definition"])
+        Fq = res["efq"] / se**2
+        lag = rw_break_even_lag(Fq, np.full_like(Fq, 1.0 / se**2), eps, res["sigma_z2"]).astype(float)
+        rows.append(pd.DataFrame(dict(alpha=1.0 - eps, one_minus_alpha=eps, snr_db=snr, rho_s_db=res["rho_s_db"],
+                                      rho_f_db=res["rho_f_db"], delta_break_even=np.where(lag < 0, np.nan, lag))))
+    scan = pd.concat(rows, ignore_index=True)
+    thr = []
+    for x in snr:
+        col = scan[scan["snr_db"] == x].sort_values("one_minus_alpha")["rho_s_db"].to_numpy() > 0
+        eps_max = rho_s_threshold_eps(float(x), se, definition=params["snr_definition"])
+        thr.append(dict(snr_db=x, one_minus_alpha_max=eps_max, alpha_min=1.0 - eps_max,
+                        single_sign_change=bool(np.count_nonzero(np.diff(col.astype(int))) <= 1)))
+    return {"table": scan, "threshold": pd.DataFrame(thr)}
 
 
 def vector_check_step(params, inputs, outputs):
