@@ -58,7 +58,10 @@ from . import estimators as est
 from .exact import ExactMoments, exact_moments
 from .lmis import GilbertElliottLMI, bisect_monotone, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
 from .model import LinearSystem, observability_index, parity_bound_example2, prop1_bound, spectral_abs
-from .stability import REFINE_DEFAULTS, classify_growth, refine_long_horizon
+from .certificates import (
+    certificate_grid, critical_distance, decide_certified, true_critical_curve, two_reception_bound,
+)
+from .stability import classify_growth, decide_estimator, refine_long_horizon
 
 __all__ = [
     "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
@@ -214,47 +217,108 @@ def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
     return ExactMoments(coef, float(head["sum_norm"]), float(head["sum_trace"]))
 
 
-def stability_map_step(params, inputs, outputs):
-    """Independent stability map of E||P_k|| on a (p, q) grid.
+def _estimator_map(em, ex, e_idx, P, Qg, mp):
+    """The estimator cross-check of the map (exact extrapolation, then the long-horizon estimator)."""
+    opts = mp["refine"]
+    means = em.mean(P, Qg, "norm")
+    rate, last, verdict = classify_growth(means, mp["bounded_tol"], mp["unbounded_tol"])
+    exact_method = f"exact E||P_k|| over all 2^{em.depth - 1} channel paths (k<={em.depth + 1}), extrapolated growth"
+    f = pd.DataFrame({"verdict_estimator": verdict.ravel(), "growth_rate_exact": rate.ravel(),
+                      "growth_rate_last": last.ravel(), "mean_norm_last": means[..., -1].ravel(),
+                      "growth_rate_long": np.nan, "rel_halfwidth_long": np.nan, "method_estimator": exact_method})
+    todo = np.flatnonzero(f.verdict_estimator.to_numpy() == "undecided")
+    if opts["enabled"] and len(todo):
+        rng = np.random.default_rng([opts["seed"], e_idx])
+        r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
+                                                  P.ravel()[todo], Qg.ravel()[todo], opts, rng)
+        f.loc[todo, "growth_rate_long"] = r_long
+        f.loc[todo, "rel_halfwidth_long"] = rel
+        decided = todo[v_long != "undecided"]
+        f.loc[decided, "verdict_estimator"] = v_long[v_long != "undecided"]
+        f.loc[decided, "method_estimator"] = (f"conditional estimator of E tr P_k, k<={opts['horizon'] + 1}, "
+                                              f"{opts['n_paths']} paths, 95% half-width < {opts['rel_tol']:g} of the mean")
+        f.loc[todo[v_long == "undecided"], "method_estimator"] = "undecided: exact horizon too short, estimator not trusted"
+    return f, means
 
-    1. Exact E||P_k|| over all channel paths for ``k <= depth + 1`` (:func:`markov_math.exact_moments`),
-       growth extrapolated by :func:`classify_growth`.
-    2. Points left undecided get the long-horizon conditional estimator of E tr P_k
-       (:func:`refine_long_horizon`; trace and 2-norm are equivalent norms for boundedness),
-       trusted only where its confidence interval is narrow.
+
+def _sensitivity_rows(name, P, Qg, facts, cert_verdict, far, means, est, mp, system, Sigma0):
+    """Re-decide the map across the configured range of every threshold, one at a time."""
+    cc, sens = mp["certify"], mp["sensitivity"]
+    rows = []
+    base_est = est.verdict_estimator.to_numpy().reshape(P.shape)
+    long_rate = est.growth_rate_long.to_numpy().reshape(P.shape)
+    long_rel = est.rel_halfwidth_long.fillna(np.inf).to_numpy().reshape(P.shape)
+    est_args = {"bounded_tol": mp["bounded_tol"], "unbounded_tol": mp["unbounded_tol"],
+                "rel_tol": mp["refine"]["rel_tol"], "refine_bounded_tol": mp["refine"]["bounded_tol"],
+                "refine_unbounded_tol": mp["refine"]["unbounded_tol"]}
+
+    def row(threshold, value, default, applies, verdict, base):
+        rows.append({
+            "example": name, "threshold": threshold, "value": value, "is_default": bool(default),
+            "applies_to": applies, "n_bounded": int((verdict == "bounded").sum()),
+            "n_unbounded": int((verdict == "unbounded").sum()), "n_undecided": int((verdict == "undecided").sum()),
+            "n_undecided_far": int(((verdict == "undecided") & far).sum()),
+            "n_changed": int((verdict != base).sum()),
+            "n_contradict_certified": int((((verdict == "bounded") & (cert_verdict == "unbounded"))
+                                          | ((verdict == "unbounded") & (cert_verdict == "bounded"))).sum()),
+        })
+
+    for v in sens["rho_margin"]:
+        verdict, _ = decide_certified(facts, P, v, cc["growth_margin"])
+        row("certify.rho_margin", v, v == cc["rho_margin"], "certified map", verdict, cert_verdict)
+    for v in sens["growth_margin"]:
+        verdict, _ = decide_certified(facts, P, cc["rho_margin"], v)
+        row("certify.growth_margin", v, v == cc["growth_margin"], "certified map", verdict, cert_verdict)
+    two_rec = system.A.shape[0] == 2 * system.C.shape[0]
+    for v in sens["n_gaps"]:
+        alt = dict(facts)
+        if two_rec:
+            alt["upper"] = two_reception_bound(system, Sigma0, P, Qg, int(v))
+        verdict, _ = decide_certified(alt, P, cc["rho_margin"], cc["growth_margin"])
+        row("certify.n_gaps", v, v == cc["n_gaps"], "certified map", verdict, cert_verdict)
+    for key, cfg_key in (("bounded_tol", "bounded_tol"), ("unbounded_tol", "unbounded_tol"),
+                         ("rel_tol", "refine.rel_tol"), ("refine_bounded_tol", "refine.bounded_tol"),
+                         ("refine_unbounded_tol", "refine.unbounded_tol")):
+        for v in sens[key]:
+            verdict = decide_estimator(means, long_rate, long_rel, **dict(est_args, **{key: v}))
+            row(cfg_key, v, v == est_args[key], "estimator cross-check", verdict, base_est)
+    return rows
+
+
+def stability_map_step(params, inputs, outputs):
+    """Stability map of E||P_k|| on a (p, q) grid, decided by certificates only (:mod:`.certificates`).
+
+    ``verdict`` / ``bounded`` / ``method``: Theorem 1 with a computed gain or the two-reception upper
+    bound certify bounded; the loss-run or parity lower bounds certify unbounded; nothing else decides.
+    ``dist_critical`` is the distance to the true critical curve (every point at ``>= far`` must be decided).
+    The former estimator map (exact extrapolation, long-horizon conditional estimator) is kept as a
+    cross-check (``verdict_estimator``); ``map_sensitivity.csv`` re-decides both across their thresholds.
     """
     table = pd.read_csv(inputs["moments"])
     mp = params["map"]
-    opts = dict(REFINE_DEFAULTS, **mp.get("refine", {}))
+    cc = mp["certify"]
     ps = np.linspace(mp["p_min"], mp["p_max"], mp["p_points"])
     qs = np.linspace(mp["q_min"], mp["q_max"], mp["q_points"])
     P, Qg = np.meshgrid(ps, qs, indexing="ij")
-    frames = []
+    frames, sens = [], []
     for e_idx, (name, ex) in enumerate(params["examples"].items()):
-        em = load_moments(table, name)
-        means = em.mean(P, Qg, "norm")
-        rate, last, verdict = classify_growth(means, mp["bounded_tol"], mp["unbounded_tol"])
-        exact_method = f"exact E||P_k|| over all 2^{em.depth - 1} channel paths (k<={em.depth + 1}), extrapolated growth"
+        system, Sigma0 = _system(ex), np.asarray(ex["Sigma0"], float)
+        facts = certificate_grid(system, Sigma0, P, Qg, cc["n_gaps"])
+        verdict, method = decide_certified(facts, P, cc["rho_margin"], cc["growth_margin"])
+        curve_q, curve_p = true_critical_curve(ex.get("reference", "none"), spectral_abs(ex["A"]))
+        dist = critical_distance(Qg, P, curve_q, curve_p)
+        est, means = _estimator_map(load_moments(table, name), ex, e_idx, P, Qg, mp)
+        growth = np.fmax(facts["loss_growth"], facts["parity_growth"])
+        with np.errstate(divide="ignore"):
+            p_thm1 = 1.0 / facts["rho1"]
         f = pd.DataFrame({"example": name, "p": P.ravel(), "q": Qg.ravel(), "verdict": verdict.ravel(),
-                          "growth_rate": rate.ravel(), "growth_rate_exact": rate.ravel(), "growth_rate_last": last.ravel(),
-                          "mean_norm_last": means[..., -1].ravel(), "growth_rate_long": np.nan,
-                          "rel_halfwidth_long": np.nan, "method": exact_method})
-        todo = np.flatnonzero(f.verdict.to_numpy() == "undecided")
-        if opts["enabled"] and len(todo):
-            rng = np.random.default_rng([opts["seed"], e_idx])
-            r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
-                                                      f.p.to_numpy()[todo], f.q.to_numpy()[todo], opts, rng)
-            f.loc[todo, "growth_rate_long"] = r_long
-            f.loc[todo, "rel_halfwidth_long"] = rel
-            decided = todo[v_long != "undecided"]
-            f.loc[decided, "verdict"] = v_long[v_long != "undecided"]
-            f.loc[decided, "growth_rate"] = r_long[v_long != "undecided"]
-            f.loc[decided, "method"] = (f"conditional estimator of E tr P_k, k<={opts['horizon'] + 1}, "
-                                        f"{opts['n_paths']} paths, 95% half-width < {opts['rel_tol']:g} of the mean")
-            f.loc[todo[v_long == "undecided"], "method"] = "undecided: exact horizon too short, conditional estimator not trusted"
+                          "method": method.ravel(), "dist_critical": dist.ravel(), "p_thm1": p_thm1.ravel(),
+                          "upper_bound": facts["upper"].ravel(), "growth_rate": growth.ravel()})
+        f = pd.concat([f, est], axis=1)
         f.insert(3, "bounded", f.verdict.map({"bounded": "True", "unbounded": "False"}).fillna(""))
         frames.append(f)
-    return {"table": pd.concat(frames, ignore_index=True)}
+        sens += _sensitivity_rows(name, P, Qg, facts, verdict, dist >= mp["far"], means, est, mp, system, Sigma0)
+    return {"table": pd.concat(frames, ignore_index=True), "sensitivity": pd.DataFrame(sens)}
 
 
 def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
