@@ -54,9 +54,10 @@ import time
 import numpy as np
 import pandas as pd
 
+from ...engines.certify import bisect_certified
 from . import estimators as est
 from .exact import ExactMoments, exact_moments
-from .lmis import GilbertElliottLMI, bisect_monotone, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
+from .lmis import GilbertElliottLMI, as_verdict, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
 from .model import LinearSystem, observability_index, parity_bound_example2, prop1_bound, spectral_abs
 from .certificates import (
     certificate_grid, critical_distance, decide_certified, true_critical_curve, two_reception_bound,
@@ -67,6 +68,11 @@ __all__ = [
     "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
     "sample_paths_step", "load_moments",
 ]
+
+
+def _verdict(r):
+    """The table's verdict: ``feasible`` only with ``rho(H(K)) < 1`` too (see :func:`.lmis.thm5_lower_bound`)."""
+    return as_verdict(r).verdict
 
 
 def _system(ex):
@@ -114,6 +120,8 @@ def critical_curves_step(params, inputs, outputs):
                 "thm5_saturated": res["saturated"], "thm5_n_solves": res["n_solves"],
                 "thm5_n_uncertified": res["n_uncertified"], "thm5_statuses": "|".join(res["statuses"]),
                 "rho_H_at_lower": res["rho_at_lower"], "p_reference": pr, "reference": ref_text,
+                "thm5_certified": res["certified"] or res["saturated"], "thm5_n_undecided": res["n_undecided"],
+                "thm5_lower_evidence": res["lower_evidence"], "thm5_upper_evidence": res["upper_evidence"],
             })
         elapsed = time.perf_counter() - t0
         # benchmark, same run: parametrised problem vs rebuilding it for every solve
@@ -150,6 +158,7 @@ def lmi_checks_step(params, inputs, outputs):
         p = float(item["p"])
         r = lmi.solve(p, float(item["q"]))
         rows.append({"check": item["name"], "example": item["example"], "p": p, "q": item["q"], "status": r.status,
+                     "verdict": _verdict(r), "evidence": r.evidence,
                      "margin": r.margin, "solver_feasible": r.solver_feasible, "certified": r.certified,
                      "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
     for item in ck["tight"]:
@@ -160,7 +169,8 @@ def lmi_checks_step(params, inputs, outputs):
         for label, p in (("tight_lower", res["p_lower"]), ("tight_upper", res["p_upper"])):
             r = lmi.solve(float(p), float(item["q"]))
             rows.append({"check": f"{item['name']}_{label}", "example": item["example"], "p": p, "q": item["q"],
-                         "status": r.status, "margin": r.margin, "solver_feasible": r.solver_feasible,
+                         "status": r.status, "verdict": _verdict(r), "evidence": r.evidence,
+                         "margin": r.margin, "solver_feasible": r.solver_feasible,
                          "certified": r.certified, "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
     return {"table": pd.DataFrame(rows)}
 
@@ -173,10 +183,11 @@ def iid_line_step(params, inputs, outputs):
         A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
         lam = spectral_abs(A)
         lower = 1.0 - 1.0 / lam ** 2
-        upper, _ = sinopoli_lmi_threshold(A, C, tol)
+        upper, _, sin_br = sinopoli_lmi_threshold(A, C, tol)
         lmi = GilbertElliottLMI(A, C)
         # feasibility at (p, q) = (1 - q, q) is monotone in q: p falls while p_underline(q) rises
-        res = bisect_monotone(lambda q: lmi.solve(1.0 - q, q).certified, lower + 1e-6, 1.0 - 1e-6, tol=tol)
+        res = bisect_certified(lambda q: as_verdict(lmi.solve(1.0 - q, q)), lower + 1e-6, 1.0 - 1e-6, tol=tol,
+                               feasible_above=True)
         kind = ex.get("reference", "none")
         if kind == "nondegenerate":
             ref, text = lower, "non-degenerate: lambda_c = 1 - 1/|lambda|^2 (Mo & Sinopoli)"
@@ -185,8 +196,10 @@ def iid_line_step(params, inputs, outputs):
         else:
             ref, text = np.nan, ""
         rows.append({"example": name, "lambda_lower": lower, "lambda_lmi_upper": upper,
-                     "q_thm5_on_iid_line": res.threshold, "lambda_c_reference": ref, "reference": text,
-                     "consistent": bool(lower - tol <= ref <= min(upper, res.threshold) + tol)})
+                     "lambda_lmi_upper_infeasible_end": sin_br.infeasible_end, "lambda_lmi_certified": sin_br.certified,
+                     "q_thm5_on_iid_line": res.feasible_end, "q_thm5_infeasible_end": res.infeasible_end,
+                     "q_thm5_certified": res.certified, "lambda_c_reference": ref, "reference": text,
+                     "consistent": bool(lower - tol <= ref <= min(upper, res.feasible_end) + tol)})
     return {"table": pd.DataFrame(rows)}
 
 
