@@ -18,7 +18,7 @@ from .model import L_operator, h_radius, observability_index, stacked_output
 
 __all__ = [
     "SOLVER", "CANDIDATE_STATUSES", "bisect_monotone", "LMIResult", "GilbertElliottLMI", "certify",
-    "rebuild_solve", "thm5_lower_bound", "sinopoli_lmi_threshold", "schur_residual", "lmi_necessary_condition", "as_verdict",
+    "rebuild_solve", "thm5_lower_bound", "sinopoli_lmi_threshold", "schur_residual", "lmi_necessary_condition", "as_verdict", "kernel_rate",
 ]
 
 SOLVER = "CLARABEL"
@@ -354,7 +354,12 @@ def thm5_lower_bound(lmi: GilbertElliottLMI, q: float, p_max: float, tol: float,
         results[p] = res
         return as_verdict(res)
 
-    br = bisect_certified(decide, p_min, p_max, tol=tol, max_evals=200, feasible_above=False)
+    # the kernel bound p < 1 / c(q) is only a starting guess (it changes the number of solves, not the answer)
+    lam = float(np.max(np.abs(np.linalg.eigvals(lmi.A))))
+    c = kernel_rate(lmi.A, lmi.C, q) if lam ** 2 * (1 - q) < 1 else np.nan
+    guess = 1.0 / c if np.isfinite(c) and p_min < 1.0 / c < p_max else None
+    br = bisect_certified(decide, p_min, p_max, tol=tol, max_evals=200, feasible_above=False, guess=guess,
+                          width=4 * tol if guess is not None else 0.0)
     feas = [r for r in results.values() if r.certified]
     best = max(feas, key=lambda r: r.p) if feas else None
     saturated = bool(np.isnan(br.infeasible_end) and br.feasible_end == p_max)
@@ -418,8 +423,6 @@ def lmi_necessary_condition(A, C, p, q, margin: float = 1e-9):
     (bool, str)
         Whether a necessary condition is violated, and the numbers.
     """
-    from scipy.linalg import solve_discrete_lyapunov
-
     A, C = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(C, float))
     lam = float(np.max(np.abs(np.linalg.eigvals(A))))
     loss = lam ** 2 * (1.0 - q)
@@ -427,9 +430,35 @@ def lmi_necessary_condition(A, C, p, q, margin: float = 1e-9):
         return True, f"|lambda_A|^2 (1-q) = {loss:.12g} >= 1"
     if loss >= 1.0 - 1e-6:
         return False, f"|lambda_A|^2 (1-q) = {loss:.12g} (too close to 1 to use the kernel bound)"
+    c = kernel_rate(A, C, q)
+    if not np.isfinite(c):
+        return False, "no kernel bound (C has a trivial kernel, or its vector is outside the range of S_1)"
+    bound = p * c
+    return bool(bound >= 1.0 + margin), f"p min_K rho(H(K)) >= {bound:.12g} (kernel/Collatz-Wielandt bound)"
+
+
+def kernel_rate(A, C, q):
+    """``c(q)`` with ``rho(H(K)) >= p c(q)`` for every ``K`` (see :func:`lmi_necessary_condition`), or ``nan``.
+
+    Parameters
+    ----------
+    A, C : array_like
+        System and output matrices.
+    q : float
+        Recovery rate with ``|lambda_A|^2 (1-q) < 1``.
+
+    Returns
+    -------
+    float
+        ``c = 1 / (v' S_1^+ v)`` for the kernel vector ``v`` of ``C``; ``1 / c`` is an upper bound on
+        Theorem 5's ``p_underline(q)`` (equal to it for both examples).
+    """
+    from scipy.linalg import solve_discrete_lyapunov
+
+    A, C = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(C, float))
     _, s, vt = np.linalg.svd(C)
     if C.shape[0] >= A.shape[0] and s.min() > 1e-12 * s.max():
-        return False, "C has a trivial kernel: no kernel bound"
+        return np.nan
     v = vt[-1]
     Av = A @ v
     Z = solve_discrete_lyapunov(np.sqrt(1.0 - q) * A, np.outer(Av, Av))  # sum_m (1-q)^m A^m Av Av' A^m'
@@ -438,12 +467,9 @@ def lmi_necessary_condition(A, C, p, q, margin: float = 1e-9):
     w, U = np.linalg.eigh(S1)
     keep = w > 1e-12 * w.max()
     coef = U[:, keep].T @ v
-    resid = np.linalg.norm(v - U[:, keep] @ coef)
-    if resid > 1e-9:
-        return False, "kernel vector outside the range of S_1: no kernel bound"
-    c = 1.0 / float(np.sum(coef ** 2 / w[keep]))
-    bound = p * c
-    return bool(bound >= 1.0 + margin), f"p min_K rho(H(K)) >= {bound:.12g} (kernel/Collatz-Wielandt bound)"
+    if np.linalg.norm(v - U[:, keep] @ coef) > 1e-9:
+        return np.nan
+    return 1.0 / float(np.sum(coef ** 2 / w[keep]))
 
 
 def sinopoli_lmi_threshold(A, C, tol: float = 1e-5):
