@@ -204,7 +204,7 @@ def iid_line_step(params, inputs, outputs):
 
 
 def exact_moments_step(params, inputs, outputs):
-    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`markov_math.exact_moments`)."""
+    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`.exact.exact_moments`)."""
     frames = []
     for name, ex in params["examples"].items():
         em = exact_moments(_system(ex), np.asarray(ex["Sigma0"], float), params["exact"]["depth"])
@@ -222,7 +222,7 @@ def exact_moments_step(params, inputs, outputs):
 
 
 def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
-    """Rebuild :class:`~netrepro.papers.markov_math.ExactMoments` from ``exact_moments.csv``."""
+    """Rebuild :class:`~netrepro.papers.markov.exact.ExactMoments` from ``exact_moments.csv``."""
     sub = table[table["example"] == example]
     head = sub[sub["depth"] == 0].iloc[0]
     cols = ["n11", "n10", "n01", "n00", "sum_norm", "sum_trace"]
