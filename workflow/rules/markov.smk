@@ -78,6 +78,7 @@ rule markov_stability_map:
         moments=rules.markov_exact_moments.output.table,
     output:
         table="results/markov/stability_map.csv",
+        sensitivity="results/markov/map_sensitivity.csv",
     log:
         "logs/markov/stability_map.log",
     conda:
@@ -171,6 +172,7 @@ if enabled("markov"):
         rules.markov_iid_line.output.table,
         rules.markov_exact_moments.output.table,
         rules.markov_stability_map.output.table,
+        rules.markov_stability_map.output.sensitivity,
         rules.markov_sample_paths.output.table,
         rules.markov_sample_paths.output.check,
     ]

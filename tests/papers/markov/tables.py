@@ -11,7 +11,8 @@ from netrepro.papers.markov import checks, claims, steps
 __all__ = ["tiny_config", "run_all", "NAMES"]
 
 ROOT = Path(__file__).resolve().parents[3]
-NAMES = ("curves", "bench", "checks", "iid", "moments", "map", "paths", "check", "claims", "errata", "recon")
+NAMES = ("curves", "bench", "checks", "iid", "moments", "map", "sensitivity", "paths", "check", "claims", "errata",
+         "recon")
 
 
 def tiny_config() -> dict:
@@ -41,7 +42,7 @@ def run_all(cfg: dict, tmp: Path) -> dict:
     _run(steps.lmi_checks_step, cfg, {}, {"table": t["checks"]})
     _run(steps.iid_line_step, cfg, {}, {"table": t["iid"]})
     _run(steps.exact_moments_step, cfg, {}, {"table": t["moments"]})
-    _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"]})
+    _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"], "sensitivity": t["sensitivity"]})
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
     _run(claims.claims_step, cfg, {"checks": t["checks"], "curves": t["curves"], "iid": t["iid"], "map": t["map"],
                                    "moments": t["moments"]}, {"table": t["claims"]})

@@ -25,7 +25,7 @@ def test_lmi_feasible_is_certified_and_matches_rebuild():
     again = lmis.rebuild_solve(A1, C1, 1 - 1e-6, 0.65)
     assert again.margin == pytest.approx(res.margin, rel=1e-4)
     bad = lmis.GilbertElliottLMI(A2, C2).solve(1.0, 0.5)  # Section 5.2: infeasible at p = 1, q = 0.5
-    assert not bad.certified
+    assert not bad.certified and bad.verdict == "infeasible"
 
 
 def test_thm5_equals_direct_minimisation_of_rho():
@@ -48,6 +48,24 @@ def test_thm5_example2_closed_form():
     res = lmis.thm5_lower_bound(lmi, 0.5, 1.0, 1e-6)
     closed = model.parity_bound_example2(1.2, 0.5)
     assert closed == pytest.approx(0.464506, abs=1e-6)
-    assert res["p_lower"] <= closed + 1e-6 and res["p_upper"] >= closed - 2e-6
+    # issue 16: both ends certified, and the true boundary (closed form) lies inside the bracket
+    assert res["certified"] and res["p_lower"] <= closed <= res["p_upper"]
+    assert res["p_upper"] - res["p_lower"] < 2e-6 and res["n_uncertified"] == 0
     assert res["p_lower"] < 0.465  # the paper's "p <= 0.465" is not certified
+
+
+def test_necessary_condition_is_the_closed_form_and_the_direct_minimum():
+    """The kernel (Collatz-Wielandt) bound: Example II = the parity closed form; Example I = 1 / min_K rho(H_1(K))
+    found by Nelder-Mead (certificates.thm1_radius, a different algorithm); both tight to 1e-7."""
+    from netrepro.papers.markov.certificates import thm1_radius
+
+    for q in (0.4, 0.5, 0.8):
+        closed = model.parity_bound_example2(1.2, q)
+        assert lmis.lmi_necessary_condition(A2, C2, closed * (1 + 1e-7), q)[0]
+        assert not lmis.lmi_necessary_condition(A2, C2, closed * (1 - 1e-7), q)[0]
+    rho1, _ = thm1_radius(A1, C1, [0.5, 0.7])
+    for q, r in zip((0.5, 0.7), rho1):
+        assert lmis.lmi_necessary_condition(A1, C1, (1 + 1e-6) / r, q)[0]
+        assert not lmis.lmi_necessary_condition(A1, C1, (1 - 1e-6) / r, q)[0]
+    assert lmis.lmi_necessary_condition(A1, C1, 0.1, 0.3)[0]  # |lambda|^2 (1-q) >= 1
 

@@ -12,9 +12,14 @@ exact
     exact ``E||P_k||`` over all channel paths, as polynomials in ``(p, q)``.
 estimators
     plain and conditional Monte Carlo estimators of ``E||P_k||``.
+certificates
+    certified bounds that decide the stability map (Theorem 1 gains, two-reception upper bound,
+    loss-run and parity lower bounds).
 stability
-    growth-rate verdicts of the stability map.
+    estimator verdicts of the stability map (a cross-check).
 steps
     pipeline steps (tables); ``claims`` the claims, errata, reconstructions; ``figures`` plotting;
     ``checks`` configuration checks.
 """
+
+__all__ = ["model", "lmis", "certificates", "exact", "estimators", "stability", "steps", "claims", "figures", "checks"]

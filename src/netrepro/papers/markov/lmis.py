@@ -18,7 +18,7 @@ from .model import L_operator, h_radius, observability_index, stacked_output
 
 __all__ = [
     "SOLVER", "CANDIDATE_STATUSES", "bisect_monotone", "LMIResult", "GilbertElliottLMI", "certify",
-    "rebuild_solve", "thm5_lower_bound", "sinopoli_lmi_threshold", "schur_residual",
+    "rebuild_solve", "thm5_lower_bound", "sinopoli_lmi_threshold", "schur_residual", "lmi_necessary_condition", "as_verdict", "kernel_rate",
 ]
 
 SOLVER = "CLARABEL"
@@ -70,6 +70,8 @@ class LMIResult:
         The certificate's spectral radius and ``min eig(X - L_K(X))``.
     K : list of arrays
         Recovered gains ``K^{(i)}``.
+    verdict, evidence : str
+        The certified verdict (:mod:`netrepro.engines.certify`) and its evidence.
     """
 
     p: float
@@ -81,6 +83,8 @@ class LMIResult:
     rho_H: float  # spectral radius of H(K) of eq. (7) for the recovered K (nan if none)
     lyap_margin: float  # min eig of X - L_K(X) (Theorem 2 (iii)) for the solver's X
     K: list = field(default_factory=list)
+    verdict: str = ""  # certified verdict of the engine: feasible / infeasible / undecided
+    evidence: str = ""  # what backs the verdict (eigenvalue check, necessary condition, dual certificate)
 
 
 class GilbertElliottLMI:
@@ -149,8 +153,14 @@ class GilbertElliottLMI:
         psi = cp.bmat([[X] + [c.T for c in cols]] + [[cols[i]] + [Y if j == i else Z for j in range(r)]
                                                      for i in range(r)])
         size = n * (r + 1)
-        cons = [0.5 * (lmi10 + lmi10.T) >> 0, 0.5 * (psi + psi.T) >> self.t * np.eye(size), Y << np.eye(n)]
+        # (10) >= t I as well as Psi >= t I: the proposed point is then interior to both blocks, so our
+        # eigenvalue check can certify it (a point on the boundary of (10) could never be certified)
+        cons = [0.5 * (lmi10 + lmi10.T) >> self.t * np.eye(3 * n), 0.5 * (psi + psi.T) >> self.t * np.eye(size),
+                Y << np.eye(n)]
         self.problem = cp.Problem(cp.Maximize(self.t), cons)
+        # the question asked of the certify engine: (10) >= 0 and Psi > 0 (t dropped); Y <= I is a normalisation
+        self.blocks = [("lmi10", cons[0]), ("psi", cons[1])]
+        self._certifier = None
         self.n_solves = 0
         self.solve_time = 0.0
 
@@ -160,7 +170,12 @@ class GilbertElliottLMI:
         self.sw.value = np.sqrt(np.array([p * (1.0 - p) ** (i - 1) for i in range(1, self.l_o)]))
 
     def solve(self, p: float, q: float) -> LMIResult:
-        """Solve at ``(p, q)``; recover ``K^{(i)} = Y^{-1} F_i'`` and certify ``rho(H(K)) < 1``.
+        """Solve at ``(p, q)``, certify the answer with the shared engine, recover ``K^{(i)} = Y^{-1} F_i'``
+        and check ``rho(H(K)) < 1``.
+
+        The verdict is ``feasible`` (our eigenvalue check of (10) and (11) at the returned point,
+        whatever the solver status), ``infeasible`` (:func:`lmi_necessary_condition` violated, or a
+        checked dual certificate) or ``undecided``. ``certified`` = feasible and ``rho(H(K)) < 1``.
 
         Parameters
         ----------
@@ -190,12 +205,27 @@ class GilbertElliottLMI:
             status = f"solver_error: {exc}"
         self.solve_time += time.perf_counter() - start
         self.n_solves += 1
+        verdict = self.certifier.certify(status, necessary=lambda: lmi_necessary_condition(self.A, self.C, p, q))
         return certify(self.A, self.C, p, q, status, self.t.value, self.X.value, self.Y.value,
-                       [F.value for F in self.F], self.margin_tol)
+                       [F.value for F in self.F], self.margin_tol, verdict)
+
+    @property
+    def certifier(self):
+        """The :class:`~netrepro.engines.certify.CertifiedLMI` of (10) ``>= 0``, ``Psi > 0`` (built once).
+
+        Returns
+        -------
+        netrepro.engines.certify.CertifiedLMI
+        """
+        if self._certifier is None:
+            from ...engines.certify import CertifiedLMI
+
+            self._certifier = CertifiedLMI(self.blocks, problem=self.problem, drop=[self.t])
+        return self._certifier
 
 
-def certify(A, C, p, q, status, t, X, Y, F, margin_tol) -> LMIResult:
-    """Independent check of a solver answer: ``rho(H(K)) < 1`` (eq. 7) and ``X - L_K(X) > 0`` (Thm 2 (iii)).
+def certify(A, C, p, q, status, t, X, Y, F, margin_tol, verdict=None) -> LMIResult:
+    """Independent checks of an answer: the engine's verdict, ``rho(H(K)) < 1`` (eq. 7) and ``X - L_K(X) > 0`` (Thm 2 (iii)).
 
     Parameters
     ----------
@@ -212,20 +242,32 @@ def certify(A, C, p, q, status, t, X, Y, F, margin_tol) -> LMIResult:
     F : list of ndarray or None
         Solver variables ``F_i``.
     margin_tol : float
-        Smallest margin counted as solver-feasible.
+        Smallest margin counted as solver-feasible (``solver_feasible``, information only when
+        ``verdict`` is given).
+    verdict : netrepro.engines.certify.Verdict or None
+        The engine's certified verdict. ``None`` (benchmark only): the legacy rule, solver status
+        and margin, then ``rho(H(K)) < 1``.
 
     Returns
     -------
     LMIResult
     """
     margin = float(t) if t is not None else np.nan
-    feasible = status in CANDIDATE_STATUSES and margin > margin_tol
-    if not feasible or Y is None or any(f is None for f in F):
-        return LMIResult(p, q, status, margin, False, False, np.nan, np.nan)
-    K = [np.linalg.solve(Y, f.T) for f in F]
+    solver_feasible = status in CANDIDATE_STATUSES and margin > margin_tol
+    v, ev = (verdict.verdict, verdict.evidence) if verdict is not None else ("", "legacy rule (not certified)")
+    usable = Y is not None and X is not None and all(f is not None for f in F)
+    if verdict is None and not solver_feasible:
+        usable = False
+    if not usable:
+        return LMIResult(p, q, status, margin, solver_feasible, False, np.nan, np.nan, [], v, ev)
+    try:
+        K = [np.linalg.solve(Y, f.T) for f in F]
+    except np.linalg.LinAlgError:
+        return LMIResult(p, q, status, margin, solver_feasible, False, np.nan, np.nan, [], v, ev)
     rho = h_radius(A, C, K, p, q)
     lyap = float(np.min(np.linalg.eigvalsh(X - L_operator(A, C, K, p, q, X))))
-    return LMIResult(p, q, status, margin, True, bool(rho < 1.0), rho, lyap, K)
+    ok = bool(rho < 1.0) and (verdict.feasible if verdict is not None else solver_feasible)
+    return LMIResult(p, q, status, margin, solver_feasible, ok, rho, lyap, K, v, ev)
 
 
 def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
@@ -263,7 +305,7 @@ def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
             for i in range(1, r + 1)]
     psi = cp.bmat([[X] + [c.T for c in cols]] + [[cols[i]] + [Y if j == i else Z for j in range(r)]
                                                  for i in range(r)])
-    prob = cp.Problem(cp.Maximize(t), [0.5 * (lmi10 + lmi10.T) >> 0,
+    prob = cp.Problem(cp.Maximize(t), [0.5 * (lmi10 + lmi10.T) >> t * np.eye(3 * n),
                                        0.5 * (psi + psi.T) >> t * np.eye(n * (r + 1)), Y << np.eye(n)])
     try:
         prob.solve(solver=SOLVER)
@@ -276,7 +318,10 @@ def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
 def thm5_lower_bound(lmi: GilbertElliottLMI, q: float, p_max: float, tol: float, p_min: float = 1e-6):
     """Theorem 5, eq. (12): ``p_underline(q) = sup{p : exists (K, P), L_K(P) < P, P > 0}`` by bisection.
 
-    A point counts as feasible only when the solver says so *and* ``rho(H(K)) < 1`` is certified.
+    Certified bisection (:func:`netrepro.engines.certify.bisect_certified`): a point is feasible when the
+    engine's eigenvalue check passes *and* ``rho(H(K)) < 1``; infeasible when
+    :func:`lmi_necessary_condition` is violated or a dual certificate is checked; both bracket ends are
+    certified (``certified``), undecided points are never an end.
     For ``l_o = 2`` the LMI depends on ``p`` only through ``sqrt(p)`` and feasibility is monotone
     in ``p`` (``L_K`` is ``p`` times a fixed operator), so bisection is exact up to ``tol``.
 
@@ -295,32 +340,136 @@ def thm5_lower_bound(lmi: GilbertElliottLMI, q: float, p_max: float, tol: float,
 
     Returns
     -------
-    dict with ``p_lower`` (largest certified-feasible p found), ``p_upper`` (smallest infeasible),
-    ``saturated`` (feasible at ``p_max``), ``n_solves``, ``n_uncertified`` (solver-feasible but not
-    certified), ``statuses`` (set of solver statuses seen), ``rho_at_lower``.
+    dict with ``p_lower`` (certified-feasible end), ``p_upper`` (certified-infeasible end, nan if none),
+    ``certified`` (both ends), ``saturated`` (feasible at ``p_max``), ``n_solves``, ``n_undecided``,
+    ``n_uncertified`` (engine-feasible but ``rho(H(K)) >= 1``: must be 0), ``statuses`` (solver statuses
+    seen, information only), ``rho_at_lower``, ``lower_evidence``, ``upper_evidence``.
     """
+    from ...engines.certify import bisect_certified
+
     results = {}
 
-    def infeasible(p):
+    def decide(p):
         res = lmi.solve(p, q)
         results[p] = res
-        return not res.certified
+        return as_verdict(res)
 
-    out = bisect_monotone(infeasible, p_min, p_max, tol=tol, max_evals=200)
+    # the kernel bound p < 1 / c(q) is only a starting guess (it changes the number of solves, not the answer)
+    lam = float(np.max(np.abs(np.linalg.eigvals(lmi.A))))
+    c = kernel_rate(lmi.A, lmi.C, q) if lam ** 2 * (1 - q) < 1 else np.nan
+    guess = 1.0 / c if np.isfinite(c) and p_min < 1.0 / c < p_max else None
+    br = bisect_certified(decide, p_min, p_max, tol=tol, max_evals=200, feasible_above=False, guess=guess,
+                          width=4 * tol if guess is not None else 0.0)
     feas = [r for r in results.values() if r.certified]
     best = max(feas, key=lambda r: r.p) if feas else None
-    if np.isnan(out.threshold):  # infeasible never found: feasible up to p_max
-        p_lower, p_upper, saturated = p_max, np.nan, True
-    elif not out.bracketed:  # infeasible at p_min
-        p_lower, p_upper, saturated = 0.0, p_min, False
-    else:
-        p_lower, p_upper, saturated = out.lower, out.threshold, False
+    saturated = bool(np.isnan(br.infeasible_end) and br.feasible_end == p_max)
+    p_lower = br.feasible_end if np.isfinite(br.feasible_end) else 0.0
+    lower_res, upper_res = results.get(br.feasible_end), results.get(br.infeasible_end)
     return {
-        "p_lower": p_lower, "p_upper": p_upper, "saturated": saturated, "n_solves": out.n_evals,
-        "n_uncertified": sum(r.solver_feasible and not r.certified for r in results.values()),
+        "p_lower": p_lower, "p_upper": br.infeasible_end, "saturated": saturated, "n_solves": br.n_evals,
+        "certified": bool(br.certified), "n_undecided": len(br.undecided),
+        "n_uncertified": sum(r.verdict == "feasible" and not r.certified for r in results.values()),
         "statuses": sorted({r.status for r in results.values()}),
         "rho_at_lower": best.rho_H if best is not None else np.nan,
+        "lower_evidence": lower_res.evidence if lower_res is not None else "",
+        "upper_evidence": upper_res.evidence if upper_res is not None else "",
     }
+
+
+def as_verdict(res: LMIResult):
+    """The engine verdict of a solve, with ``feasible`` kept only when ``rho(H(K)) < 1`` also holds.
+
+    Parameters
+    ----------
+    res : LMIResult
+        One solve of :class:`GilbertElliottLMI`.
+
+    Returns
+    -------
+    netrepro.engines.certify.Verdict
+        ``feasible`` (eigenvalue check and ``rho(H(K)) < 1``), ``infeasible`` or ``undecided``.
+    """
+    from ...engines.certify import UNDECIDED, Verdict
+
+    if res.verdict == "feasible" and not res.certified:
+        return Verdict(UNDECIDED, res.status, f"eigenvalue check passed but rho(H(K)) = {res.rho_H:.6g} >= 1")
+    return Verdict(res.verdict or UNDECIDED, res.status, res.evidence)
+
+
+def lmi_necessary_condition(A, C, p, q, margin: float = 1e-9):
+    """Necessary conditions for the LMI (10)-(11), computed without it: ``(violated, evidence)``.
+
+    1. (10) with ``X, Y > 0`` gives ``Y - (1-q) A'YA >= q A'XA > 0``, so ``sqrt(1-q) A`` is Schur:
+       ``|lambda_A|^2 (1-q) < 1``.
+    2. Theorem 2: a feasible LMI gives a ``K`` with ``rho(H(K)) < 1`` (eq. 7). For ``v != 0`` with
+       ``C v = 0`` the forward map of ``H(K)`` sends ``v v'`` to ``p S_1`` with
+       ``S_1 = q sum_j (1-q)^{j-1} A^j (A v)(A v)' (A^j)'`` *for every* ``K`` (``(A + K C) v = A v``),
+       and ``S_1 >= c v v'`` with ``c = 1 / (v' S_1^+ v)`` when ``v`` is in the range of ``S_1``. A
+       positive map with ``T(X) >= r X``, ``X >= 0``, ``X != 0`` has ``rho(T) >= r`` (Collatz-Wielandt),
+       so ``p c >= 1`` makes every ``rho(H(K)) >= 1``: ``p min_K rho(H(K)) >= 1``, the LMI is infeasible.
+       For Example II this is the parity bound (``p c = pq|lambda|^4 / (1 - (|lambda|^2 (1-q))^2)``).
+
+    Parameters
+    ----------
+    A, C : array_like
+        System and output matrices (``l_o = 2``: one gain).
+    p, q : float
+        Failure and recovery rates.
+    margin : float
+        Violated only when the bound exceeds ``1 + margin`` (rounding of the Stein solution, ~1e-12).
+
+    Returns
+    -------
+    (bool, str)
+        Whether a necessary condition is violated, and the numbers.
+    """
+    A, C = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(C, float))
+    lam = float(np.max(np.abs(np.linalg.eigvals(A))))
+    loss = lam ** 2 * (1.0 - q)
+    if loss >= 1.0 + margin:
+        return True, f"|lambda_A|^2 (1-q) = {loss:.12g} >= 1"
+    if loss >= 1.0 - 1e-6:
+        return False, f"|lambda_A|^2 (1-q) = {loss:.12g} (too close to 1 to use the kernel bound)"
+    c = kernel_rate(A, C, q)
+    if not np.isfinite(c):
+        return False, "no kernel bound (C has a trivial kernel, or its vector is outside the range of S_1)"
+    bound = p * c
+    return bool(bound >= 1.0 + margin), f"p min_K rho(H(K)) >= {bound:.12g} (kernel/Collatz-Wielandt bound)"
+
+
+def kernel_rate(A, C, q):
+    """``c(q)`` with ``rho(H(K)) >= p c(q)`` for every ``K`` (see :func:`lmi_necessary_condition`), or ``nan``.
+
+    Parameters
+    ----------
+    A, C : array_like
+        System and output matrices.
+    q : float
+        Recovery rate with ``|lambda_A|^2 (1-q) < 1``.
+
+    Returns
+    -------
+    float
+        ``c = 1 / (v' S_1^+ v)`` for the kernel vector ``v`` of ``C``; ``1 / c`` is an upper bound on
+        Theorem 5's ``p_underline(q)`` (equal to it for both examples).
+    """
+    from scipy.linalg import solve_discrete_lyapunov
+
+    A, C = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(C, float))
+    _, s, vt = np.linalg.svd(C)
+    if C.shape[0] >= A.shape[0] and s.min() > 1e-12 * s.max():
+        return np.nan
+    v = vt[-1]
+    Av = A @ v
+    Z = solve_discrete_lyapunov(np.sqrt(1.0 - q) * A, np.outer(Av, Av))  # sum_m (1-q)^m A^m Av Av' A^m'
+    S1 = q * A @ Z @ A.T
+    S1 = 0.5 * (S1 + S1.T)
+    w, U = np.linalg.eigh(S1)
+    keep = w > 1e-12 * w.max()
+    coef = U[:, keep].T @ v
+    if np.linalg.norm(v - U[:, keep] @ coef) > 1e-9:
+        return np.nan
+    return 1.0 / float(np.sum(coef ** 2 / w[keep]))
 
 
 def sinopoli_lmi_threshold(A, C, tol: float = 1e-5):
@@ -338,14 +487,17 @@ def sinopoli_lmi_threshold(A, C, tol: float = 1e-5):
 
     Returns
     -------
-    (float, int)
-        The threshold and the number of LMI solves.
+    (float, int, CertifiedBracket)
+        The certified-feasible end (the upper bound on ``lambda_c``), the number of LMI solves and
+        the bracket (both ends certified when ``certified``).
     """
     from ...engines.lmi import MareStabilizabilityLMI
 
+    from ...engines.certify import bisect_certified
+
     lmi = MareStabilizabilityLMI(A, [None, C])
-    res = bisect_monotone(lambda lam: lmi.solve([1 - lam, lam]).certified, 1e-6, 1.0, tol=tol)
-    return res.threshold, lmi.n_solves
+    br = bisect_certified(lambda lam: lmi.certify([1 - lam, lam]), 1e-6, 1.0, tol=tol, feasible_above=True)
+    return br.feasible_end, lmi.n_solves, br
 
 
 def schur_residual(A, C, p, q, rng):

@@ -1,5 +1,6 @@
-"""Growth-rate verdicts of the stability map: extrapolated growth of the exact ``E||P_k||`` and the
-long-horizon conditional estimator for points the exact horizon leaves undecided.
+"""Estimator verdicts of the stability map (a cross-check; the map is decided by :mod:`.certificates`):
+extrapolated growth of the exact ``E||P_k||`` and the long-horizon conditional estimator for points
+the exact horizon leaves undecided. Both depend on thresholds; ``map_sensitivity.csv`` shows how much.
 """
 
 from __future__ import annotations
@@ -8,7 +9,7 @@ import numpy as np
 
 from .estimators import rb_trace_grid
 
-__all__ = ["classify_growth", "REFINE_DEFAULTS", "refine_long_horizon"]
+__all__ = ["classify_growth", "refine_long_horizon", "decide_estimator"]
 
 
 def classify_growth(means: np.ndarray, bounded_tol: float, unbounded_tol: float):
@@ -49,11 +50,6 @@ def classify_growth(means: np.ndarray, bounded_tol: float, unbounded_tol: float)
     return rate, x2, verdict
 
 
-REFINE_DEFAULTS = {"enabled": True, "n_paths": 200, "horizon": 160, "n_batches": 10, "rel_tol": 0.1,
-                   "bounded_tol": 0.003, "unbounded_tol": 0.01, "chunk": 64, "seed": 4242,
-                   "pilot_paths": 100, "pilot_horizon": 60}
-
-
 def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
     """Long-horizon verdicts from the conditional trace estimator (:func:`~.estimators.rb_trace_grid`).
 
@@ -73,7 +69,7 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
     ps, qs : array_like
         The points.
     opts : dict
-        Estimator settings (keys of :data:`REFINE_DEFAULTS`).
+        Estimator settings (``config.yaml``: ``markov.map.refine``).
     rng : numpy.random.Generator
         Random source.
 
@@ -102,3 +98,36 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
                                                          np.where(rate > opts["unbounded_tol"], "unbounded", "undecided")))
     return rate, rel, verdict
 
+
+
+def decide_estimator(means, long_rate, long_rel, bounded_tol, unbounded_tol, rel_tol, refine_bounded_tol,
+                     refine_unbounded_tol):
+    """Re-decide the estimator verdicts with other thresholds (for the sensitivity table).
+
+    The exact stage is :func:`classify_growth`; points it leaves undecided take the long-horizon verdict
+    of :func:`refine_long_horizon` where that was computed (``long_rate`` finite), with the same rule.
+
+    Parameters
+    ----------
+    means : ndarray
+        ``(..., K)`` exact ``E||P_k||``.
+    long_rate, long_rel : ndarray
+        Long-horizon growth rate and relative half-width (``nan`` / ``inf`` where not computed).
+    bounded_tol, unbounded_tol : float
+        Thresholds of :func:`classify_growth`.
+    rel_tol, refine_bounded_tol, refine_unbounded_tol : float
+        Thresholds of the long-horizon stage.
+
+    Returns
+    -------
+    ndarray of str
+        ``bounded`` / ``unbounded`` / ``undecided``.
+    """
+    _, _, verdict = classify_growth(means, bounded_tol, unbounded_tol)
+    long_rate, long_rel = np.asarray(long_rate, float), np.asarray(long_rel, float)
+    with np.errstate(invalid="ignore"):
+        reliable = np.isfinite(long_rate) & np.isfinite(long_rel) & (long_rel < rel_tol)
+        v_long = np.where(~reliable, "undecided", np.where(long_rate < refine_bounded_tol, "bounded",
+                                                            np.where(long_rate > refine_unbounded_tol, "unbounded",
+                                                                     "undecided")))
+    return np.where(verdict == "undecided", v_long, verdict)

@@ -54,16 +54,25 @@ import time
 import numpy as np
 import pandas as pd
 
+from ...engines.certify import bisect_certified
 from . import estimators as est
 from .exact import ExactMoments, exact_moments
-from .lmis import GilbertElliottLMI, bisect_monotone, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
+from .lmis import GilbertElliottLMI, as_verdict, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
 from .model import LinearSystem, observability_index, parity_bound_example2, prop1_bound, spectral_abs
-from .stability import REFINE_DEFAULTS, classify_growth, refine_long_horizon
+from .certificates import (
+    certificate_grid, critical_distance, decide_certified, true_critical_curve, two_reception_bound,
+)
+from .stability import classify_growth, decide_estimator, refine_long_horizon
 
 __all__ = [
     "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
     "sample_paths_step", "load_moments",
 ]
+
+
+def _verdict(r):
+    """The table's verdict: ``feasible`` only with ``rho(H(K)) < 1`` too (see :func:`.lmis.thm5_lower_bound`)."""
+    return as_verdict(r).verdict
 
 
 def _system(ex):
@@ -111,6 +120,8 @@ def critical_curves_step(params, inputs, outputs):
                 "thm5_saturated": res["saturated"], "thm5_n_solves": res["n_solves"],
                 "thm5_n_uncertified": res["n_uncertified"], "thm5_statuses": "|".join(res["statuses"]),
                 "rho_H_at_lower": res["rho_at_lower"], "p_reference": pr, "reference": ref_text,
+                "thm5_certified": res["certified"] or res["saturated"], "thm5_n_undecided": res["n_undecided"],
+                "thm5_lower_evidence": res["lower_evidence"], "thm5_upper_evidence": res["upper_evidence"],
             })
         elapsed = time.perf_counter() - t0
         # benchmark, same run: parametrised problem vs rebuilding it for every solve
@@ -147,6 +158,7 @@ def lmi_checks_step(params, inputs, outputs):
         p = float(item["p"])
         r = lmi.solve(p, float(item["q"]))
         rows.append({"check": item["name"], "example": item["example"], "p": p, "q": item["q"], "status": r.status,
+                     "verdict": _verdict(r), "evidence": r.evidence,
                      "margin": r.margin, "solver_feasible": r.solver_feasible, "certified": r.certified,
                      "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
     for item in ck["tight"]:
@@ -157,7 +169,8 @@ def lmi_checks_step(params, inputs, outputs):
         for label, p in (("tight_lower", res["p_lower"]), ("tight_upper", res["p_upper"])):
             r = lmi.solve(float(p), float(item["q"]))
             rows.append({"check": f"{item['name']}_{label}", "example": item["example"], "p": p, "q": item["q"],
-                         "status": r.status, "margin": r.margin, "solver_feasible": r.solver_feasible,
+                         "status": r.status, "verdict": _verdict(r), "evidence": r.evidence,
+                         "margin": r.margin, "solver_feasible": r.solver_feasible,
                          "certified": r.certified, "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
     return {"table": pd.DataFrame(rows)}
 
@@ -170,10 +183,11 @@ def iid_line_step(params, inputs, outputs):
         A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
         lam = spectral_abs(A)
         lower = 1.0 - 1.0 / lam ** 2
-        upper, _ = sinopoli_lmi_threshold(A, C, tol)
+        upper, _, sin_br = sinopoli_lmi_threshold(A, C, tol)
         lmi = GilbertElliottLMI(A, C)
         # feasibility at (p, q) = (1 - q, q) is monotone in q: p falls while p_underline(q) rises
-        res = bisect_monotone(lambda q: lmi.solve(1.0 - q, q).certified, lower + 1e-6, 1.0 - 1e-6, tol=tol)
+        res = bisect_certified(lambda q: as_verdict(lmi.solve(1.0 - q, q)), lower + 1e-6, 1.0 - 1e-6, tol=tol,
+                               feasible_above=True)
         kind = ex.get("reference", "none")
         if kind == "nondegenerate":
             ref, text = lower, "non-degenerate: lambda_c = 1 - 1/|lambda|^2 (Mo & Sinopoli)"
@@ -182,13 +196,15 @@ def iid_line_step(params, inputs, outputs):
         else:
             ref, text = np.nan, ""
         rows.append({"example": name, "lambda_lower": lower, "lambda_lmi_upper": upper,
-                     "q_thm5_on_iid_line": res.threshold, "lambda_c_reference": ref, "reference": text,
-                     "consistent": bool(lower - tol <= ref <= min(upper, res.threshold) + tol)})
+                     "lambda_lmi_upper_infeasible_end": sin_br.infeasible_end, "lambda_lmi_certified": sin_br.certified,
+                     "q_thm5_on_iid_line": res.feasible_end, "q_thm5_infeasible_end": res.infeasible_end,
+                     "q_thm5_certified": res.certified, "lambda_c_reference": ref, "reference": text,
+                     "consistent": bool(lower - tol <= ref <= min(upper, res.feasible_end) + tol)})
     return {"table": pd.DataFrame(rows)}
 
 
 def exact_moments_step(params, inputs, outputs):
-    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`markov_math.exact_moments`)."""
+    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`.exact.exact_moments`)."""
     frames = []
     for name, ex in params["examples"].items():
         em = exact_moments(_system(ex), np.asarray(ex["Sigma0"], float), params["exact"]["depth"])
@@ -206,7 +222,7 @@ def exact_moments_step(params, inputs, outputs):
 
 
 def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
-    """Rebuild :class:`~netrepro.papers.markov_math.ExactMoments` from ``exact_moments.csv``."""
+    """Rebuild :class:`~netrepro.papers.markov.exact.ExactMoments` from ``exact_moments.csv``."""
     sub = table[table["example"] == example]
     head = sub[sub["depth"] == 0].iloc[0]
     cols = ["n11", "n10", "n01", "n00", "sum_norm", "sum_trace"]
@@ -214,47 +230,108 @@ def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
     return ExactMoments(coef, float(head["sum_norm"]), float(head["sum_trace"]))
 
 
-def stability_map_step(params, inputs, outputs):
-    """Independent stability map of E||P_k|| on a (p, q) grid.
+def _estimator_map(em, ex, e_idx, P, Qg, mp):
+    """The estimator cross-check of the map (exact extrapolation, then the long-horizon estimator)."""
+    opts = mp["refine"]
+    means = em.mean(P, Qg, "norm")
+    rate, last, verdict = classify_growth(means, mp["bounded_tol"], mp["unbounded_tol"])
+    exact_method = f"exact E||P_k|| over all 2^{em.depth - 1} channel paths (k<={em.depth + 1}), extrapolated growth"
+    f = pd.DataFrame({"verdict_estimator": verdict.ravel(), "growth_rate_exact": rate.ravel(),
+                      "growth_rate_last": last.ravel(), "mean_norm_last": means[..., -1].ravel(),
+                      "growth_rate_long": np.nan, "rel_halfwidth_long": np.nan, "method_estimator": exact_method})
+    todo = np.flatnonzero(f.verdict_estimator.to_numpy() == "undecided")
+    if opts["enabled"] and len(todo):
+        rng = np.random.default_rng([opts["seed"], e_idx])
+        r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
+                                                  P.ravel()[todo], Qg.ravel()[todo], opts, rng)
+        f.loc[todo, "growth_rate_long"] = r_long
+        f.loc[todo, "rel_halfwidth_long"] = rel
+        decided = todo[v_long != "undecided"]
+        f.loc[decided, "verdict_estimator"] = v_long[v_long != "undecided"]
+        f.loc[decided, "method_estimator"] = (f"conditional estimator of E tr P_k, k<={opts['horizon'] + 1}, "
+                                              f"{opts['n_paths']} paths, 95% half-width < {opts['rel_tol']:g} of the mean")
+        f.loc[todo[v_long == "undecided"], "method_estimator"] = "undecided: exact horizon too short, estimator not trusted"
+    return f, means
 
-    1. Exact E||P_k|| over all channel paths for ``k <= depth + 1`` (:func:`markov_math.exact_moments`),
-       growth extrapolated by :func:`classify_growth`.
-    2. Points left undecided get the long-horizon conditional estimator of E tr P_k
-       (:func:`refine_long_horizon`; trace and 2-norm are equivalent norms for boundedness),
-       trusted only where its confidence interval is narrow.
+
+def _sensitivity_rows(name, P, Qg, facts, cert_verdict, far, means, est, mp, system, Sigma0):
+    """Re-decide the map across the configured range of every threshold, one at a time."""
+    cc, sens = mp["certify"], mp["sensitivity"]
+    rows = []
+    base_est = est.verdict_estimator.to_numpy().reshape(P.shape)
+    long_rate = est.growth_rate_long.to_numpy().reshape(P.shape)
+    long_rel = est.rel_halfwidth_long.fillna(np.inf).to_numpy().reshape(P.shape)
+    est_args = {"bounded_tol": mp["bounded_tol"], "unbounded_tol": mp["unbounded_tol"],
+                "rel_tol": mp["refine"]["rel_tol"], "refine_bounded_tol": mp["refine"]["bounded_tol"],
+                "refine_unbounded_tol": mp["refine"]["unbounded_tol"]}
+
+    def row(threshold, value, default, applies, verdict, base):
+        rows.append({
+            "example": name, "threshold": threshold, "value": value, "is_default": bool(default),
+            "applies_to": applies, "n_bounded": int((verdict == "bounded").sum()),
+            "n_unbounded": int((verdict == "unbounded").sum()), "n_undecided": int((verdict == "undecided").sum()),
+            "n_undecided_far": int(((verdict == "undecided") & far).sum()),
+            "n_changed": int((verdict != base).sum()),
+            "n_contradict_certified": int((((verdict == "bounded") & (cert_verdict == "unbounded"))
+                                          | ((verdict == "unbounded") & (cert_verdict == "bounded"))).sum()),
+        })
+
+    for v in sens["rho_margin"]:
+        verdict, _ = decide_certified(facts, P, v, cc["growth_margin"])
+        row("certify.rho_margin", v, v == cc["rho_margin"], "certified map", verdict, cert_verdict)
+    for v in sens["growth_margin"]:
+        verdict, _ = decide_certified(facts, P, cc["rho_margin"], v)
+        row("certify.growth_margin", v, v == cc["growth_margin"], "certified map", verdict, cert_verdict)
+    two_rec = system.A.shape[0] == 2 * system.C.shape[0]
+    for v in sens["n_gaps"]:
+        alt = dict(facts)
+        if two_rec:
+            alt["upper"] = two_reception_bound(system, Sigma0, P, Qg, int(v))
+        verdict, _ = decide_certified(alt, P, cc["rho_margin"], cc["growth_margin"])
+        row("certify.n_gaps", v, v == cc["n_gaps"], "certified map", verdict, cert_verdict)
+    for key, cfg_key in (("bounded_tol", "bounded_tol"), ("unbounded_tol", "unbounded_tol"),
+                         ("rel_tol", "refine.rel_tol"), ("refine_bounded_tol", "refine.bounded_tol"),
+                         ("refine_unbounded_tol", "refine.unbounded_tol")):
+        for v in sens[key]:
+            verdict = decide_estimator(means, long_rate, long_rel, **dict(est_args, **{key: v}))
+            row(cfg_key, v, v == est_args[key], "estimator cross-check", verdict, base_est)
+    return rows
+
+
+def stability_map_step(params, inputs, outputs):
+    """Stability map of E||P_k|| on a (p, q) grid, decided by certificates only (:mod:`.certificates`).
+
+    ``verdict`` / ``bounded`` / ``method``: Theorem 1 with a computed gain or the two-reception upper
+    bound certify bounded; the loss-run or parity lower bounds certify unbounded; nothing else decides.
+    ``dist_critical`` is the distance to the true critical curve (every point at ``>= far`` must be decided).
+    The former estimator map (exact extrapolation, long-horizon conditional estimator) is kept as a
+    cross-check (``verdict_estimator``); ``map_sensitivity.csv`` re-decides both across their thresholds.
     """
     table = pd.read_csv(inputs["moments"])
     mp = params["map"]
-    opts = dict(REFINE_DEFAULTS, **mp.get("refine", {}))
+    cc = mp["certify"]
     ps = np.linspace(mp["p_min"], mp["p_max"], mp["p_points"])
     qs = np.linspace(mp["q_min"], mp["q_max"], mp["q_points"])
     P, Qg = np.meshgrid(ps, qs, indexing="ij")
-    frames = []
+    frames, sens = [], []
     for e_idx, (name, ex) in enumerate(params["examples"].items()):
-        em = load_moments(table, name)
-        means = em.mean(P, Qg, "norm")
-        rate, last, verdict = classify_growth(means, mp["bounded_tol"], mp["unbounded_tol"])
-        exact_method = f"exact E||P_k|| over all 2^{em.depth - 1} channel paths (k<={em.depth + 1}), extrapolated growth"
+        system, Sigma0 = _system(ex), np.asarray(ex["Sigma0"], float)
+        facts = certificate_grid(system, Sigma0, P, Qg, cc["n_gaps"])
+        verdict, method = decide_certified(facts, P, cc["rho_margin"], cc["growth_margin"])
+        curve_q, curve_p = true_critical_curve(ex.get("reference", "none"), spectral_abs(ex["A"]))
+        dist = critical_distance(Qg, P, curve_q, curve_p)
+        est, means = _estimator_map(load_moments(table, name), ex, e_idx, P, Qg, mp)
+        growth = np.fmax(facts["loss_growth"], facts["parity_growth"])
+        with np.errstate(divide="ignore"):
+            p_thm1 = 1.0 / facts["rho1"]
         f = pd.DataFrame({"example": name, "p": P.ravel(), "q": Qg.ravel(), "verdict": verdict.ravel(),
-                          "growth_rate": rate.ravel(), "growth_rate_exact": rate.ravel(), "growth_rate_last": last.ravel(),
-                          "mean_norm_last": means[..., -1].ravel(), "growth_rate_long": np.nan,
-                          "rel_halfwidth_long": np.nan, "method": exact_method})
-        todo = np.flatnonzero(f.verdict.to_numpy() == "undecided")
-        if opts["enabled"] and len(todo):
-            rng = np.random.default_rng([opts["seed"], e_idx])
-            r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
-                                                      f.p.to_numpy()[todo], f.q.to_numpy()[todo], opts, rng)
-            f.loc[todo, "growth_rate_long"] = r_long
-            f.loc[todo, "rel_halfwidth_long"] = rel
-            decided = todo[v_long != "undecided"]
-            f.loc[decided, "verdict"] = v_long[v_long != "undecided"]
-            f.loc[decided, "growth_rate"] = r_long[v_long != "undecided"]
-            f.loc[decided, "method"] = (f"conditional estimator of E tr P_k, k<={opts['horizon'] + 1}, "
-                                        f"{opts['n_paths']} paths, 95% half-width < {opts['rel_tol']:g} of the mean")
-            f.loc[todo[v_long == "undecided"], "method"] = "undecided: exact horizon too short, conditional estimator not trusted"
+                          "method": method.ravel(), "dist_critical": dist.ravel(), "p_thm1": p_thm1.ravel(),
+                          "upper_bound": facts["upper"].ravel(), "growth_rate": growth.ravel()})
+        f = pd.concat([f, est], axis=1)
         f.insert(3, "bounded", f.verdict.map({"bounded": "True", "unbounded": "False"}).fillna(""))
         frames.append(f)
-    return {"table": pd.concat(frames, ignore_index=True)}
+        sens += _sensitivity_rows(name, P, Qg, facts, verdict, dist >= mp["far"], means, est, mp, system, Sigma0)
+    return {"table": pd.concat(frames, ignore_index=True), "sensitivity": pd.DataFrame(sens)}
 
 
 def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
