@@ -115,6 +115,8 @@ class Theorem3:
         t <= margin_cap; uncapped, Clarabel ends ``optimal_inaccurate``.
     gamma3_top : {"HC", "zero"}
         Upper row of Γ3: H̄^i C (what the congruence gives) or 0 (the misreading).
+    zero_filter : bool
+        Fix Ḡ0 = H̄0 = Ḡf = H̄f = 0: the LMIs for the trivial estimate x_f = 0 (design ``zero``).
     noise_row : bool
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
@@ -133,8 +135,11 @@ class Theorem3:
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
-                 gamma3_top: str = "HC", noise_row: bool = True):
+                 gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False):
         self.noise_row = noise_row
+        self.zero_filter = zero_filter
+        if zero_filter:
+            scheduled = False
         if gamma3_top not in ("HC", "zero"):
             raise GainschedError(f"gamma3_top must be 'HC' or 'zero', got {gamma3_top!r}")
         self.gamma3_top = gamma3_top
@@ -150,9 +155,10 @@ class Theorem3:
             "S11": cp.Variable((n, n), name="S11"),
             "R1": cp.Variable((n, n), name="R1"),
             "R2": cp.Variable((n, n), name="R2"),
-            "G0": cp.Variable((n, n), name="Gbar0"),
-            "H0": cp.Variable((n, m), name="Hbar0"),
         }
+        if not zero_filter:
+            v["G0"] = cp.Variable((n, n), name="Gbar0")
+            v["H0"] = cp.Variable((n, m), name="Hbar0")
         if scheduled:
             v["Gf"] = cp.Variable((n, n), name="Gbarf")
             v["Hf"] = cp.Variable((n, m), name="Hbarf")
@@ -167,6 +173,9 @@ class Theorem3:
             cons += [v["Q0"] + p * v["Qp"] >> eps * np.eye(nn) for p in ps]
         L = np.hstack([np.eye(n), -np.eye(n)])
         self.n_vertices = 0
+        self._vertices = []
+        self._eps = eps
+        self._qp_positive = qp_positive
         for i in range(2):
             for j in range(2):
                 for r in range(2):
@@ -174,6 +183,7 @@ class Theorem3:
                         M = self.vertex(ps[i], ps[j], ps[r], ps[l])
                         size = M.shape[0]
                         Msym = 0.5 * (M + M.T)
+                        self._vertices.append(Msym)
                         if performance:
                             E = np.zeros((size, size))
                             E[:nn, :nn] = L.T @ L
@@ -219,6 +229,8 @@ class Theorem3:
         -------
         cvxpy expression
         """
+        if self.zero_filter:
+            return np.zeros((self.sys.n, self.sys.n))
         return self.vars["G0"] + p * self.vars["Gf"] if self.scheduled else self.vars["G0"]
 
     def Hbar(self, p):
@@ -232,6 +244,8 @@ class Theorem3:
         -------
         cvxpy expression
         """
+        if self.zero_filter:
+            return np.zeros((self.sys.n, self.sys.m))
         return self.vars["H0"] + p * self.vars["Hf"] if self.scheduled else self.vars["H0"]
 
     def Lambda(self, pl):
@@ -368,6 +382,9 @@ class Theorem3:
                                     n_scalar_variables=self.n_scalar_variables())
         elapsed = time.perf_counter() - start
         values = {k: (None if x.value is None else np.array(x.value)) for k, x in self.vars.items()}
+        if self.zero_filter and values["R2"] is not None:
+            values["G0"] = np.zeros((self.sys.n, self.sys.n))
+            values["H0"] = np.zeros((self.sys.n, self.sys.m))
         if not self.scheduled and values["G0"] is not None:
             values["Gf"] = np.zeros_like(values["G0"])
             values["Hf"] = np.zeros_like(values["H0"])
@@ -383,6 +400,64 @@ class Theorem3:
             feasible = ok_status and margin > self.margin_tol
         return Theorem3Solution(status, margin, objective, feasible, values if has_values else {}, elapsed,
                                 self.n_scalar_variables())
+
+    def check_point(self, values: dict, sigma2: float):
+        """Our own check of a candidate point of (24)-(25) (and Q̄0, Q̄p > 0 of (27)), whatever the solver said.
+
+        Parameters
+        ----------
+        values : dict
+            Variable name -> ndarray (a solution or any candidate).
+        sigma2 : float
+
+        Returns
+        -------
+        tuple
+            ``(ok, slack)`` of :func:`.feasibility.check_blocks`: every vertex matrix (plus L^T L in the
+            (1,1) block for the performance design) negative definite and the Q̄ blocks positive
+            definite, each beyond its fixed margin.
+        """
+        from .feasibility import check_blocks
+
+        for name, var in self.vars.items():
+            var.value = values[name]
+        self.sigma2.value = float(sigma2)
+        nn = 2 * self.sys.n
+        L = np.hstack([np.eye(self.sys.n), -np.eye(self.sys.n)])
+        negative = []
+        for M in self._vertices:
+            V = np.array(M.value, dtype=float)
+            if self.performance:
+                V[:nn, :nn] += L.T @ L
+            negative.append(V)
+        Q0, Qp = np.array(values["Q0"], float), np.array(values["Qp"], float)
+        positive = [Q0, Qp] if self._qp_positive else [Q0 + p * Qp for p in (self.sys.p1, self.sys.p2)]
+        return check_blocks(negative=negative, positive=positive)
+
+    def certify(self, sigma2: float | None = None):
+        """Solve at ``sigma2`` and decide: feasible (our point check), infeasible (necessary condition), undecided.
+
+        Parameters
+        ----------
+        sigma2 : float, optional
+
+        Returns
+        -------
+        tuple
+            ``(Verdict, Theorem3Solution)``; the solution's status is information only.
+        """
+        from .feasibility import FEASIBLE, INFEASIBLE, RADIUS_MARGIN, UNDECIDED, Verdict, plant_vertex_radius
+
+        s2 = self.sys.sigma2 if sigma2 is None else float(sigma2)
+        sol = self.solve(s2)
+        radius = plant_vertex_radius(self.sys, s2)
+        slack = np.nan
+        if sol.values and all(sol.values.get(k) is not None for k in self.vars):
+            ok, slack = self.check_point(sol.values, s2)
+            if ok:
+                return Verdict(FEASIBLE, slack, radius, sol.status, sol.margin), sol
+        verdict = INFEASIBLE if radius >= 1.0 + RADIUS_MARGIN else UNDECIDED
+        return Verdict(verdict, slack, radius, sol.status, sol.margin), sol
 
 
 def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains, dict]:

@@ -18,7 +18,7 @@ Designs compared (column ``design`` of the tables):
 * ``tuned_fixed`` / ``tuned_scheduled``: gains of form (9) tuned by Monte Carlo
   (Nelder-Mead on common random numbers) for the named nonlinearity: what a
   filter of this structure can achieve when not restricted to a worst-case bound;
-* ``trivial``: x_f = 0 (all gains zero).
+* ``zero``: the trivial estimate x_f = 0 (all gains zero): what any filter must beat.
 """
 
 from __future__ import annotations
@@ -37,7 +37,6 @@ from .model import (
     frozen_radius,
     gains_from_dict,
     p_schedule,
-    plant_ms_radius,
     scheduled_growth_rate,
     sector_cases,
     simulate,
@@ -46,6 +45,7 @@ from .model import (
     theorem1_lmi,
     zero_gains,
 )
+from .moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
 from .tuning import tune_gains
 
 __all__ = [
@@ -57,6 +57,7 @@ __all__ = [
     "design_step",
     "stability_step",
     "simulation_step",
+    "exact_moments_step",
     "sensitivity_step",
     "timing_step",
 ]
@@ -108,7 +109,7 @@ def _mc_errors(sys, gains, p_seq, x0, seed, nonlinearity, xf0=None):
 
 # ----------------------------------------------------------------------------- steps
 def design_step(params, inputs, outputs):
-    """All designs: paper gains, Theorem 3 (24)-(26) variants, performance-aware, MC-tuned, trivial.
+    """All designs: paper gains, Theorem 3 (24)-(26) variants, performance-aware, MC-tuned, zero (x_f = 0).
 
     Writes ``gains`` (design, matrix, row, col, value) and ``designs`` (one row
     per design: solver status, margin, objective, solve time, realisation).
@@ -140,10 +141,12 @@ def design_step(params, inputs, outputs):
         for var, val in sol.values.items():
             for (r, c), x in np.ndenumerate(np.atleast_2d(val)):
                 lmi_rows.append({"problem": name, "variable": var, "row": r, "col": c, "value": float(x)})
+        verdict, slack = decide_point(prob, sol, sys)
         if not sol.values:
             rows.append({"design": name, "method": "Theorem 3", "status": sol.status, "margin": sol.margin,
                          "objective": sol.objective, "solver_feasible": False, "solve_time_s": sol.solve_time_s,
-                         "n_scalar_variables": sol.n_scalar_variables, "realisation": ""})
+                         "n_scalar_variables": sol.n_scalar_variables, "realisation": "", "verdict": verdict,
+                         "certified_slack": slack})
             continue
         realisations = [("identity_T", name)]
         if name == "theorem3":
@@ -156,7 +159,7 @@ def design_step(params, inputs, outputs):
             rows.append({"design": dname, "method": method, "status": sol.status, "margin": sol.margin,
                          "objective": sol.objective, "solver_feasible": sol.solver_feasible,
                          "solve_time_s": sol.solve_time_s, "n_scalar_variables": sol.n_scalar_variables,
-                         "realisation": real})
+                         "realisation": real, "verdict": verdict, "certified_slack": slack})
     tune = params["tuning"]
     p_seq = p_sequence(params, sys, tune["horizon"])
     tuned = None
@@ -171,12 +174,24 @@ def design_step(params, inputs, outputs):
                      "solve_time_s": time.perf_counter() - start, "n_scalar_variables": len(MATRICES) and
                      (tuned.G0.size + tuned.H0.size) * (2 if sched else 1), "realisation": "direct",
                      "n_evaluations": info["n_eval"]})
-    tables.append(gains_table("trivial", zero_gains(sys)))
-    rows.append({"design": "trivial", "method": "x_f = 0", "status": "given", "margin": np.nan, "objective": np.nan,
+    tables.append(gains_table("zero", zero_gains(sys)))
+    rows.append({"design": "zero", "method": "x_f = 0 (trivial estimate)", "status": "given", "margin": np.nan, "objective": np.nan,
                  "solver_feasible": np.nan, "solve_time_s": np.nan, "n_scalar_variables": 0, "realisation": ""})
     return {"gains": pd.concat(tables, ignore_index=True), "designs": pd.DataFrame(rows),
             "solutions": pd.DataFrame(lmi_rows, columns=["problem", "variable", "row", "col", "value"]),
             "provenance": {"solver_status": {k: v.status for k, v in solutions.items()}}}
+
+
+def decide_point(prob, sol, sys):
+    """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve): see :mod:`.feasibility`."""
+    from .feasibility import FEASIBLE, INFEASIBLE, UNDECIDED, plant_necessary_fails
+
+    slack = np.nan
+    if sol.values:
+        ok, slack = prob.check_point(sol.values, sys.sigma2)
+        if ok:
+            return FEASIBLE, slack
+    return (INFEASIBLE if plant_necessary_fails(sys, sys.sigma2) else UNDECIDED), slack
 
 
 def load_solutions(path) -> dict:
@@ -259,7 +274,13 @@ def simulation_step(params, inputs, outputs):
     Runs are vectorised, time is looped; the same random numbers (seed) for
     every design. ``errors``: mean over runs of e1, e2 with a 95% band (2.5 and
     97.5 percentiles over runs) and mse(k) = E||e(k)||^2 for the fixed initial
-    state; ``error_summary``: sum_k mse(k) for the fixed x0 and for x0 ~ N(0, initial_cov).
+    state with its standard error ``mse_se``; ``error_summary``: sum_k mse(k) for the fixed x0
+    and for x0 ~ N(0, initial_cov), with the standard error of the per-run sum.
+
+    This Monte Carlo is for the configured (nonlinear) f only; for linear f the exact
+    second moments are in ``exact_moments.csv`` (:func:`exact_moments_step`). With a
+    multiplicative noise ||e||^2 is heavy-tailed: the standard errors are sample
+    standard errors and understate the uncertainty where the fourth moment is large.
     """
     sys = _sys(params)
     sim = params["simulation"]
@@ -278,57 +299,108 @@ def simulation_step(params, inputs, outputs):
         e = _mc_errors(sys, gains, p_seq, x0_fixed, int(sim["seed"]), sim["nonlinearity"], sim.get("xf0"))
         mean = e.mean(0)
         lo, hi = np.percentile(e, q_lo, axis=0), np.percentile(e, q_hi, axis=0)
-        mse = (e ** 2).sum(-1).mean(0)
+        sq = (e ** 2).sum(-1)
+        mse = sq.mean(0)
+        mse_se = sq.std(0, ddof=1) / np.sqrt(R)
         for k in ks:
             erows.append({"design": d, "k": int(k), "e1_mean": mean[k, 0], "e2_mean": mean[k, 1], "e1_lo": lo[k, 0],
-                          "e1_hi": hi[k, 0], "e2_lo": lo[k, 1], "e2_hi": hi[k, 1], "mse": mse[k]})
+                          "e1_hi": hi[k, 0], "e2_lo": lo[k, 1], "e2_hi": hi[k, 1], "mse": mse[k],
+                          "mse_se": mse_se[k]})
             prow.append({"design": d, "k": int(k), "p": float(p_seq[k]) if k < len(p_seq) else np.nan,
                          "e1": e[0, k, 0], "e2": e[0, k, 1]})
-        srows.append({"design": d, "initial_state": "fixed_x0", "sum_mse": float(mse.sum())})
+        srows.append({"design": d, "initial_state": "fixed_x0", "sum_mse": float(mse.sum()),
+                      "sum_mse_se": float(sq.sum(1).std(ddof=1) / np.sqrt(R))})
         er = _mc_errors(sys, gains, p_seq, x0_rand, int(sim["seed"]) + 1, sim["nonlinearity"])
-        srows.append({"design": d, "initial_state": "gaussian", "sum_mse": float((er ** 2).sum(-1).mean(0).sum())})
+        sr = (er ** 2).sum(-1)
+        srows.append({"design": d, "initial_state": "gaussian", "sum_mse": float(sr.mean(0).sum()),
+                      "sum_mse_se": float(sr.sum(1).std(ddof=1) / np.sqrt(R))})
     return {"errors": pd.DataFrame(erows), "error_summary": pd.DataFrame(srows), "paths": pd.DataFrame(prow)}
 
 
-def sensitivity_step(params, inputs, outputs):
-    """Theorem 3 margin against sigma^2 (one parametrised problem per variant) and the largest feasible sigma^2.
+def exact_moments_step(params, inputs, outputs):
+    """Exact E||e(k)||^2 of every design for linear f = F z, F in {F1, F2, mid}, by the recursion of :mod:`.moments`.
 
-    Also the true mean-square stability limit of the plant (linear sector
-    vertices): the criterion can never certify beyond it.
+    Initial states: ``gaussian`` (x(0) ~ N(0, I), x_f(0) = 0) and ``x0`` (the configured x0 and
+    x_f(0) = xf0; the ``zero`` design keeps x_f = 0 throughout). ``exact_moments``: design,
+    nonlinearity, initial_state, sum_mse (k = 0..K), final_mse (k = K); ``exact_mse``: the same
+    per k.
     """
-    from ...engines.lmi import bisect_monotone
+    sys = _sys(params)
+    sim = params["simulation"]
+    table = read_table(inputs["gains"])
+    designs = list(dict.fromkeys(table["design"]))
+    p_seq = p_sequence(params, sys)
+    n = sys.n
+    x0 = np.asarray(sim["x0"], dtype=float)
+    xf0 = np.asarray(sim.get("xf0", np.zeros(n)), dtype=float)
+    starts = {"gaussian": lambda d: initial_moment(np.zeros(n), np.eye(n), np.zeros(n)),
+              "x0": lambda d: initial_moment(x0, np.zeros((n, n)), np.zeros(n) if d == "zero" else xf0)}
+    keys, M1s, M0s, X0s = [], [], [], []
+    for d in designs:
+        gains = gains_from_table(table, d, sys)
+        for fname, F in linear_gains(sys).items():
+            M1, M0, W = mode_matrices(sys, gains, p_seq, F)
+            for sname, start in starts.items():
+                keys.append((d, fname, sname))
+                M1s.append(M1)
+                M0s.append(M0)
+                X0s.append(start(d))
+    X = second_moments(np.array(M1s), np.array(M0s), W, p_seq, sys.sigma2, np.array(X0s))
+    mse = error_mse(X)
+    ks = np.arange(mse.shape[1])
+    summary = pd.DataFrame([{"design": d, "nonlinearity": f, "initial_state": s, "sum_mse": float(m.sum()),
+                             "final_mse": float(m[-1])} for (d, f, s), m in zip(keys, mse)])
+    per_k = pd.DataFrame({"design": np.repeat([k[0] for k in keys], ks.size),
+                          "nonlinearity": np.repeat([k[1] for k in keys], ks.size),
+                          "initial_state": np.repeat([k[2] for k in keys], ks.size),
+                          "k": np.tile(ks, len(keys)), "mse": mse.ravel()})
+    return {"table": summary, "per_k": per_k}
 
+
+def sensitivity_step(params, inputs, outputs):
+    """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter) and the plant.
+
+    Every decision is ``feasible`` (our eigenvalue check of the returned point), ``infeasible``
+    (the plant's vertex second-moment radius >= 1: a necessary condition of every criterion
+    fails) or ``undecided`` (:mod:`.feasibility`); the solver status is information.
+    ``table``: the sigma^2 grid per design (solver status and margin t, our slack, verdict).
+    ``limits`` (feasibility_limit.csv): per design the largest certified-feasible sigma^2
+    (``sigma2_max = sigma2_lo``), the smallest certified-infeasible one (``sigma2_hi``), the
+    smallest undecided point between them, and whether both ends are certified.
+    """
     from .design import Theorem3
+    from .feasibility import PlantLMI, bisect_certified, necessary_limit
 
     base = _sys(params)
     lmi = params["lmi"]
     sens = params["sensitivity"]
     grid = np.asarray(sens["sigma2_grid"], dtype=float)
-    rows = []
-    for variant, sched in (("scheduled", True), ("fixed", False)):
-        prob = Theorem3(base, scheduled=sched, eps=float(lmi["eps"]), bound=float(lmi["bound"]),
-                        qp_positive=bool(lmi["qp_positive"]), margin_cap=float(lmi["margin_cap"]),
-                        gamma3_top=lmi.get("gamma3_top", "HC"))
+    lo0, hi0, tol = float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), float(sens["tol"])
+    nec_below, nec_above = necessary_limit(base, lo0, hi0)
+    common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
+                  margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
+    problems = {"scheduled": Theorem3(base, scheduled=True, **common),
+                "fixed_gain": Theorem3(base, scheduled=False, **common),
+                "zero": Theorem3(base, zero_filter=True, **common)}
+    deciders = {name: (lambda s2, prob=prob: prob.certify(s2)[0]) for name, prob in problems.items()}
+    plant = PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]))
+    deciders["plant"] = plant.certify
+    methods = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
+               "zero": "Theorem 3 with all gains 0 (x_f = 0)", "plant": "plant Lyapunov + S-procedure LMI"}
+    rows, limits = [], []
+    top = nec_above if np.isfinite(nec_above) else hi0
+    for name, decide in deciders.items():
         for s2 in grid:
-            sol = prob.solve(float(s2))
-            rows.append({"variant": variant, "sigma2": float(s2), "status": sol.status, "margin": sol.margin,
-                         "solver_feasible": sol.solver_feasible, "kind": "grid"})
-
-        def infeasible(s2, prob=prob):
-            return not prob.solve(float(s2)).solver_feasible
-
-        b = bisect_monotone(infeasible, float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), tol=float(sens["tol"]))
-        rows.append({"variant": variant, "sigma2": b.lower, "status": f"bisection ({b.n_evals} solves)",
-                     "margin": np.nan, "solver_feasible": True, "kind": "sigma2_max"})
-    # plant MS stability limit: radius of A+BFZ (x) itself + sigma2 D(x)D crosses 1
-    def plant_unstable(s2):
-        sysv = System(base.A, base.B, base.C, base.D, base.Z, base.F1, base.F2, float(s2), base.p1, base.p2)
-        return plant_ms_radius(sysv) >= 1.0
-
-    b = bisect_monotone(plant_unstable, float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), tol=float(sens["tol"]))
-    rows.append({"variant": "plant_ms_limit", "sigma2": b.lower, "status": "bisection on spectral radius",
-                 "margin": np.nan, "solver_feasible": np.nan, "kind": "sigma2_max"})
-    return {"table": pd.DataFrame(rows)}
+            v = decide(float(s2))
+            rows.append({"variant": name, "sigma2": float(s2), "status": v.status, "margin": v.solver_margin,
+                         "certified_slack": v.slack, "plant_radius": v.radius, "verdict": v.verdict,
+                         "kind": "grid"})
+        b = bisect_certified(decide, lo0, top, tol)
+        limits.append({"design": name, "sigma2_max": b.lo, "sigma2_lo": b.lo, "sigma2_hi": b.hi,
+                       "certified": b.certified, "undecided_from": b.undecided_lo, "n_solves": b.n_evals,
+                       "method": methods[name],
+                       "infeasible_by": "plant vertex second-moment radius >= 1 (necessary condition)"})
+    return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
 
 
 def timing_step(params, inputs, outputs):
