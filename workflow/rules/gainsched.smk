@@ -80,9 +80,11 @@ rule gainsched_exact_moments:
     input:
         code=code("netrepro.papers.gainsched.steps:exact_moments_step"),
         gains=rules.gainsched_design.output.gains,
+        designs=rules.gainsched_design.output.designs,
     output:
         table="results/gainsched/exact_moments.csv",
         per_k="results/gainsched/exact_mse.csv",
+        performance="results/gainsched/performance.csv",
     log:
         "logs/gainsched/exact_moments.log",
     conda:
@@ -226,6 +228,7 @@ if enabled("gainsched"):
         rules.gainsched_simulation.output.paths,
         rules.gainsched_exact_moments.output.table,
         rules.gainsched_exact_moments.output.per_k,
+        rules.gainsched_exact_moments.output.performance,
         rules.gainsched_sensitivity.output.table,
         rules.gainsched_sensitivity.output.limits,
         rules.gainsched_timing.output.table,

@@ -22,7 +22,9 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
     from netrepro.papers.gainsched.steps import exact_moments_step
 
     pd.concat([gains_table("paper", paper), gains_table("zero", zero_gains(sys))]).to_csv(tmp_path / "g.csv", index=False)
-    out = exact_moments_step(cfg, {"gains": tmp_path / "g.csv"}, {})
+    pd.DataFrame([{"design": "paper", "method": "printed", "certified_cost": np.nan},
+                  {"design": "zero", "method": "x_f = 0", "certified_cost": np.nan}]).to_csv(tmp_path / "d.csv", index=False)
+    out = exact_moments_step(cfg, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
     table, per_k = out["table"], out["per_k"]
     assert list(table.columns) == ["design", "nonlinearity", "initial_state", "sum_mse", "final_mse"]
     assert len(table) == 2 * 3 * 2
@@ -35,3 +37,6 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
         assert np.isclose(row["sum_mse"], sub["mse"].sum(), rtol=1e-12)
         if s == "gaussian":
             assert np.isclose(sub.sort_values("k")["mse"].iloc[0], sys.n)
+    perf = out["performance"].set_index("design")
+    assert perf.loc["zero", "sum_mse_gaussian_worst"] == table[(table["design"] == "zero")
+                                                              & (table["initial_state"] == "gaussian")]["sum_mse"].max()

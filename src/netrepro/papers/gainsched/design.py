@@ -48,8 +48,9 @@ import numpy as np
 from ...engines.lmi import SOLVER
 from .model import Gains, GainschedError, System
 
-__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "congruence_residual",
-           "REALISATIONS"]
+__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "recover_output_gains", "certified_cost",
+           "output_certificate",
+           "certificate_from_solution", "congruence_residual", "REALISATIONS"]
 
 REALISATIONS = ("identity_T", "S21_identity")
 
@@ -117,6 +118,13 @@ class Theorem3:
         Upper row of Γ3: H̄^i C (what the congruence gives) or 0 (the misreading).
     zero_filter : bool
         Fix Ḡ0 = H̄0 = Ḡf = H̄f = 0: the LMIs for the trivial estimate x_f = 0 (design ``zero``).
+    output_slack : bool
+        With ``performance``: the full-slack performance design. The estimate is
+        x̂ = L_f x_f with L_f free, so the error row of the congruence T = diag(I, J),
+        [I, -L_f J], is linear in the new variable L̄ = L_f J; the bound term enters
+        as the Schur complement [[M, E^T], [E, -I]] < 0, E = [I, -L̄, 0]. Unlike
+        adding [I, -I]^T [I, -I] (which ties the estimate to S21 = S22), nothing is
+        forced: recover with :func:`recover_output_gains`.
     noise_row : bool
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
@@ -135,8 +143,10 @@ class Theorem3:
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
-                 gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False):
+                 gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False,
+                 output_slack: bool = False):
         self.noise_row = noise_row
+        self.output_slack = bool(output_slack and performance)
         self.zero_filter = zero_filter
         if zero_filter:
             scheduled = False
@@ -162,6 +172,8 @@ class Theorem3:
         if scheduled:
             v["Gf"] = cp.Variable((n, n), name="Gbarf")
             v["Hf"] = cp.Variable((n, m), name="Hbarf")
+        if self.output_slack:
+            v["Lbar"] = cp.Variable((n, n), name="Lbar")
         self.vars = v
         self.t = cp.Variable(name="t")
         ps = (sys.p1, sys.p2)
@@ -183,6 +195,15 @@ class Theorem3:
                         M = self.vertex(ps[i], ps[j], ps[r], ps[l])
                         size = M.shape[0]
                         Msym = 0.5 * (M + M.T)
+                        if self.output_slack:
+                            # error row [I, -L̄] in T-coordinates, Schur complement of + [I, -L̄]^T [I, -L̄]
+                            Erow = cp.hstack([np.eye(n), -v["Lbar"], np.zeros((n, size - nn))])
+                            big = cp.bmat([[Msym, Erow.T], [Erow, -np.eye(n)]])
+                            big = 0.5 * (big + big.T)
+                            self._vertices.append(big)
+                            cons.append(big << -eps * np.eye(size + n))
+                            self.n_vertices += 1
+                            continue
                         self._vertices.append(Msym)
                         if performance:
                             E = np.zeros((size, size))
@@ -427,7 +448,7 @@ class Theorem3:
         negative = []
         for M in self._vertices:
             V = np.array(M.value, dtype=float)
-            if self.performance:
+            if self.performance and not self.output_slack:
                 V[:nn, :nn] += L.T @ L
             negative.append(V)
         Q0, Qp = np.array(values["Q0"], float), np.array(values["Qp"], float)
@@ -515,6 +536,86 @@ def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains,
     J = np.linalg.solve(S22, S21)
     T = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), J]])
     return gains, {"S": S, "T": T}
+
+
+def recover_output_gains(values: dict) -> Gains:
+    """Gains of form (9) of the full-slack performance design (``output_slack``), estimate x̂ = L̄ x_f.
+
+    With the ``identity_T`` realisation (J = I, so L_f = L̄), (26) gives G(p), H(p) for x_f and
+    the estimate is x̂ = L̄ x_f. In the coordinates x̃ = L̄ x_f (L̄ nonsingular, x̃(0) = 0 when
+    x_f(0) = 0) the filter is again of form (9) with x̃ itself the estimate:
+
+    .. math::
+
+        G_0' = \bar L G_0 \bar L^{-1},\; G_f' = \bar L G_f \bar L^{-1},\; H_0' = \bar L H_0,\; H_f' = \bar L H_f .
+
+    Parameters
+    ----------
+    values : dict
+        A solution of the ``output_slack`` performance problem (must hold ``Lbar``).
+
+    Returns
+    -------
+    Gains
+
+    Raises
+    ------
+    GainschedError
+        If ``Lbar`` is missing or singular.
+    """
+    if values.get("Lbar") is None:
+        raise GainschedError("values has no 'Lbar': not an output_slack performance solution")
+    Lb = np.asarray(values["Lbar"], dtype=float)
+    if np.linalg.cond(Lb) > 1e12:
+        raise GainschedError(f"Lbar is singular (condition {np.linalg.cond(Lb):.3g})")
+    g, _ = recover_gains(values, "identity_T")
+    Li = np.linalg.inv(Lb)
+    return Gains(Lb @ g.G0 @ Li, Lb @ g.Gf @ Li, Lb @ g.H0, Lb @ g.Hf)
+
+
+def certified_cost(values: dict, X0, p1: float, p2: float) -> float:
+    """The guaranteed cost max_{p in [p1, p2]} tr(Q̄(p) X0) of a performance solution, from its values.
+
+    Q̄(p) = Q̄0 + p Q̄p is affine in p, so the maximum is at p1 or p2. With the point certified
+    (every block strictly negative), sum_k E||e(k)||^2 <= this value for every f in the sector and
+    every p(k) in [p1, p2], from E z̄(0) z̄(0)^T = X0 with x_f(0) = 0 (T-invariant).
+
+    Parameters
+    ----------
+    values : dict
+    X0 : ndarray (2n, 2n)
+    p1, p2 : float
+
+    Returns
+    -------
+    float
+    """
+    X0 = np.asarray(X0, dtype=float)
+    return max(float(np.trace((values["Q0"] + p * values["Qp"]) @ X0)) for p in (p1, p2))
+
+
+def output_certificate(values: dict) -> dict:
+    """Theorem 1 certificate (Q0, Qp, S) of the full-slack performance design in the coordinates of its form-(9) gains.
+
+    (26) with T = I gives the filter state x_f and the certificate Q̄, S = [[S11, R1], [R2, R2]];
+    in the coordinates z' = [x; x̃], x̃ = L̄ x_f, i.e. z̄ = T' z' with T' = diag(I, L̄^{-1}),
+    the certificate is Q' = T'^T Q̄ T', S' = T'^T S T' (V is unchanged).
+
+    Parameters
+    ----------
+    values : dict
+        A solution of the ``output_slack`` performance problem.
+
+    Returns
+    -------
+    dict
+        ``Q0``, ``Qp``, ``S`` for (12) with the gains of :func:`recover_output_gains`.
+    """
+    _, extra = recover_gains(values, "identity_T")
+    n = values["R2"].shape[0]
+    Tp = np.eye(2 * n)
+    Tp[n:, n:] = np.linalg.inv(np.asarray(values["Lbar"], dtype=float))
+    return {"Q0": Tp.T @ values["Q0"] @ Tp, "Qp": Tp.T @ values["Qp"] @ Tp, "S": Tp.T @ extra["S"] @ Tp}
 
 
 def certificate_from_solution(values: dict, realisation: str = "identity_T") -> dict:

@@ -9,28 +9,39 @@ from ...io import read_table
 __all__ = ["figure_errors", "figure_mse", "figure_sensitivity"]
 
 _COLORS = {"paper": "C3", "theorem3": "C0", "theorem3_S21I": "C9", "fixed_gain": "C1", "performance": "C2",
-           "performance_fixed": "C8", "tuned_fixed": "C4", "tuned_scheduled": "C5", "zero": "k"}
+           "performance_fixed": "C8", "tuned_fixed": "C4", "tuned_scheduled": "C5", "zero": "k",
+           "performance_tied": "C8", "tuned_exact": "C6"}
 
 
 def figure_errors(params, inputs, outputs):
-    """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper) and the Monte Carlo mean with a band."""
+    """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper), and the Monte Carlo mean with a band
+    for the configured x0 and for x(0) ~ N(0, I); cut at ``k_max`` where the errors have decayed."""
     from ...plotting import new_figure, save_figure
 
     comp = int(params["component"])
+    kmax = int(params.get("k_max", 10 ** 9))
     errors = read_table(inputs["errors"])
+    errors = errors[errors["k"] <= kmax]
     paths = read_table(inputs["paths"])
+    paths = paths[paths["k"] <= kmax]
+    if "initial_state" not in errors:
+        errors = errors.assign(initial_state="fixed_x0")
     show = params["designs"]
-    fig, (ax1, ax2) = new_figure(1, 2, figsize=(10, 3.8), sharey=False)
+    fig, (ax1, ax2, ax3) = new_figure(1, 3, figsize=(15, 4.0), sharey=False)
     for d in show:
         pth = paths[paths["design"] == d]
         ax1.plot(pth["k"], pth[f"e{comp}"], marker=".", ms=3, lw=1, color=_COLORS.get(d), label=d)
-        er = errors[errors["design"] == d]
-        ax2.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), label=f"{d} mean")
-        ax2.fill_between(er["k"], er[f"e{comp}_lo"], er[f"e{comp}_hi"], color=_COLORS.get(d), alpha=0.15)
-    ax1.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title="one sample path")
-    ax2.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"mean over runs, central {params['band']:.0%} band")
+        for ax, start in ((ax2, "fixed_x0"), (ax3, "gaussian")):
+            er = errors[(errors["design"] == d) & (errors["initial_state"] == start)]
+            if er.empty:
+                continue
+            ax.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), label=f"{d} mean")
+            ax.fill_between(er["k"], er[f"e{comp}_lo"], er[f"e{comp}_hi"], color=_COLORS.get(d), alpha=0.15)
+    ax1.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title="one sample path, configured $x_0$")
+    ax2.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"configured $x_0$: mean, central {params['band']:.0%} band")
+    ax3.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"$x(0)\\sim N(0, I)$: mean, central {params['band']:.0%} band")
     ax1.legend(fontsize=8)
-    ax2.legend(fontsize=8)
+    ax3.legend(fontsize=8)
     save_figure(fig, outputs["figure"])
     return {}
 
