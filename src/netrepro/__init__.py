@@ -6,4 +6,6 @@ LMI helpers); each paper has one module in :mod:`netrepro.papers`. The
 Snakemake rules call into the package through :mod:`netrepro.runner`.
 """
 
+__all__ = ["__version__"]
+
 __version__ = "0.1.0"

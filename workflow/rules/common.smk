@@ -13,6 +13,7 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.reportgen import rule_for, workflow_producers
+    from netrepro.verdicts import load_claims
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "
@@ -24,6 +25,11 @@ try:
     check_dependencies()
     # the schemas of this workflow copy (not of the installed package's checkout)
     validate_config(config, schema_dir=Path(workflow.current_basedir).parent / "schemas")
+    # the claims data files of the papers (issue 15), validated before any job starts
+    for _slug in config["papers"]:
+        _claims_file = Path("src/netrepro/papers") / _slug / "claims.yaml"
+        if _claims_file.is_file():
+            load_claims(_claims_file)
 except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
 

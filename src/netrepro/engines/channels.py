@@ -35,13 +35,23 @@ def iid_arrivals(rng: np.random.Generator, n_paths: int, horizon: int, prob) -> 
 
     Parameters
     ----------
+    rng : numpy.random.Generator
+        Source of the uniforms.
+    n_paths, horizon : int
+        Number of sample paths and of time steps.
     prob : float or sequence of float
         Arrival probability lambda; a sequence gives one independent channel per sensor.
 
     Returns
     -------
-    ndarray of bool, shape ``(n_paths, horizon)`` for a scalar ``prob`` or
-    ``(n_paths, horizon, n_sensors)`` for a sequence.
+    ndarray of bool
+        Shape ``(n_paths, horizon)`` for a scalar ``prob`` or ``(n_paths, horizon, n_sensors)``
+        for a sequence; True where the packet arrived.
+
+    Raises
+    ------
+    ValueError
+        If a probability is not in [0, 1].
     """
     prob = _check_prob("prob", prob)
     if prob.ndim == 0:
@@ -50,7 +60,24 @@ def iid_arrivals(rng: np.random.Generator, n_paths: int, horizon: int, prob) -> 
 
 
 def gilbert_elliott_stationary(p: float, q: float) -> tuple[float, float]:
-    """Stationary probabilities ``(P(gamma=1), P(gamma=0)) = (q/(p+q), p/(p+q))``."""
+    """Stationary probabilities ``(P(gamma=1), P(gamma=0)) = (q/(p+q), p/(p+q))``.
+
+    Parameters
+    ----------
+    p, q : float
+        Failure rate ``P(gamma_{k+1} = 0 | gamma_k = 1)`` and recovery rate
+        ``P(gamma_{k+1} = 1 | gamma_k = 0)``.
+
+    Returns
+    -------
+    tuple of float
+        ``(P(gamma = 1), P(gamma = 0))``.
+
+    Raises
+    ------
+    ValueError
+        If a rate is not in [0, 1], or ``p + q = 0`` (no unique stationary law).
+    """
     p, q = float(_check_prob("p", p)), float(_check_prob("q", q))
     if p + q == 0:
         raise ValueError("p + q = 0: the Gilbert-Elliott chain has no unique stationary law")
@@ -62,8 +89,28 @@ def gilbert_elliott_arrivals(
 ) -> np.ndarray:
     """Gilbert-Elliott arrivals, shape ``(n_paths, horizon)``.
 
-    ``initial`` is ``"stationary"`` (gamma_0 drawn from the stationary law), or 0 / 1.
     The loop runs over time only; every step is batched over paths.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the uniforms (one per path and step).
+    n_paths, horizon : int
+        Number of sample paths and of time steps.
+    p, q : float
+        Failure and recovery rates (module docstring).
+    initial : {"stationary", 0, 1}
+        ``gamma_0`` drawn from the stationary law, or fixed.
+
+    Returns
+    -------
+    ndarray of bool, shape ``(n_paths, horizon)``
+        True where the packet arrived.
+
+    Raises
+    ------
+    ValueError
+        If a rate is not in [0, 1] or ``initial`` is not one of the above.
     """
     p, q = float(_check_prob("p", p)), float(_check_prob("q", q))
     uniforms = rng.random((n_paths, horizon))
@@ -85,8 +132,22 @@ def gilbert_elliott_arrivals(
 def arrival_patterns(probs) -> tuple[np.ndarray, np.ndarray]:
     """All arrival patterns of independent sensors and their probabilities.
 
-    Returns ``(patterns, weights)``: ``patterns`` is a bool array ``(2**m, m)``,
-    ``weights[i] = prod_j probs_j**s_j (1-probs_j)**(1-s_j)``.
+    Parameters
+    ----------
+    probs : sequence of float
+        Arrival probability of each of the ``m`` sensors.
+
+    Returns
+    -------
+    patterns : ndarray of bool, shape ``(2**m, m)``
+        Every pattern ``s`` (True: sensor ``j`` delivered).
+    weights : ndarray, shape ``(2**m,)``
+        ``weights[i] = prod_j probs_j**s_j (1-probs_j)**(1-s_j)``.
+
+    Raises
+    ------
+    ValueError
+        If a probability is not in [0, 1].
     """
     probs = _check_prob("probs", probs).ravel()
     patterns = np.array(list(itertools.product([False, True], repeat=probs.size)), dtype=bool)

@@ -34,7 +34,19 @@ _ROW_PAD = 8  # doubles added to each row of a block buffer (see module docstrin
 
 
 def packed_index(n: int) -> np.ndarray:
-    """``(n, n)`` table of the packed position of entry ``(a, b)`` (upper triangle, row by row)."""
+    """``(n, n)`` table of the packed position of entry ``(a, b)`` (upper triangle, row by row).
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    ndarray of int64, shape ``(n, n)``
+        Symmetric: ``idx[a, b] = idx[b, a]`` is the position of ``P_ab`` among the
+        ``n (n + 1) / 2`` packed entries.
+    """
     idx = np.empty((n, n), dtype=np.int64)
     a_idx, b_idx = np.triu_indices(n)
     idx[a_idx, b_idx] = np.arange(len(a_idx))
@@ -48,6 +60,20 @@ def packed_prediction(A: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndar
     Entry ``(a, b)`` of ``A P A^T`` is ``sum_{k,l} A_ak A_bl P_kl``; grouping ``P_kl`` and
     ``P_lk`` (one packed entry) with the symmetrised coefficient ``(A_ak A_bl + A_al A_bk) / 2``
     makes the map exact on symmetric matrices, whatever rounding does.
+
+    Parameters
+    ----------
+    A : array_like, shape ``(n, n)``
+        State matrix.
+    Q : array_like, shape ``(n, n)`` or scalar
+        Process noise covariance (symmetrised).
+
+    Returns
+    -------
+    M : ndarray, shape ``(c, c)``
+        The linear part on packed entries, ``c = n (n + 1) / 2``.
+    q : ndarray, shape ``(c,)``
+        The packed ``Q``.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
     n = A.shape[0]
@@ -69,6 +95,16 @@ def arrival_words(arrivals: np.ndarray) -> np.ndarray:
     ``b & 7`` (little-endian). Without a copy when ``T * channels`` is a multiple of 8 (the row
     is padded with zeros otherwise). :func:`_transpose_block` turns each word into one byte of
     8 flag bits.
+
+    Parameters
+    ----------
+    arrivals : ndarray of bool, shape ``(N, T, channels)``
+        Arrival flags per path, step and channel.
+
+    Returns
+    -------
+    ndarray of uint64, shape ``(N, ceil(T * channels / 8))``
+        The flags, eight per word (a view when no padding is needed).
     """
     N, T, m = arrivals.shape
     flat = np.ascontiguousarray(arrivals, dtype=bool).reshape(N, T * m).view(np.uint8)
@@ -111,6 +147,16 @@ def small_state_kernel(n: int):
     direction to rounding: :func:`netrepro.engines.riccati.covariance_paths`, "Numerical range"). ``words`` are the arrivals from
     :func:`arrival_words`; ``hist`` is ``(N, T + 1, c)`` (the packed ``P_0 .. P_T``; ``T`` is
     taken from it) and ``last`` (``(N, c)``) receives ``P_T``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension (1 to 3; a compile-time constant of the kernel).
+
+    Returns
+    -------
+    callable
+        The compiled ``kernel`` above (cached per ``n``; it writes into ``hist`` and ``last``).
     """
     c = n * (n + 1) // 2
     idx = tuple(tuple(int(v) for v in row) for row in packed_index(n))
@@ -201,6 +247,11 @@ def scalar_kernel():
     ``p <- a2 p + q``. One division per update where the numpy kernel's
     ``r / (1 + r / p)`` needs two: the divider bounds this loop. ``words`` from
     :func:`arrival_words`; ``hist`` is ``(N, T + 1)`` or ``(N, 0)``; ``last`` is ``(N,)``.
+
+    Returns
+    -------
+    callable
+        The compiled ``kernel`` above (cached; it writes into ``hist`` and ``last``).
     """
     block = BLOCK_PATHS
     width = block + _ROW_PAD
@@ -252,6 +303,19 @@ def scalar_information_steps(j, a2, s2, F, J):
     ``j`` after step ``i``. Sequential in the step by nature; compiled because a numpy loop over
     ~1e6 steps of a few dozen lanes is all interpreter overhead. Same operations in the same
     order as that numpy loop, so bit-identical to it.
+
+    Parameters
+    ----------
+    j : ndarray, shape ``(lanes,)``
+        Initial information per lane; updated in place.
+    a2 : float
+        ``a^2``.
+    s2 : ndarray, shape ``(lanes,)``
+        Process noise variance per lane.
+    F : ndarray, shape ``(steps, lanes)``
+        Fisher information of the measurement at each step.
+    J : ndarray, shape ``(steps, lanes)``
+        Receives ``j`` after each step (output).
     """
     for i in range(F.shape[0]):
         for lane in range(j.shape[0]):

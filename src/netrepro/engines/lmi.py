@@ -30,7 +30,23 @@ SOLVER = "CLARABEL"
 
 @dataclass
 class LMIOutcome:
-    """One solve: the solver's status, its margin, and our independent verdict."""
+    """One solve: the solver's status, its margin, and our independent verdict.
+
+    Attributes
+    ----------
+    status : str
+        The solver's status (or ``solver_error: ...``).
+    margin : float
+        The maximised ``t`` in ``Psi >= t I`` (nan when the solver failed).
+    solver_feasible : bool
+        Status optimal and margin above the tolerance.
+    certified : bool
+        The independent check passed (see :class:`MareStabilizabilityLMI`).
+    certificate_value : float
+        E.g. the spectral radius of the closed loop (nan if none).
+    variables : dict
+        The recovered values (e.g. ``Y`` and the gains ``K``).
+    """
 
     status: str
     margin: float  # the maximised t in Psi >= t I (nan when the solver failed)
@@ -42,6 +58,22 @@ class LMIOutcome:
 
 @dataclass
 class BisectionResult:
+    """Outcome of :func:`bisect_monotone` / :func:`bisect_bracketed`.
+
+    Attributes
+    ----------
+    threshold : float
+        Smallest value found feasible (upper end of the final bracket; nan if none).
+    lower : float
+        Largest value found infeasible (nan if none).
+    n_evals : int
+        Number of predicate evaluations.
+    history : list of (float, bool)
+        ``(value, feasible)`` pairs in evaluation order.
+    bracketed : bool
+        True when ``lower`` was infeasible and ``threshold`` feasible.
+    """
+
     threshold: float  # smallest value found feasible (upper end of the final bracket)
     lower: float  # largest value found infeasible
     n_evals: int
@@ -93,6 +125,22 @@ def bisect_monotone(is_feasible, lo: float, hi: float, tol: float = 1e-4, max_ev
     The ends are evaluated first; if ``lo`` is feasible, the threshold is ``lo``;
     if ``hi`` is infeasible the result has ``threshold = nan``. Otherwise the bracket is
     halved until it is at most ``tol`` wide; the threshold is a point of :func:`_lattice`.
+
+    Parameters
+    ----------
+    is_feasible : callable
+        ``is_feasible(x) -> bool``, monotone in ``x``.
+    lo, hi : float
+        The search interval.
+    tol : float
+        Target bracket width (the lattice spacing).
+    max_evals : int
+        Caps the number of halvings.
+
+    Returns
+    -------
+    BisectionResult
+        The threshold, the bracket and the evaluation history.
     """
     check, history = _recording(is_feasible)
     n, point = _lattice(lo, hi, tol, max_evals)
@@ -116,6 +164,29 @@ def bisect_bracketed(is_feasible, lo: float, hi: float, guess: float, width: flo
     exactly those of :func:`bisect_monotone` (both are the smallest feasible lattice point and
     its neighbour), so the guess changes the number of evaluations, never the answer. With a
     good guess that is about ``2 + log2(2 width / tol)`` instead of ``2 + log2((hi - lo) / tol)``.
+
+    Parameters
+    ----------
+    is_feasible : callable
+        ``is_feasible(x) -> bool``, monotone in ``x``.
+    lo, hi : float
+        The search interval.
+    guess : float
+        Estimate of the threshold (non-finite: plain :func:`bisect_monotone`).
+    width : float
+        Half-width of the first bracket around ``guess``.
+    tol, max_evals : float, int
+        As in :func:`bisect_monotone`.
+
+    Returns
+    -------
+    BisectionResult
+        The same threshold and lower end as :func:`bisect_monotone`.
+
+    Raises
+    ------
+    ValueError
+        If ``lo > hi``.
     """
     if not lo <= hi:
         raise ValueError(f"bisect_bracketed needs lo <= hi, got lo={lo}, hi={hi}")
@@ -159,6 +230,22 @@ def sweep_thresholds(make_predicate, grid, lo: float, hi: float, tol: float = 1e
     at least ``2 tol``). ``warm_start=False`` runs plain bisections throughout
     (the reference). For monotone predicates every threshold equals the plain bisection's
     exactly (:func:`bisect_bracketed`); only the number of solves changes.
+
+    Parameters
+    ----------
+    make_predicate : callable
+        ``make_predicate(x) -> is_feasible`` for grid point ``x``.
+    grid : iterable of float
+        The grid points, in sweep order.
+    lo, hi, tol, max_evals : float, float, float, int
+        As in :func:`bisect_monotone`.
+    warm_start : bool
+        Start each bisection from the extrapolated neighbours (same answers, fewer solves).
+
+    Returns
+    -------
+    list of BisectionResult
+        One per grid point.
     """
     results, found = [], []
     for x in grid:
@@ -189,6 +276,18 @@ def second_moment_radius(closed_loops, weights) -> float:
 
     The expected error covariance of a switched linear recursion with i.i.d.
     mode weights ``w_i`` stays bounded for every noise level iff this is < 1.
+
+    Parameters
+    ----------
+    closed_loops : sequence of ndarray (n, n)
+        The matrices ``F_i``.
+    weights : sequence of float
+        The weights ``w_i``.
+
+    Returns
+    -------
+    float
+        The spectral radius.
     """
     op = sum(w * np.kron(F, F) for F, w in zip(closed_loops, weights))
     return float(np.max(np.abs(np.linalg.eigvals(np.atleast_2d(op)))))
@@ -212,6 +311,28 @@ class MareStabilizabilityLMI:
     The problem maximises t subject to Psi >= t I and 0 <= Y <= I (the LMI is
     homogeneous, so the bound only fixes the scale). The weights' square
     roots are :class:`cvxpy.Parameter` objects: a sweep compiles once.
+
+    :meth:`solve` keeps its historical decision rule (status optimal, margin above
+    ``margin_tol``, then the second-moment radius); :meth:`certify` gives the verdict of
+    :mod:`netrepro.engines.certify` (feasible / infeasible / undecided, each certified).
+
+    Parameters
+    ----------
+    A : array_like, shape ``(n, n)``
+        State matrix.
+    mode_outputs : sequence of (array_like or None)
+        ``C_i`` delivered by mode ``i`` (None: nothing arrives).
+    margin_tol : float
+        Margin above which :meth:`solve` counts a solve as solver-feasible.
+
+    Attributes
+    ----------
+    problem : cvxpy.Problem
+        The parametrised problem (maximise ``t``).
+    psi : cvxpy.Expression
+        The symmetrised ``Psi``.
+    n_solves : int
+        Solves so far (:meth:`solve` and :meth:`certify`).
     """
 
     def __init__(self, A, mode_outputs, margin_tol: float = 1e-7):
@@ -237,12 +358,118 @@ class MareStabilizabilityLMI:
             blocks.append(row)
         psi = cp.bmat(blocks)
         size = n * (m + 1)
-        constraints = [0.5 * (psi + psi.T) >> self.t * np.eye(size), self.Y << np.eye(n), self.Y >> 0]
+        self.psi = 0.5 * (psi + psi.T)
+        constraints = [self.psi >> self.t * np.eye(size), self.Y << np.eye(n), self.Y >> 0]
         self.problem = cp.Problem(cp.Maximize(self.t), constraints)
         self.n_solves = 0
+        self._certifier = None
+
+    def certifier(self, box=None, dual_routes=("exact", "box")):
+        """The :class:`~netrepro.engines.certify.CertifiedLMI` of this LMI: blocks ``Psi > 0`` and ``Y > 0``.
+
+        Built on first use and kept (the same cvxpy problem and parameters), so a sweep compiles
+        once. The system is homogeneous in ``(Y, Z_i)``: a ``box`` bounds the coordinates after the
+        normalisation ``lambda_min = 1`` (see :func:`~netrepro.engines.certify.check_dual_certificate`).
+
+        Parameters
+        ----------
+        box : float, dict or None
+            Passed to :class:`~netrepro.engines.certify.CertifiedLMI` on first use only.
+        dual_routes : tuple of str
+            Passed likewise.
+
+        Returns
+        -------
+        CertifiedLMI
+            The certifier.
+        """
+        if self._certifier is None:
+            from .certify import CertifiedLMI
+
+            self._certifier = CertifiedLMI([("Psi", self.psi), ("Y", self.Y)], problem=self.problem, box=box,
+                                           dual_routes=dual_routes)
+        return self._certifier
+
+    def loss_condition(self, weights):
+        """The necessary condition ``w_loss rho(A)^2 < 1``, computed without the LMI.
+
+        ``w_loss`` is the total weight of the modes that deliver nothing (``C_i = None``): the
+        operator dominates ``X -> w_loss A X A^T``, so a solution needs ``w_loss rho(A)^2 < 1``
+        (Sinopoli et al. 2004; for ``C`` invertible it is also sufficient). Called violated
+        only when ``w_loss rho(A)^2 >= 1 + 1e-9`` (the margin covers the eigenvalue error of a
+        moderately conditioned ``A``).
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities.
+
+        Returns
+        -------
+        tuple (bool, str)
+            ``(violated, evidence)``, the form :meth:`CertifiedLMI.certify` takes.
+        """
+        w_loss = float(sum(w for w, C in zip(np.asarray(weights, dtype=float), self.mode_outputs) if C is None))
+        rho = float(np.max(np.abs(np.linalg.eigvals(self.A))))
+        value = w_loss * rho ** 2
+        return value >= 1.0 + 1e-9, f"w_loss * rho(A)^2 = {value:.12g}"
+
+    def certify(self, weights, necessary=True, box=None):
+        """Solve for mode probabilities ``weights`` and return the certified verdict.
+
+        Unlike :meth:`solve` (kept unchanged for the tables that use it), the answer is one of
+        ``feasible`` (our eigenvalue check of ``Psi > 0, Y > 0`` at the returned point),
+        ``infeasible`` (the loss condition of :meth:`loss_condition` is violated, or a checked
+        dual certificate) or ``undecided``; the solver status is information only.
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities (non-negative, one per mode).
+        necessary : bool or callable
+            True: use :meth:`loss_condition`; False: none; a callable: ``() -> (violated, evidence)``.
+        box : float, dict or None
+            Passed to :meth:`certifier` on its first use.
+
+        Returns
+        -------
+        Verdict
+            The certified verdict.
+
+        Raises
+        ------
+        ValueError
+            If ``weights`` has the wrong length or a negative entry.
+        """
+        weights = np.asarray(weights, dtype=float)
+        if weights.shape != (len(self.mode_outputs),) or np.any(weights < 0):
+            raise ValueError(f"weights must be {len(self.mode_outputs)} non-negative numbers, got {weights}")
+        self.sqrt_w.value = np.sqrt(weights)
+        self.n_solves += 1
+        if necessary is True:
+            nec = (lambda: self.loss_condition(weights))
+        else:
+            nec = necessary or None
+        return self.certifier(box).solve(necessary=nec)
 
     def solve(self, weights) -> LMIOutcome:
-        """Solve for mode probabilities ``weights``; certify any feasible answer independently."""
+        """Solve for mode probabilities ``weights``; certify any feasible answer independently.
+
+        Parameters
+        ----------
+        weights : array_like
+            Mode probabilities (non-negative, one per mode).
+
+        Returns
+        -------
+        LMIOutcome
+            Status, margin, and the second-moment-radius check of the recovered gains.
+
+        Raises
+        ------
+        ValueError
+            If ``weights`` has the wrong length or a negative entry.
+        """
         weights = np.asarray(weights, dtype=float)
         if weights.shape != (len(self.mode_outputs),) or np.any(weights < 0):
             raise ValueError(f"weights must be {len(self.mode_outputs)} non-negative numbers, got {weights}")

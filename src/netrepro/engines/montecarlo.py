@@ -23,11 +23,41 @@ __all__ = ["block_rng", "n_blocks", "run_blocks", "merge_block_sums", "MonteCarl
 
 
 def block_rng(seed: int, block: int) -> np.random.Generator:
-    """The generator of block ``block`` under root seed ``seed``."""
+    """The generator of block ``block`` under root seed ``seed``.
+
+    Parameters
+    ----------
+    seed : int
+        Root seed of the experiment.
+    block : int
+        Block index.
+
+    Returns
+    -------
+    numpy.random.Generator
+        ``default_rng(SeedSequence(seed, spawn_key=(block,)))``.
+    """
     return np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(block),)))
 
 
 def n_blocks(n_paths: int, block_size: int) -> int:
+    """Number of blocks of ``block_size`` paths that hold ``n_paths`` paths (the last may be short).
+
+    Parameters
+    ----------
+    n_paths, block_size : int
+        Positive path count and block size.
+
+    Returns
+    -------
+    int
+        ``ceil(n_paths / block_size)``.
+
+    Raises
+    ------
+    ValueError
+        If either argument is not positive.
+    """
     if n_paths <= 0 or block_size <= 0:
         raise ValueError(f"n_paths and block_size must be positive, got {n_paths}, {block_size}")
     return -(-n_paths // block_size)
@@ -42,7 +72,17 @@ def _block_sizes(n_paths, block_size):
 
 @dataclass
 class MonteCarloSums:
-    """Per-block sums; combine with :func:`merge_block_sums`, read with :meth:`mean` / :meth:`ci`."""
+    """Per-block sums; combine with :func:`merge_block_sums`, read with :meth:`mean` / :meth:`ci`.
+
+    Attributes
+    ----------
+    blocks : ndarray of int, shape ``(B,)``
+        Block indices, in block order.
+    counts : ndarray of int, shape ``(B,)``
+        Paths per block.
+    sums, sumsq, maxima : dict
+        Key -> ``(B, ...)`` arrays: per-block sum, sum of squares and maximum over paths.
+    """
 
     blocks: np.ndarray  # (B,) block indices
     counts: np.ndarray  # (B,)
@@ -91,6 +131,24 @@ def run_blocks(fn, n_paths: int, block_size: int, seed: int, blocks=None, chunk_
     ``chunk_blocks`` blocks' worth of paths are simulated per call of ``fn``
     only when it does not change results: each block still uses its own
     generator, so chunking here only groups the bookkeeping.
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(rng, n) -> dict[str, ndarray]``, per-path values (first axis = path).
+    n_paths, block_size : int
+        Total paths and paths per block.
+    seed : int
+        Root seed (:func:`block_rng`).
+    blocks : iterable of int or None
+        Which blocks to run (default: all).
+    chunk_blocks : int
+        Bookkeeping grouping (no effect on results).
+
+    Returns
+    -------
+    MonteCarloSums
+        The per-block sums of the blocks run.
     """
     sizes = _block_sizes(n_paths, block_size)
     blocks = np.arange(len(sizes)) if blocks is None else np.asarray(list(blocks), dtype=int)
@@ -110,7 +168,23 @@ def run_blocks(fn, n_paths: int, block_size: int, seed: int, blocks=None, chunk_
 
 
 def merge_block_sums(parts) -> MonteCarloSums:
-    """Merge partial results (e.g. from shards), ordering by block index."""
+    """Merge partial results (e.g. from shards), ordering by block index.
+
+    Parameters
+    ----------
+    parts : iterable of MonteCarloSums
+        Results over disjoint sets of blocks, with the same keys.
+
+    Returns
+    -------
+    MonteCarloSums
+        All blocks, in block order.
+
+    Raises
+    ------
+    ValueError
+        If a block appears in two parts.
+    """
     parts = list(parts)
     blocks = np.concatenate([p.blocks for p in parts])
     order = np.argsort(blocks, kind="stable")
@@ -128,21 +202,66 @@ def merge_block_sums(parts) -> MonteCarloSums:
 
 
 def run_monte_carlo(fn, n_paths: int, block_size: int, seed: int, n_chunks: int = 1) -> MonteCarloSums:
-    """All blocks, split into ``n_chunks`` contiguous chunks and merged (same result for any ``n_chunks``)."""
+    """All blocks, split into ``n_chunks`` contiguous chunks and merged (same result for any ``n_chunks``).
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(rng, n) -> dict[str, ndarray]`` (see :func:`run_blocks`).
+    n_paths, block_size : int
+        Total paths and paths per block.
+    seed : int
+        Root seed.
+    n_chunks : int
+        Number of chunks (no effect on results).
+
+    Returns
+    -------
+    MonteCarloSums
+        Every block's sums.
+    """
     nb = n_blocks(n_paths, block_size)
     chunks = np.array_split(np.arange(nb), max(1, min(n_chunks, nb)))
     return merge_block_sums(run_blocks(fn, n_paths, block_size, seed, blocks=c) for c in chunks if len(c))
 
 
 def shard_blocks(n_paths: int, block_size: int, n_shards: int, shard: int) -> np.ndarray:
-    """Block indices of shard ``shard`` (0-based) when all blocks are split into ``n_shards`` contiguous shards."""
+    """Block indices of shard ``shard`` (0-based) when all blocks are split into ``n_shards`` contiguous shards.
+
+    Parameters
+    ----------
+    n_paths, block_size : int
+        Total paths and paths per block.
+    n_shards : int
+        Number of shards.
+    shard : int
+        This shard, ``0 <= shard < n_shards``.
+
+    Returns
+    -------
+    ndarray of int
+        The shard's block indices.
+
+    Raises
+    ------
+    ValueError
+        If ``shard`` is out of range.
+    """
     if not 0 <= shard < n_shards:
         raise ValueError(f"shard must be in [0, {n_shards}), got {shard}")
     return np.array_split(np.arange(n_blocks(n_paths, block_size)), n_shards)[shard]
 
 
 def save_sums(path, named: dict) -> None:
-    """Write several :class:`MonteCarloSums` (name -> sums) to one ``.npz`` file, atomically."""
+    """Write several :class:`MonteCarloSums` (name -> sums) to one ``.npz`` file, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.npz`` file.
+    named : dict
+        Name -> :class:`MonteCarloSums` (names and keys must not contain ``|``).
+    """
     from ..io import atomic_path
 
     arrays = {}
@@ -158,7 +277,18 @@ def save_sums(path, named: dict) -> None:
 
 
 def load_sums(path) -> dict:
-    """Inverse of :func:`save_sums`."""
+    """Inverse of :func:`save_sums`.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file written by :func:`save_sums`.
+
+    Returns
+    -------
+    dict
+        Name -> :class:`MonteCarloSums`.
+    """
     out = {}
     with np.load(path) as data:
         for full in data.files:

@@ -43,7 +43,20 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Sensor:
-    """One sensor: output matrix ``C`` (m x n) and noise covariance ``R`` (m x m)."""
+    """One sensor: output matrix ``C`` (m x n) and noise covariance ``R`` (m x m).
+
+    Parameters
+    ----------
+    C : array_like, shape ``(m, n)``
+        Output matrix (a vector is one row).
+    R : array_like, shape ``(m, m)``
+        Measurement noise covariance.
+
+    Raises
+    ------
+    ValueError
+        If ``R`` does not match the rows of ``C``.
+    """
 
     C: np.ndarray
     R: np.ndarray
@@ -58,7 +71,25 @@ class Sensor:
 
 
 def as_sensors(C, R) -> list[Sensor]:
-    """Split a stacked ``(C, R)`` with block-diagonal ``R`` into one sensor per output row."""
+    """Split a stacked ``(C, R)`` with diagonal ``R`` into one sensor per output row.
+
+    Parameters
+    ----------
+    C : array_like, shape ``(m, n)``
+        Stacked output matrix.
+    R : array_like, shape ``(m, m)``
+        Diagonal noise covariance (independent sensor noises).
+
+    Returns
+    -------
+    list of Sensor
+        One scalar sensor per row of ``C``.
+
+    Raises
+    ------
+    ValueError
+        If ``R`` has an off-diagonal entry.
+    """
     C = np.atleast_2d(np.asarray(C, dtype=float))
     R = np.atleast_2d(np.asarray(R, dtype=float))
     off = R - np.diag(np.diag(R))
@@ -74,7 +105,19 @@ def _is_scalar_problem(A, sensors):
 def measurement_update(P: np.ndarray, sensor: Sensor, received: np.ndarray) -> np.ndarray:
     """Posterior covariance after one sensor's packet, batched: ``P - g P C^T (C P C^T + R)^{-1} C P``.
 
-    ``P`` has shape ``(N, n, n)``; ``received`` is a bool array ``(N,)``.
+    Parameters
+    ----------
+    P : ndarray, shape ``(N, n, n)``
+        Prior covariances.
+    sensor : Sensor
+        The sensor whose packet is (or is not) received.
+    received : ndarray of bool, shape ``(N,)``
+        ``g``: whether each path received the packet.
+
+    Returns
+    -------
+    ndarray, shape ``(N, n, n)``
+        Posterior covariances (symmetrised; the prior where nothing arrived).
     """
     C, R = sensor.C, sensor.R
     PCt = P @ C.T  # (N, n, m)
@@ -97,15 +140,30 @@ def covariance_paths(P0, A, Q, sensors, arrivals: np.ndarray, keep: str = "all",
     P0 : array (n, n) or scalar
         Initial covariance, common to all paths.
     A, Q : arrays (n, n)
+        State matrix and process noise covariance.
     sensors : list of :class:`Sensor`
+        The sensors, one arrival channel each.
     arrivals : bool array ``(N, T)`` (one sensor) or ``(N, T, n_sensors)``
-    keep : ``"all"`` returns ``P_0..P_T`` with shape ``(N, T+1, n, n)``;
+        Which packets arrived, per path and step.
+    keep : {"all", "last"}
+        ``"all"`` returns ``P_0..P_T`` with shape ``(N, T+1, n, n)``;
         ``"last"`` returns ``P_T`` with shape ``(N, n, n)``.
-    kernel : ``"compiled"`` (default) runs n <= 3 on the fused numba kernels of
+    kernel : {"compiled", "numpy", "dense"}
+        ``"compiled"`` (default) runs n <= 3 on the fused numba kernels of
         :mod:`netrepro.engines.kernels`; ``"numpy"`` on the batched numpy kernels (the
         reference form the benchmark and tests compare with); ``"dense"`` on the plain
         ``(N, n, n)`` batches with one LAPACK-style update per sensor. All three agree to
         rounding; n > 3 (or a sensor noise that is not positive definite) always runs dense.
+
+    Returns
+    -------
+    ndarray
+        The covariances, shaped as ``keep`` says (scalar problems: see Notes).
+
+    Raises
+    ------
+    ValueError
+        If ``arrivals`` does not match ``sensors``, or ``keep`` / ``kernel`` is unknown.
 
     Notes
     -----
@@ -313,6 +371,18 @@ def packed_flops_per_step(n: int, n_rows: int) -> int:
     counts as two flops. This is the count of the compiled kernel
     (:func:`netrepro.engines.kernels.small_state_kernel`) and the one the benchmark's
     "fraction of peak" uses; the numpy kernel works on all ``n^2`` entries (more flops).
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+    n_rows : int
+        Scalar measurement rows per step.
+
+    Returns
+    -------
+    int
+        Flops per path and step.
     """
     m = n * (n + 1) // 2
     return n_rows * (2 * n * n + 2 * n + 1 + n + 2 * m) + 2 * m * m
@@ -429,7 +499,22 @@ def expected_riccati_map(X, A, Q, sensors, probs) -> np.ndarray:
     over all arrival patterns S. For one sensor this is Sinopoli's modified
     algebraic Riccati map g_lambda(X); for two scalar sensors it is the
     corrected eq. (15) of the `intermittent` report (Liu & Goldsmith).
-    ``X`` may be batched with shape ``(B, n, n)``.
+
+    Parameters
+    ----------
+    X : array_like, shape ``(n, n)`` or ``(B, n, n)``
+        Covariance(s) to map.
+    A, Q : array_like, shape ``(n, n)``
+        State matrix and process noise covariance.
+    sensors : list of Sensor
+        The sensors.
+    probs : sequence of float
+        Independent arrival probability of each sensor.
+
+    Returns
+    -------
+    ndarray
+        ``g(X)``, shaped like ``X``.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
@@ -449,7 +534,26 @@ def expected_riccati_map(X, A, Q, sensors, probs) -> np.ndarray:
 
 
 def iterate_expected_riccati(X0, A, Q, sensors, probs, n_steps: int) -> np.ndarray:
-    """``X_0, g(X_0), g(g(X_0)), ...`` (n_steps + 1 matrices): the upper-bound sequence."""
+    """``X_0, g(X_0), g(g(X_0)), ...`` (n_steps + 1 matrices): the upper-bound sequence.
+
+    Parameters
+    ----------
+    X0 : array_like, shape ``(n, n)``
+        Starting covariance.
+    A, Q : array_like, shape ``(n, n)``
+        State matrix and process noise covariance.
+    sensors : list of Sensor
+        The sensors.
+    probs : sequence of float
+        Arrival probabilities (:func:`expected_riccati_map`).
+    n_steps : int
+        Number of applications of ``g``.
+
+    Returns
+    -------
+    ndarray, shape ``(n_steps + 1, n, n)``
+        The sequence (overflow gives ``inf``, silently).
+    """
     X = np.atleast_2d(np.asarray(X0, dtype=float))
     seq = [X]
     with np.errstate(over="ignore", invalid="ignore"):

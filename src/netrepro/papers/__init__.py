@@ -1,5 +1,7 @@
 """One module per paper. ``PAPERS`` maps each slug to its source text and title."""
 
+__all__ = ["PAPERS"]
+
 PAPERS = {
     "intermittent": {
         "file": "000_afcb209f5b7aba6b.txt",
