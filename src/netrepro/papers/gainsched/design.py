@@ -539,7 +539,7 @@ def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains,
 
 
 def recover_output_gains(values: dict) -> Gains:
-    """Gains of form (9) of the full-slack performance design (``output_slack``), estimate x̂ = L̄ x_f.
+    r"""Gains of form (9) of the full-slack performance design (``output_slack``), estimate x̂ = L̄ x_f.
 
     With the ``identity_T`` realisation (J = I, so L_f = L̄), (26) gives G(p), H(p) for x_f and
     the estimate is x̂ = L̄ x_f. In the coordinates x̃ = L̄ x_f (L̄ nonsingular, x̃(0) = 0 when
