@@ -6,15 +6,10 @@ import numpy as np
 import pytest
 
 from netrepro.papers.gainsched.design import Theorem3
+from netrepro.engines.certify import FEASIBLE, INFEASIBLE
 from netrepro.papers.gainsched.feasibility import (
-    FEASIBLE,
-    INFEASIBLE,
-    UNDECIDED,
     PlantLMI,
-    Verdict,
-    bisect_certified,
-    check_blocks,
-    eig_margin,
+    necessary_condition,
     necessary_limit,
     plant_vertex_radius,
     with_sigma2,
@@ -27,13 +22,10 @@ def _scalar_system(a=0.5, b=0.2, d=0.6, f1=0.5, f2=2.0, sigma2=1.0):
     return System(m(a), m(b), m(1.0), m(d), m(1.0), m(f1), m(f2), sigma2, 0.4, 0.8)
 
 
-def test_check_blocks_respects_the_margin():
-    assert check_blocks(negative=[-np.eye(3)], positive=[np.eye(2)])[0]
-    tiny = np.diag([-1.0, -1e-17])  # negative, but within rounding of a norm-1 matrix: not certified
-    assert not check_blocks(negative=[tiny])[0]
-    assert eig_margin(np.eye(4)) == pytest.approx(100 * 4 * 2.0 ** -53 * 2.0)
-    ok, slack = check_blocks(negative=[np.diag([-1.0, 0.5])])
-    assert not ok and slack < 0
+def test_necessary_condition_callable_matches_the_radius(sys):
+    below, above = necessary_limit(sys, 0.25, 10.0)
+    assert necessary_condition(sys, above)()[0] and not necessary_condition(sys, below)()[0]
+    assert "radius" in necessary_condition(sys, above)()[1]
 
 
 def test_vertex_radius_and_necessary_limit_against_the_scalar_closed_form():
@@ -50,7 +42,7 @@ def test_plant_lmi_certificate_implies_decrease_at_every_linear_vertex(sys):
     """A certified plant certificate P gives (A+BFZ)^T P (A+BFZ) + sigma^2 D^T P D < P at every vertex F."""
     lmi = PlantLMI(sys)
     v = lmi.certify(sys.sigma2)
-    assert v.verdict == FEASIBLE
+    assert v.verdict == FEASIBLE and v.point.slack > 0
     P = np.array(lmi.P.value)
     for F in sector_cases(sys).values():
         AF = sys.A + sys.B @ F @ sys.Z
@@ -60,7 +52,7 @@ def test_plant_lmi_certificate_implies_decrease_at_every_linear_vertex(sys):
 def test_plant_lmi_infeasible_beyond_the_necessary_condition(sys):
     _, above = necessary_limit(sys, 0.25, 10.0)
     v = PlantLMI(sys).certify(above + 0.05)
-    assert v.verdict == INFEASIBLE and v.radius >= 1
+    assert v.verdict == INFEASIBLE and plant_vertex_radius(sys, above + 0.05) >= 1
 
 
 def test_optimal_inaccurate_at_a_strictly_feasible_point(sys):
@@ -69,7 +61,7 @@ def test_optimal_inaccurate_at_a_strictly_feasible_point(sys):
     prob = Theorem3(sys, bound=100.0, margin_cap=0.1)
     verdict, sol = prob.certify(3.9)
     assert sol.status == "optimal_inaccurate"
-    assert verdict.verdict == FEASIBLE and verdict.slack > 0
+    assert verdict.verdict == FEASIBLE and verdict.point.slack > 0
     # independent of check_point: every vertex matrix evaluated afresh and its eigenvalues read directly
     ps = (sys.p1, sys.p2)
     worst = max(np.linalg.eigvalsh(0.5 * (M + M.T)).max()
@@ -92,18 +84,11 @@ def test_zero_filter_design_has_zero_gains(sys):
         assert np.all(sol.values[k] == 0)
 
 
-def test_bisect_certified_brackets_with_certified_ends():
-    def decide(x):
-        v = FEASIBLE if x < 1.0 else (UNDECIDED if x < 1.2 else INFEASIBLE)
-        return Verdict(v, np.nan, np.nan)
-
-    b = bisect_certified(decide, 0.0, 2.0, tol=1e-3)
-    assert b.certified and b.lo < 1.0 <= b.undecided_lo and b.hi >= 1.2
-    assert b.undecided_lo - b.lo <= 1e-3 + 1e-12
-    for x, v in b.history:
-        assert v == decide(x).verdict
-    # no feasible point at all: lower end not certified
-    assert not bisect_certified(lambda x: Verdict(INFEASIBLE, np.nan, np.nan), 0.0, 1.0, 1e-3).certified
+def test_theorem3_decisions_are_monotone_in_sigma2(sys):
+    """Feasible below, infeasible above (by point check, dual certificate or the necessary condition)."""
+    prob = Theorem3(sys, bound=100.0)
+    verdicts = [prob.certify(s2)[0].verdict for s2 in (1.0, 3.5, 3.9, 4.0, 5.0)]
+    assert verdicts[:3] == [FEASIBLE] * 3 and verdicts[3:] == [INFEASIBLE] * 2
 
 
 def test_with_sigma2_changes_only_sigma2(sys):

@@ -254,13 +254,15 @@ def claims_step(params, inputs, outputs):
                           "the fixed-gain filter (largest sigma^2 for which Theorem 3 is feasible)", True, better, 0,
                           "qualitative, certified: the scheduled design certified feasible at a sigma^2 where the "
                           "fixed-gain design is certified infeasible",
-                          note=f"certified brackets of the limit: scheduled [{sch['sigma2_lo']:.4g}, "
-                               f"{sch['sigma2_hi']:.4g}], fixed gain [{fix['sigma2_lo']:.4g}, {fix['sigma2_hi']:.4g}], "
-                               f"zero filter [{limits.loc['zero', 'sigma2_lo']:.4g}, {limits.loc['zero', 'sigma2_hi']:.4g}], "
-                               f"plant [{limits.loc['plant', 'sigma2_lo']:.4g}, {limits.loc['plant', 'sigma2_hi']:.4g}]"
-                               "; every upper end is the plant's own necessary condition: (10) is block-triangular, "
-                               "so no filter gain can move the limit (the former 3.725 for both read optimal_inaccurate "
-                               "as infeasible)"))
+                          note=f"certified brackets of the limit: scheduled [{sch['sigma2_lo']:.5g}, "
+                               f"{sch['sigma2_hi']:.5g}], fixed gain [{fix['sigma2_lo']:.5g}, {fix['sigma2_hi']:.5g}], "
+                               f"zero filter [{limits.loc['zero', 'sigma2_lo']:.5g}, {limits.loc['zero', 'sigma2_hi']:.5g}], "
+                               f"plant [{limits.loc['plant', 'sigma2_lo']:.5g}, {limits.loc['plant', 'sigma2_hi']:.5g}]"
+                               "; upper ends certified by: " + "; ".join(
+                                   f"{d}: {str(limits.loc[d, 'infeasible_by']).split(':')[0]}"
+                                   for d in ("scheduled", "fixed_gain", "zero", "plant"))
+                               + ". (10) is block-triangular, so the filter gains cannot move the plant's limit; "
+                               "the former 3.725 for both designs read optimal_inaccurate as infeasible"))
     # Remark 2: 0.5
     rows.append(claim_row(PAPER, "remark2_missing_bound", "Remark 2: a sensor whose missing probability exceeds 0.5 "
                           "is replaced, so the missing probability is bounded by 0.5", 0.5, 1.0 - sys.p1, 0.0,

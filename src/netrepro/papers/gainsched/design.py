@@ -186,6 +186,8 @@ class Theorem3:
         L = np.hstack([np.eye(n), -np.eye(n)])
         self.n_vertices = 0
         self._vertices = []
+        self._blocks = []
+        self._certifier = None
         self._eps = eps
         self._qp_positive = qp_positive
         for i in range(2):
@@ -201,6 +203,7 @@ class Theorem3:
                             big = cp.bmat([[Msym, Erow.T], [Erow, -np.eye(n)]])
                             big = 0.5 * (big + big.T)
                             self._vertices.append(big)
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -big))
                             cons.append(big << -eps * np.eye(size + n))
                             self.n_vertices += 1
                             continue
@@ -208,8 +211,10 @@ class Theorem3:
                         if performance:
                             E = np.zeros((size, size))
                             E[:nn, :nn] = L.T @ L
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -(Msym + E)))
                             cons.append(Msym + E << -eps * np.eye(size))
                         else:
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -Msym))
                             cons.append(Msym << -self.t * np.eye(size))
                         self.n_vertices += 1
         if performance:
@@ -224,6 +229,29 @@ class Theorem3:
             cons.append(self.t <= margin_cap)
             self.problem = cp.Problem(cp.Maximize(self.t), cons)
         self.margin_tol = eps
+        if qp_positive:
+            self._blocks += [("Qbar0", v["Q0"]), ("Qbarp", v["Qp"])]
+        else:
+            self._blocks += [(f"Qbar(p{k + 1})", v["Q0"] + p * v["Qp"]) for k, p in enumerate(ps)]
+
+    @property
+    def certifier(self):
+        """The shared engine's certifier of this LMI system (built on first use).
+
+        The question is the strict system of (24)-(25) (and (27)): every vertex matrix negative
+        definite (with the bound term for the performance designs) and Q̄0, Q̄p positive definite.
+        The entry bounds and the margin cap are normalisations, not part of it.
+
+        Returns
+        -------
+        netrepro.engines.certify.CertifiedLMI
+        """
+        if self._certifier is None:
+            from ...engines.certify import CertifiedLMI
+
+            self._certifier = CertifiedLMI(self._blocks, problem=self.problem,
+                                           drop=() if self.performance else (self.t,))
+        return self._certifier
 
     # -- the blocks of (24)-(25), one function each, so they read against the paper
     def Qbar(self, p):
@@ -423,7 +451,7 @@ class Theorem3:
                                 self.n_scalar_variables())
 
     def check_point(self, values: dict, sigma2: float):
-        """Our own check of a candidate point of (24)-(25) (and Q̄0, Q̄p > 0 of (27)), whatever the solver said.
+        """The engine's eigenvalue check of a candidate point of (24)-(25), (27), whatever the solver said.
 
         Parameters
         ----------
@@ -434,29 +462,21 @@ class Theorem3:
         Returns
         -------
         tuple
-            ``(ok, slack)`` of :func:`.feasibility.check_blocks`: every vertex matrix (plus L^T L in the
-            (1,1) block for the performance design) negative definite and the Q̄ blocks positive
-            definite, each beyond its fixed margin.
+            ``(ok, slack)``: every block strictly on its side beyond the engine's margin, and the
+            smallest ``min_eig - tolerance`` over the blocks (> 0 iff ``ok``).
         """
-        from .feasibility import check_blocks
+        from ...engines.certify import check_point
 
         for name, var in self.vars.items():
             var.value = values[name]
         self.sigma2.value = float(sigma2)
-        nn = 2 * self.sys.n
-        L = np.hstack([np.eye(self.sys.n), -np.eye(self.sys.n)])
-        negative = []
-        for M in self._vertices:
-            V = np.array(M.value, dtype=float)
-            if self.performance and not self.output_slack:
-                V[:nn, :nn] += L.T @ L
-            negative.append(V)
-        Q0, Qp = np.array(values["Q0"], float), np.array(values["Qp"], float)
-        positive = [Q0, Qp] if self._qp_positive else [Q0 + p * Qp for p in (self.sys.p1, self.sys.p2)]
-        return check_blocks(negative=negative, positive=positive)
+        cert = self.certifier
+        pc = check_point(cert.coefficients(), cert.point(), safety=cert.safety)
+        return bool(pc.feasible), float(pc.slack)
 
     def certify(self, sigma2: float | None = None):
-        """Solve at ``sigma2`` and decide: feasible (our point check), infeasible (necessary condition), undecided.
+        """Solve at ``sigma2`` and decide with the engine: feasible (point check), infeasible (necessary
+        condition of :mod:`.feasibility`, or a checked dual certificate), undecided.
 
         Parameters
         ----------
@@ -465,20 +485,14 @@ class Theorem3:
         Returns
         -------
         tuple
-            ``(Verdict, Theorem3Solution)``; the solution's status is information only.
+            ``(Verdict, Theorem3Solution)`` (:class:`netrepro.engines.certify.Verdict`); the status is information only.
         """
-        from .feasibility import FEASIBLE, INFEASIBLE, RADIUS_MARGIN, UNDECIDED, Verdict, plant_vertex_radius
+        from .feasibility import necessary_condition
 
         s2 = self.sys.sigma2 if sigma2 is None else float(sigma2)
         sol = self.solve(s2)
-        radius = plant_vertex_radius(self.sys, s2)
-        slack = np.nan
-        if sol.values and all(sol.values.get(k) is not None for k in self.vars):
-            ok, slack = self.check_point(sol.values, s2)
-            if ok:
-                return Verdict(FEASIBLE, slack, radius, sol.status, sol.margin), sol
-        verdict = INFEASIBLE if radius >= 1.0 + RADIUS_MARGIN else UNDECIDED
-        return Verdict(verdict, slack, radius, sol.status, sol.margin), sol
+        verdict = self.certifier.certify(sol.status, necessary=necessary_condition(self.sys, s2))
+        return verdict, sol
 
 
 def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains, dict]:

@@ -209,15 +209,11 @@ def design_step(params, inputs, outputs):
 
 
 def decide_point(prob, sol, sys):
-    """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve): see :mod:`.feasibility`."""
-    from .feasibility import FEASIBLE, INFEASIBLE, UNDECIDED, plant_necessary_fails
+    """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve), by the shared engine."""
+    from .feasibility import necessary_condition
 
-    slack = np.nan
-    if sol.values:
-        ok, slack = prob.check_point(sol.values, sys.sigma2)
-        if ok:
-            return FEASIBLE, slack
-    return (INFEASIBLE if plant_necessary_fails(sys, sys.sigma2) else UNDECIDED), slack
+    v = prob.certifier.certify(sol.status, necessary=necessary_condition(sys, sys.sigma2))
+    return v.verdict, (v.point.slack if v.point is not None else np.nan)
 
 
 def load_solutions(path) -> dict:
@@ -411,46 +407,63 @@ def exact_moments_step(params, inputs, outputs):
 def sensitivity_step(params, inputs, outputs):
     """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter) and the plant.
 
-    Every decision is ``feasible`` (our eigenvalue check of the returned point), ``infeasible``
-    (the plant's vertex second-moment radius >= 1: a necessary condition of every criterion
-    fails) or ``undecided`` (:mod:`.feasibility`); the solver status is information.
-    ``table``: the sigma^2 grid per design (solver status and margin t, our slack, verdict).
-    ``limits`` (feasibility_limit.csv): per design the largest certified-feasible sigma^2
-    (``sigma2_max = sigma2_lo``), the smallest certified-infeasible one (``sigma2_hi``), the
-    smallest undecided point between them, and whether both ends are certified.
+    Every decision comes from the shared engine (:mod:`netrepro.engines.certify`): ``feasible``
+    (its eigenvalue check of the returned point), ``infeasible`` (the plant's vertex
+    second-moment radius >= 1, a necessary condition of every criterion, or a checked dual
+    certificate) or ``undecided``; the solver status and margin are information.
+    ``table``: the sigma^2 grid per design. ``limits`` (feasibility_limit.csv): per design the
+    certified-feasible end ``sigma2_lo`` (= ``sigma2_max``) and certified-infeasible end
+    ``sigma2_hi`` of the engine's certified bisection, the undecided points between them, and
+    whether both ends are certified.
     """
+    from ...engines.certify import bisect_certified
+
     from .design import Theorem3
-    from .feasibility import PlantLMI, bisect_certified, necessary_limit
+    from .feasibility import PlantLMI, necessary_limit
 
     base = _sys(params)
     lmi = params["lmi"]
     sens = params["sensitivity"]
     grid = np.asarray(sens["sigma2_grid"], dtype=float)
     lo0, hi0, tol = float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), float(sens["tol"])
-    nec_below, nec_above = necessary_limit(base, lo0, hi0)
+    _, nec_above = necessary_limit(base, lo0, hi0)
     common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
                   margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
     problems = {"scheduled": Theorem3(base, scheduled=True, **common),
                 "fixed_gain": Theorem3(base, scheduled=False, **common),
                 "zero": Theorem3(base, zero_filter=True, **common)}
-    deciders = {name: (lambda s2, prob=prob: prob.certify(s2)[0]) for name, prob in problems.items()}
     plant = PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]))
-    deciders["plant"] = plant.certify
+
+    def decider(name):
+        if name == "plant":
+            def decide(s2):
+                v = plant.certify(s2)
+                return v, (float(plant.t.value) if plant.t.value is not None else np.nan)
+        else:
+            def decide(s2, prob=problems[name]):
+                v, sol = prob.certify(s2)
+                return v, sol.margin
+        return decide
+
     methods = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
                "zero": "Theorem 3 with all gains 0 (x_f = 0)", "plant": "plant Lyapunov + S-procedure LMI"}
     rows, limits = [], []
     top = nec_above if np.isfinite(nec_above) else hi0
-    for name, decide in deciders.items():
+    for name in ("scheduled", "fixed_gain", "zero", "plant"):
+        decide = decider(name)
         for s2 in grid:
-            v = decide(float(s2))
-            rows.append({"variant": name, "sigma2": float(s2), "status": v.status, "margin": v.solver_margin,
-                         "certified_slack": v.slack, "plant_radius": v.radius, "verdict": v.verdict,
-                         "kind": "grid"})
-        b = bisect_certified(decide, lo0, top, tol)
-        limits.append({"design": name, "sigma2_max": b.lo, "sigma2_lo": b.lo, "sigma2_hi": b.hi,
-                       "certified": b.certified, "undecided_from": b.undecided_lo, "n_solves": b.n_evals,
-                       "method": methods[name],
-                       "infeasible_by": "plant vertex second-moment radius >= 1 (necessary condition)"})
+            v, margin = decide(float(s2))
+            rows.append({"variant": name, "sigma2": float(s2), "status": v.solver_status, "margin": margin,
+                         "certified_slack": v.point.slack if v.point is not None else np.nan,
+                         "verdict": v.verdict, "evidence": v.evidence, "kind": "grid"})
+        b = bisect_certified(lambda s2, decide=decide: decide(s2)[0], lo0, top, tol=tol, feasible_above=False)
+        ends = (b.feasible_end, b.infeasible_end)
+        between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
+        limits.append({"design": name, "sigma2_max": b.feasible_end, "sigma2_lo": b.feasible_end,
+                       "sigma2_hi": b.infeasible_end, "certified": bool(b.certified),
+                       "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
+                       "n_solves": b.n_evals, "method": methods[name],
+                       "infeasible_by": b.verdicts[b.infeasible_end].evidence if b.certified else ""})
     return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
 
 
