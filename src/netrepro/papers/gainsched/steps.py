@@ -236,13 +236,13 @@ def _certificate_for(design, sys, gains, params):
     res = theorem1_lmi(sys, gains, n_grid=int(lmi["theorem1_grid"]), bound=float(lmi["bound"]),
                        margin_cap=float(lmi["margin_cap"]))
     out = {"design": design, "thm1_status": res.status, "thm1_margin": res.margin,
-           "thm1_solver_feasible": res.solver_feasible, "thm1_pairs": res.n_pairs}
+           "thm1_solver_feasible": res.solver_feasible, "thm1_pairs": res.n_pairs, "thm1_verdict": res.verdict}
     if res.Q0 is not None:
         worst, qmin, wv = theorem1_grid_check(sys, gains, res.Q0, res.Qp, res.S, int(lmi["check_grid"]))
     else:
         worst, qmin, wv = np.nan, np.nan, np.nan
     out.update({"thm1_max_eig_grid": worst, "thm1_max_eig_vertices": wv, "thm1_min_eig_Q": qmin,
-                "thm1_certified": bool(res.Q0 is not None and worst < 0 and qmin > 0)})
+                "thm1_certified": bool(res.verdict == "feasible" and res.Q0 is not None and worst < 0 and qmin > 0)})
     return out
 
 
