@@ -449,6 +449,7 @@ def sensitivity_step(params, inputs, outputs):
                "zero": "Theorem 3 with all gains 0 (x_f = 0)", "plant": "plant Lyapunov + S-procedure LMI"}
     rows, limits = [], []
     top = nec_above if np.isfinite(nec_above) else hi0
+    guess = None  # the previous design's threshold: a guess changes the number of solves, never the answer
     for name in ("scheduled", "fixed_gain", "zero", "plant"):
         decide = decider(name)
         for s2 in grid:
@@ -456,7 +457,9 @@ def sensitivity_step(params, inputs, outputs):
             rows.append({"variant": name, "sigma2": float(s2), "status": v.solver_status, "margin": margin,
                          "certified_slack": v.point.slack if v.point is not None else np.nan,
                          "verdict": v.verdict, "evidence": v.evidence, "kind": "grid"})
-        b = bisect_certified(lambda s2, decide=decide: decide(s2)[0], lo0, top, tol=tol, feasible_above=False)
+        b = bisect_certified(lambda s2, decide=decide: decide(s2)[0], lo0, top, tol=tol, feasible_above=False,
+                             guess=guess, width=2 * tol)
+        guess = b.feasible_end if b.certified else None
         ends = (b.feasible_end, b.infeasible_end)
         between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
         limits.append({"design": name, "sigma2_max": b.feasible_end, "sigma2_lo": b.feasible_end,
