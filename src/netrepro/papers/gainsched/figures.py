@@ -114,7 +114,7 @@ def figure_sensitivity(params, inputs, outputs):
         ax2.plot([lo, hi], [yi, yi], "-", color=col, lw=4, alpha=0.4)
         ax2.plot([lo], [yi], "o", color=col)
         ax2.plot([hi], [yi], "x", color=col, ms=8)
-        ax2.annotate(f"[{lo:.4g}, {hi:.4g}]", (lo, yi), textcoords="offset points", xytext=(-70, 6), fontsize=7)
+        ax2.annotate(f"[{lo:.5g}, {hi:.5g}]", (lo, yi), textcoords="offset points", xytext=(-70, 6), fontsize=7)
     ax2.set_yticks(y, names)
     ax2.invert_yaxis()
     ax2.set(xlabel=r"$\sigma^2$", title=r"certified bracket of the largest $\sigma^2$")
