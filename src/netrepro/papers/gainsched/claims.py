@@ -93,18 +93,21 @@ def errata_step(params, inputs, outputs):
                      "residual_printed": res["zero"], "residual_corrected": res["HC"]})
     # D4: sigma = 0
     lmi = params["lmi"]
-    margins = {}
+    margins, verdicts = {}, {}
     for keep in (True, False):
         sys0 = System(sys.A, sys.B, sys.C, sys.D, sys.Z, sys.F1, sys.F2, 0.0, sys.p1, sys.p2)
-        sol0 = Theorem3(sys0, eps=float(lmi["eps"]), bound=float(lmi["bound"]), margin_cap=float(lmi["margin_cap"]),
-                        noise_row=keep).solve()
+        v0, sol0 = Theorem3(sys0, eps=float(lmi["eps"]), bound=float(lmi["bound"]),
+                            margin_cap=float(lmi["margin_cap"]), noise_row=keep).certify(0.0)
         margins[keep] = sol0.margin
+        verdicts[keep] = f"{v0.verdict} ({v0.evidence})"
     rows.append({"paper": PAPER, "erratum_id": "D4_noise_free_case", "location": "(12), (24): last block row",
                  "printed": "σ²S^T D̄N and -σ²Λ(k) kept for every σ",
                  "corrected": "for σ = 0 the last block row/column must be deleted; as printed the strict LMI is "
                               "then infeasible (a zero diagonal block)",
                  "demonstration": "largest margin t (vertices <= -tI) of Theorem 3 at σ² = 0 with the row (printed "
-                                  "column, must be > 0 for feasibility) and without it (corrected column)",
+                                  "column, must be > 0 for feasibility) and without it (corrected column); certified "
+                                  f"verdicts (shared engine): with the row {verdicts[True]}, without it "
+                                  f"{verdicts[False]}",
                  "residual_printed": margins[True], "residual_corrected": margins[False]})
     # D1: stability of (10) does not involve the estimate; zero gains pass
     exact = read_table(inputs["exact"])
