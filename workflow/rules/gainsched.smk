@@ -76,11 +76,36 @@ rule gainsched_simulation:
         step("netrepro.papers.gainsched.steps:simulation_step")
 
 
+rule gainsched_exact_moments:
+    input:
+        code=code("netrepro.papers.gainsched.steps:exact_moments_step"),
+        gains=rules.gainsched_design.output.gains,
+        designs=rules.gainsched_design.output.designs,
+    output:
+        table="results/gainsched/exact_moments.csv",
+        per_k="results/gainsched/exact_mse.csv",
+        performance="results/gainsched/performance.csv",
+    log:
+        "logs/gainsched/exact_moments.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=1,
+    params:
+        cfg=as_json(pick(GCFG, "system", "simulation")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.gainsched.steps:exact_moments_step")
+
+
 rule gainsched_sensitivity:
     input:
         code=code("netrepro.papers.gainsched.steps:sensitivity_step"),
     output:
         table="results/gainsched/sensitivity.csv",
+        limits="results/gainsched/feasibility_limit.csv",
     log:
         "logs/gainsched/sensitivity.log",
     conda:
@@ -120,7 +145,7 @@ rule gainsched_errata:
     input:
         code=code("netrepro.papers.gainsched.claims:errata_step"),
         gains=rules.gainsched_design.output.gains,
-        summary=rules.gainsched_simulation.output.error_summary,
+        exact=rules.gainsched_exact_moments.output.table,
         theorem1=rules.gainsched_stability.output.theorem1,
         solutions=rules.gainsched_design.output.solutions,
     output:
@@ -143,8 +168,8 @@ rule gainsched_errata:
 rule gainsched_reconstructions:
     input:
         code=code("netrepro.papers.gainsched.claims:reconstructions_step"),
-        sensitivity=rules.gainsched_sensitivity.output.table,
-        summary=rules.gainsched_simulation.output.error_summary,
+        limits=rules.gainsched_sensitivity.output.limits,
+        exact=rules.gainsched_exact_moments.output.table,
     output:
         table="results/reconstructions/gainsched.csv",
     log:
@@ -169,9 +194,9 @@ rule gainsched_claims:
         gains=rules.gainsched_design.output.gains,
         designs=rules.gainsched_design.output.designs,
         theorem1=rules.gainsched_stability.output.theorem1,
-        errors=rules.gainsched_simulation.output.errors,
+        exact_mse=rules.gainsched_exact_moments.output.per_k,
         stability=rules.gainsched_stability.output.stability,
-        sensitivity=rules.gainsched_sensitivity.output.table,
+        limits=rules.gainsched_sensitivity.output.limits,
         timing=rules.gainsched_timing.output.table,
     output:
         table="results/claims/gainsched.csv",
@@ -201,6 +226,10 @@ if enabled("gainsched"):
         rules.gainsched_simulation.output.errors,
         rules.gainsched_simulation.output.error_summary,
         rules.gainsched_simulation.output.paths,
+        rules.gainsched_exact_moments.output.table,
+        rules.gainsched_exact_moments.output.per_k,
+        rules.gainsched_exact_moments.output.performance,
         rules.gainsched_sensitivity.output.table,
+        rules.gainsched_sensitivity.output.limits,
         rules.gainsched_timing.output.table,
     ]

@@ -8,15 +8,18 @@ import pandas as pd
 from netrepro.papers.gainsched.claims import reconstructions_step
 
 
-def test_reconstructions_carry_the_sensitivity_limits(cfg, tmp_path):
-    sens = pd.DataFrame([{"variant": v, "sigma2": s2, "kind": "sigma2_max"}
-                         for v, s2 in (("scheduled", 3.25), ("fixed", 2.5), ("plant_ms_limit", 5.5))])
-    summary = pd.DataFrame([{"design": d, "initial_state": "gaussian", "sum_mse": s}
-                            for d, s in (("theorem3", 4.0), ("theorem3_S21I", 6.0))])
-    sens.to_csv(tmp_path / "s.csv", index=False)
-    summary.to_csv(tmp_path / "m.csv", index=False)
-    table = reconstructions_step(cfg, {"sensitivity": tmp_path / "s.csv", "summary": tmp_path / "m.csv"}, {})["table"]
+def test_reconstructions_carry_the_certified_limits(cfg, tmp_path):
+    limits = pd.DataFrame([{"design": d, "sigma2_lo": lo, "sigma2_hi": hi}
+                           for d, lo, hi in (("scheduled", 3.25, 4.0), ("fixed_gain", 2.5, 4.0), ("zero", 2.0, 4.0),
+                                             ("plant", 3.5, 5.5))])
+    exact = pd.DataFrame([{"design": d, "nonlinearity": "mid", "initial_state": "gaussian", "sum_mse": s}
+                          for d, s in (("theorem3", 4.0), ("theorem3_S21I", 6.0))])
+    limits.to_csv(tmp_path / "s.csv", index=False)
+    exact.to_csv(tmp_path / "m.csv", index=False)
+    table = reconstructions_step(cfg, {"limits": tmp_path / "s.csv", "exact": tmp_path / "m.csv"}, {})["table"]
     assert {"paper", "key", "value", "reason", "sensitivity"} <= set(table.columns)
     row = table[table["key"] == "system.sigma2"].iloc[0]
     assert "3.25" in row["sensitivity"] and "2.5" in row["sensitivity"] and "5.5" in row["sensitivity"]
+    d3 = table[table["key"] == "lmi.realisation"].iloc[0]
+    assert "4" in d3["sensitivity"] and "6" in d3["sensitivity"]
     assert np.all(table["paper"] == "gainsched")

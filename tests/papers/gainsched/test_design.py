@@ -91,3 +91,34 @@ def test_noise_free_case_needs_the_last_row_removed(sys):
     assert not Theorem3(s0, bound=100.0).solve().solver_feasible
     assert Theorem3(s0, bound=100.0, noise_row=False).solve().solver_feasible
 
+
+
+def test_full_slack_performance_design_cost_is_certified_and_respected(sys):
+    """The full-slack design: its checked point certifies gamma; the exact error sums (any linear f at the sector
+    edges, worst p(k) of a few fixed sequences) stay below it, and it beats x_f = 0 (independent: exact recursion)."""
+    from netrepro.papers.gainsched.design import certified_cost, output_certificate, recover_output_gains
+    from netrepro.papers.gainsched.model import augmented_initial_moment, zero_gains
+    from netrepro.papers.gainsched.moments import error_mse, linear_gains, mode_matrices, second_moments
+
+    X0 = augmented_initial_moment(np.eye(2), 2)
+    prob = Theorem3(sys, performance=True, output_slack=True, X0=X0, bound=100.0)
+    sol = prob.solve()
+    ok, slack = prob.check_point(sol.values, sys.sigma2)
+    assert ok and slack > 0
+    gamma = certified_cost(sol.values, X0, sys.p1, sys.p2)
+    g = recover_output_gains(sol.values)
+    # Theorem 1 with the performance term, rebuilt from the final gains and the transformed certificate
+    c = output_certificate(sol.values)
+    worst, qmin, _ = theorem1_grid_check(sys, g, c["Q0"], c["Qp"], c["S"], n_fine=9, performance=True)
+    assert worst < 0 and qmin > 0
+    sums = {}
+    for name, gains in (("perf", g), ("zero", zero_gains(sys))):
+        vals = []
+        for F in linear_gains(sys).values():
+            for p_seq in (np.full(60, sys.p1), np.full(60, sys.p2), p_schedule(np.arange(60), sys.p1, sys.p2, 1.0),
+                          np.where(np.arange(60) % 2, sys.p1, sys.p2)):
+                M1, M0, W = mode_matrices(sys, gains, p_seq, F)
+                vals.append(error_mse(second_moments(M1, M0, W, p_seq, sys.sigma2, X0)).sum())
+        sums[name] = np.array(vals)
+    assert np.all(sums["perf"] <= gamma)
+    assert np.all(sums["perf"] < sums["zero"])

@@ -88,10 +88,12 @@ def test_theorem1_schur_complement_gives_pi(sys):
 def test_theorem1_rejects_unstable_filter(sys, paper):
     """A filter matrix with spectral radius > 1 cannot pass Theorem 1; the printed gains do."""
     ok = theorem1_lmi(sys, paper, n_grid=2)
-    assert ok.solver_feasible
+    assert ok.solver_feasible and ok.verdict == "feasible"
     bad = Gains(1.2 * np.eye(2), np.zeros((2, 2)), paper.H0, np.zeros_like(paper.Hf))
     res = theorem1_lmi(sys, bad, n_grid=2)
     assert not res.solver_feasible
+    # certified, not read off the status: G(p) = 1.2 I makes the filter block unstable, so a dual certificate exists
+    assert res.verdict == "infeasible", res.evidence
     assert frozen_radius(sys, bad, 0.6, sector_cases(sys)["F11"]) > 1
 
 

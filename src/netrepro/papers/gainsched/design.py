@@ -48,8 +48,9 @@ import numpy as np
 from ...engines.lmi import SOLVER
 from .model import Gains, GainschedError, System
 
-__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "certificate_from_solution", "congruence_residual",
-           "REALISATIONS"]
+__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "recover_output_gains", "certified_cost",
+           "output_certificate",
+           "certificate_from_solution", "congruence_residual", "REALISATIONS"]
 
 REALISATIONS = ("identity_T", "S21_identity")
 
@@ -115,6 +116,15 @@ class Theorem3:
         t <= margin_cap; uncapped, Clarabel ends ``optimal_inaccurate``.
     gamma3_top : {"HC", "zero"}
         Upper row of Γ3: H̄^i C (what the congruence gives) or 0 (the misreading).
+    zero_filter : bool
+        Fix Ḡ0 = H̄0 = Ḡf = H̄f = 0: the LMIs for the trivial estimate x_f = 0 (design ``zero``).
+    output_slack : bool
+        With ``performance``: the full-slack performance design. The estimate is
+        x̂ = L_f x_f with L_f free, so the error row of the congruence T = diag(I, J),
+        [I, -L_f J], is linear in the new variable L̄ = L_f J; the bound term enters
+        as the Schur complement [[M, E^T], [E, -I]] < 0, E = [I, -L̄, 0]. Unlike
+        adding [I, -I]^T [I, -I] (which ties the estimate to S21 = S22), nothing is
+        forced: recover with :func:`recover_output_gains`.
     noise_row : bool
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
@@ -133,8 +143,13 @@ class Theorem3:
 
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
-                 gamma3_top: str = "HC", noise_row: bool = True):
+                 gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False,
+                 output_slack: bool = False):
         self.noise_row = noise_row
+        self.output_slack = bool(output_slack and performance)
+        self.zero_filter = zero_filter
+        if zero_filter:
+            scheduled = False
         if gamma3_top not in ("HC", "zero"):
             raise GainschedError(f"gamma3_top must be 'HC' or 'zero', got {gamma3_top!r}")
         self.gamma3_top = gamma3_top
@@ -150,12 +165,15 @@ class Theorem3:
             "S11": cp.Variable((n, n), name="S11"),
             "R1": cp.Variable((n, n), name="R1"),
             "R2": cp.Variable((n, n), name="R2"),
-            "G0": cp.Variable((n, n), name="Gbar0"),
-            "H0": cp.Variable((n, m), name="Hbar0"),
         }
+        if not zero_filter:
+            v["G0"] = cp.Variable((n, n), name="Gbar0")
+            v["H0"] = cp.Variable((n, m), name="Hbar0")
         if scheduled:
             v["Gf"] = cp.Variable((n, n), name="Gbarf")
             v["Hf"] = cp.Variable((n, m), name="Hbarf")
+        if self.output_slack:
+            v["Lbar"] = cp.Variable((n, n), name="Lbar")
         self.vars = v
         self.t = cp.Variable(name="t")
         ps = (sys.p1, sys.p2)
@@ -167,6 +185,11 @@ class Theorem3:
             cons += [v["Q0"] + p * v["Qp"] >> eps * np.eye(nn) for p in ps]
         L = np.hstack([np.eye(n), -np.eye(n)])
         self.n_vertices = 0
+        self._vertices = []
+        self._blocks = []
+        self._certifier = None
+        self._eps = eps
+        self._qp_positive = qp_positive
         for i in range(2):
             for j in range(2):
                 for r in range(2):
@@ -174,11 +197,24 @@ class Theorem3:
                         M = self.vertex(ps[i], ps[j], ps[r], ps[l])
                         size = M.shape[0]
                         Msym = 0.5 * (M + M.T)
+                        if self.output_slack:
+                            # error row [I, -L̄] in T-coordinates, Schur complement of + [I, -L̄]^T [I, -L̄]
+                            Erow = cp.hstack([np.eye(n), -v["Lbar"], np.zeros((n, size - nn))])
+                            big = cp.bmat([[Msym, Erow.T], [Erow, -np.eye(n)]])
+                            big = 0.5 * (big + big.T)
+                            self._vertices.append(big)
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -big))
+                            cons.append(big << -eps * np.eye(size + n))
+                            self.n_vertices += 1
+                            continue
+                        self._vertices.append(Msym)
                         if performance:
                             E = np.zeros((size, size))
                             E[:nn, :nn] = L.T @ L
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -(Msym + E)))
                             cons.append(Msym + E << -eps * np.eye(size))
                         else:
+                            self._blocks.append((f"vertex{i}{j}{r}{l}", -Msym))
                             cons.append(Msym << -self.t * np.eye(size))
                         self.n_vertices += 1
         if performance:
@@ -193,6 +229,29 @@ class Theorem3:
             cons.append(self.t <= margin_cap)
             self.problem = cp.Problem(cp.Maximize(self.t), cons)
         self.margin_tol = eps
+        if qp_positive:
+            self._blocks += [("Qbar0", v["Q0"]), ("Qbarp", v["Qp"])]
+        else:
+            self._blocks += [(f"Qbar(p{k + 1})", v["Q0"] + p * v["Qp"]) for k, p in enumerate(ps)]
+
+    @property
+    def certifier(self):
+        """The shared engine's certifier of this LMI system (built on first use).
+
+        The question is the strict system of (24)-(25) (and (27)): every vertex matrix negative
+        definite (with the bound term for the performance designs) and Q̄0, Q̄p positive definite.
+        The entry bounds and the margin cap are normalisations, not part of it.
+
+        Returns
+        -------
+        netrepro.engines.certify.CertifiedLMI
+        """
+        if self._certifier is None:
+            from ...engines.certify import CertifiedLMI
+
+            self._certifier = CertifiedLMI(self._blocks, problem=self.problem,
+                                           drop=() if self.performance else (self.t,))
+        return self._certifier
 
     # -- the blocks of (24)-(25), one function each, so they read against the paper
     def Qbar(self, p):
@@ -219,6 +278,8 @@ class Theorem3:
         -------
         cvxpy expression
         """
+        if self.zero_filter:
+            return np.zeros((self.sys.n, self.sys.n))
         return self.vars["G0"] + p * self.vars["Gf"] if self.scheduled else self.vars["G0"]
 
     def Hbar(self, p):
@@ -232,6 +293,8 @@ class Theorem3:
         -------
         cvxpy expression
         """
+        if self.zero_filter:
+            return np.zeros((self.sys.n, self.sys.m))
         return self.vars["H0"] + p * self.vars["Hf"] if self.scheduled else self.vars["H0"]
 
     def Lambda(self, pl):
@@ -368,6 +431,9 @@ class Theorem3:
                                     n_scalar_variables=self.n_scalar_variables())
         elapsed = time.perf_counter() - start
         values = {k: (None if x.value is None else np.array(x.value)) for k, x in self.vars.items()}
+        if self.zero_filter and values["R2"] is not None:
+            values["G0"] = np.zeros((self.sys.n, self.sys.n))
+            values["H0"] = np.zeros((self.sys.n, self.sys.m))
         if not self.scheduled and values["G0"] is not None:
             values["Gf"] = np.zeros_like(values["G0"])
             values["Hf"] = np.zeros_like(values["H0"])
@@ -383,6 +449,50 @@ class Theorem3:
             feasible = ok_status and margin > self.margin_tol
         return Theorem3Solution(status, margin, objective, feasible, values if has_values else {}, elapsed,
                                 self.n_scalar_variables())
+
+    def check_point(self, values: dict, sigma2: float):
+        """The engine's eigenvalue check of a candidate point of (24)-(25), (27), whatever the solver said.
+
+        Parameters
+        ----------
+        values : dict
+            Variable name -> ndarray (a solution or any candidate).
+        sigma2 : float
+
+        Returns
+        -------
+        tuple
+            ``(ok, slack)``: every block strictly on its side beyond the engine's margin, and the
+            smallest ``min_eig - tolerance`` over the blocks (> 0 iff ``ok``).
+        """
+        from ...engines.certify import check_point
+
+        for name, var in self.vars.items():
+            var.value = values[name]
+        self.sigma2.value = float(sigma2)
+        cert = self.certifier
+        pc = check_point(cert.coefficients(), cert.point(), safety=cert.safety)
+        return bool(pc.feasible), float(pc.slack)
+
+    def certify(self, sigma2: float | None = None):
+        """Solve at ``sigma2`` and decide with the engine: feasible (point check), infeasible (necessary
+        condition of :mod:`.feasibility`, or a checked dual certificate), undecided.
+
+        Parameters
+        ----------
+        sigma2 : float, optional
+
+        Returns
+        -------
+        tuple
+            ``(Verdict, Theorem3Solution)`` (:class:`netrepro.engines.certify.Verdict`); the status is information only.
+        """
+        from .feasibility import necessary_condition
+
+        s2 = self.sys.sigma2 if sigma2 is None else float(sigma2)
+        sol = self.solve(s2)
+        verdict = self.certifier.certify(sol.status, necessary=necessary_condition(self.sys, s2))
+        return verdict, sol
 
 
 def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains, dict]:
@@ -440,6 +550,86 @@ def recover_gains(values: dict, realisation: str = "identity_T") -> tuple[Gains,
     J = np.linalg.solve(S22, S21)
     T = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), J]])
     return gains, {"S": S, "T": T}
+
+
+def recover_output_gains(values: dict) -> Gains:
+    r"""Gains of form (9) of the full-slack performance design (``output_slack``), estimate x̂ = L̄ x_f.
+
+    With the ``identity_T`` realisation (J = I, so L_f = L̄), (26) gives G(p), H(p) for x_f and
+    the estimate is x̂ = L̄ x_f. In the coordinates x̃ = L̄ x_f (L̄ nonsingular, x̃(0) = 0 when
+    x_f(0) = 0) the filter is again of form (9) with x̃ itself the estimate:
+
+    .. math::
+
+        G_0' = \bar L G_0 \bar L^{-1},\; G_f' = \bar L G_f \bar L^{-1},\; H_0' = \bar L H_0,\; H_f' = \bar L H_f .
+
+    Parameters
+    ----------
+    values : dict
+        A solution of the ``output_slack`` performance problem (must hold ``Lbar``).
+
+    Returns
+    -------
+    Gains
+
+    Raises
+    ------
+    GainschedError
+        If ``Lbar`` is missing or singular.
+    """
+    if values.get("Lbar") is None:
+        raise GainschedError("values has no 'Lbar': not an output_slack performance solution")
+    Lb = np.asarray(values["Lbar"], dtype=float)
+    if np.linalg.cond(Lb) > 1e12:
+        raise GainschedError(f"Lbar is singular (condition {np.linalg.cond(Lb):.3g})")
+    g, _ = recover_gains(values, "identity_T")
+    Li = np.linalg.inv(Lb)
+    return Gains(Lb @ g.G0 @ Li, Lb @ g.Gf @ Li, Lb @ g.H0, Lb @ g.Hf)
+
+
+def certified_cost(values: dict, X0, p1: float, p2: float) -> float:
+    """The guaranteed cost max_{p in [p1, p2]} tr(Q̄(p) X0) of a performance solution, from its values.
+
+    Q̄(p) = Q̄0 + p Q̄p is affine in p, so the maximum is at p1 or p2. With the point certified
+    (every block strictly negative), sum_k E||e(k)||^2 <= this value for every f in the sector and
+    every p(k) in [p1, p2], from E z̄(0) z̄(0)^T = X0 with x_f(0) = 0 (T-invariant).
+
+    Parameters
+    ----------
+    values : dict
+    X0 : ndarray (2n, 2n)
+    p1, p2 : float
+
+    Returns
+    -------
+    float
+    """
+    X0 = np.asarray(X0, dtype=float)
+    return max(float(np.trace((values["Q0"] + p * values["Qp"]) @ X0)) for p in (p1, p2))
+
+
+def output_certificate(values: dict) -> dict:
+    """Theorem 1 certificate (Q0, Qp, S) of the full-slack performance design in the coordinates of its form-(9) gains.
+
+    (26) with T = I gives the filter state x_f and the certificate Q̄, S = [[S11, R1], [R2, R2]];
+    in the coordinates z' = [x; x̃], x̃ = L̄ x_f, i.e. z̄ = T' z' with T' = diag(I, L̄^{-1}),
+    the certificate is Q' = T'^T Q̄ T', S' = T'^T S T' (V is unchanged).
+
+    Parameters
+    ----------
+    values : dict
+        A solution of the ``output_slack`` performance problem.
+
+    Returns
+    -------
+    dict
+        ``Q0``, ``Qp``, ``S`` for (12) with the gains of :func:`recover_output_gains`.
+    """
+    _, extra = recover_gains(values, "identity_T")
+    n = values["R2"].shape[0]
+    Tp = np.eye(2 * n)
+    Tp[n:, n:] = np.linalg.inv(np.asarray(values["Lbar"], dtype=float))
+    return {"Q0": Tp.T @ values["Q0"] @ Tp, "Qp": Tp.T @ values["Qp"] @ Tp, "S": Tp.T @ extra["S"] @ Tp}
 
 
 def certificate_from_solution(values: dict, realisation: str = "identity_T") -> dict:

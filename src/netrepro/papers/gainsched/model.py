@@ -478,6 +478,10 @@ class Theorem1Result:
         The certificate candidate Q(p) = Q0 + p Qp (27) and S.
     n_pairs : int
         Number of (p, p+) pairs imposed.
+    verdict : str
+        The shared engine's decision on the gridded system (``feasible`` / ``infeasible`` / ``undecided``).
+    evidence : str
+        What backs the verdict.
 
     Returns
     -------
@@ -491,6 +495,8 @@ class Theorem1Result:
     Qp: np.ndarray | None
     S: np.ndarray | None
     n_pairs: int
+    verdict: str = ""
+    evidence: str = ""
 
 
 def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float = 1e-7, bound: float = 1e3,
@@ -521,9 +527,12 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     Returns
     -------
     Theorem1Result
+        ``verdict`` is the shared engine's certified decision on the gridded system
+        (:mod:`netrepro.engines.certify`); ``solver_feasible`` is the solver's opinion (information).
     """
     import cvxpy as cp
 
+    from ...engines.certify import CertifiedLMI
     from ...engines.lmi import SOLVER
 
     nn = 2 * sys.n
@@ -533,23 +542,34 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     t = cp.Variable(name="t")
     grid = np.linspace(sys.p1, sys.p2, max(2, n_grid))
     cons = [cp.abs(S) <= bound, cp.abs(Q0) <= bound, cp.abs(Qp) <= bound, t <= margin_cap]
+    blocks = []
     for p in grid:
         cons.append(Q0 + p * Qp >> t * np.eye(nn))
+        blocks.append((f"Q({p:.4g})", Q0 + p * Qp))
         for pn in grid:
             M = theorem1_matrix(sys, gains, Q0 + p * Qp, Q0 + pn * Qp, S, p)
             size = M.shape[0]
             cons.append(0.5 * (M + M.T) << -t * np.eye(size))
+            blocks.append((f"(12) at ({p:.4g}, {pn:.4g})", -0.5 * (M + M.T)))
     prob = cp.Problem(cp.Maximize(t), cons)
+    certifier = CertifiedLMI(blocks, problem=prob, drop=(t,))
     try:
         prob.solve(solver=SOLVER)
         status = str(prob.status)
     except cp.error.SolverError as exc:  # pragma: no cover - solver failure path
         return Theorem1Result(f"solver_error: {exc}", np.nan, False, None, None, None, len(grid) ** 2)
     margin = float(t.value) if t.value is not None else np.nan
-    ok = status == cp.OPTIMAL and margin > margin_tol
+    ok = status == cp.OPTIMAL and margin > margin_tol  # the solver's opinion, kept as information
+    def necessary():
+        # (12) for all admissible p(k) implies MS stability of (10) for every f in the sector, in particular for
+        # constant p and linear f = F z at the sector vertices: the frozen second-moment radius must be < 1
+        rho = max(frozen_radius(sys, gains, float(p), F) for p in grid for F in sector_cases(sys).values())
+        return rho >= 1.0 + 1e-9, f"frozen second-moment radius of (10) {rho:.12g} >= 1 at a sector vertex"
+
+    v = certifier.certify(status, necessary=necessary)
     if t.value is None:
-        return Theorem1Result(status, margin, False, None, None, None, len(grid) ** 2)
-    return Theorem1Result(status, margin, ok, Q0.value, Qp.value, S.value, len(grid) ** 2)
+        return Theorem1Result(status, margin, False, None, None, None, len(grid) ** 2, v.verdict, v.evidence)
+    return Theorem1Result(status, margin, ok, Q0.value, Qp.value, S.value, len(grid) ** 2, v.verdict, v.evidence)
 
 
 def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, performance: bool = False):

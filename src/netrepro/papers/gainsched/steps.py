@@ -13,12 +13,16 @@ Designs compared (column ``design`` of the tables):
 * ``theorem3_S21I``: the same LMI solution recovered with S21 = I (Algorithm 1
   leaves S21, S22 free): same stability, different estimate;
 * ``fixed_gain``: Theorem 3 with Ḡf = H̄f = 0 (G_f = H_f = 0);
-* ``performance``: Theorem 3 plus the bound sum_k E||e(k)||^2 <= gamma, minimised;
-* ``performance_fixed``: the same with G_f = H_f = 0;
+* ``performance``: Theorem 3 plus the bound sum_k E||e(k)||^2 <= gamma, minimised, with the full
+  slack variable (a free estimate output L̄, :class:`.design.Theorem3` ``output_slack``); its
+  cost is certified from the checked point (``certified_cost``);
+* ``performance_tied``: the former performance design: the bound term [I, -I] added in the
+  T-coordinates ties the estimate to S21 = S22 and the optimum collapses to x_f = 0;
+* ``tuned_exact``: gains tuned on the exact second-moment cost (f = (F1+F2)/2 z, x(0) ~ N(0, I));
 * ``tuned_fixed`` / ``tuned_scheduled``: gains of form (9) tuned by Monte Carlo
   (Nelder-Mead on common random numbers) for the named nonlinearity: what a
   filter of this structure can achieve when not restricted to a worst-case bound;
-* ``trivial``: x_f = 0 (all gains zero).
+* ``zero``: the trivial estimate x_f = 0 (all gains zero): what any filter must beat.
 """
 
 from __future__ import annotations
@@ -37,7 +41,6 @@ from .model import (
     frozen_radius,
     gains_from_dict,
     p_schedule,
-    plant_ms_radius,
     scheduled_growth_rate,
     sector_cases,
     simulate,
@@ -46,7 +49,8 @@ from .model import (
     theorem1_lmi,
     zero_gains,
 )
-from .tuning import tune_gains
+from .moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
+from .tuning import tune_gains, tune_gains_exact
 
 __all__ = [
     "MATRICES",
@@ -57,6 +61,7 @@ __all__ = [
     "design_step",
     "stability_step",
     "simulation_step",
+    "exact_moments_step",
     "sensitivity_step",
     "timing_step",
 ]
@@ -108,12 +113,12 @@ def _mc_errors(sys, gains, p_seq, x0, seed, nonlinearity, xf0=None):
 
 # ----------------------------------------------------------------------------- steps
 def design_step(params, inputs, outputs):
-    """All designs: paper gains, Theorem 3 (24)-(26) variants, performance-aware, MC-tuned, trivial.
+    """All designs: paper gains, Theorem 3 (24)-(26) variants, performance-aware, MC-tuned, zero (x_f = 0).
 
     Writes ``gains`` (design, matrix, row, col, value) and ``designs`` (one row
     per design: solver status, margin, objective, solve time, realisation).
     """
-    from .design import Theorem3, recover_gains
+    from .design import Theorem3, certified_cost, recover_gains, recover_output_gains
 
     sys = _sys(params)
     lmi = params["lmi"]
@@ -129,9 +134,13 @@ def design_step(params, inputs, outputs):
     problems = {
         "theorem3": dict(scheduled=True, performance=False),
         "fixed_gain": dict(scheduled=False, performance=False),
-        "performance": dict(scheduled=True, performance=True),
-        "performance_fixed": dict(scheduled=False, performance=True),
+        "performance": dict(scheduled=True, performance=True, output_slack=True),
+        "performance_tied": dict(scheduled=True, performance=True),
     }
+    methods = {"theorem3": "Theorem 3 feasibility, scheduled", "fixed_gain": "Theorem 3 feasibility, fixed (Gf=Hf=0)",
+               "performance": "Theorem 3 + error bound, full slack (free estimate output L̄), gamma minimised",
+               "performance_tied": "Theorem 3 + error bound [I,-I] in T-coordinates (ties the estimate to "
+                                   "S21 = S22): collapses to x_f = 0"}
     solutions, lmi_rows = {}, []
     for name, opts in problems.items():
         prob = Theorem3(sys, X0=X0 if opts["performance"] else None, **opts, **common)
@@ -140,23 +149,29 @@ def design_step(params, inputs, outputs):
         for var, val in sol.values.items():
             for (r, c), x in np.ndenumerate(np.atleast_2d(val)):
                 lmi_rows.append({"problem": name, "variable": var, "row": r, "col": c, "value": float(x)})
+        verdict, slack = decide_point(prob, sol, sys)
         if not sol.values:
             rows.append({"design": name, "method": "Theorem 3", "status": sol.status, "margin": sol.margin,
                          "objective": sol.objective, "solver_feasible": False, "solve_time_s": sol.solve_time_s,
-                         "n_scalar_variables": sol.n_scalar_variables, "realisation": ""})
+                         "n_scalar_variables": sol.n_scalar_variables, "realisation": "", "verdict": verdict,
+                         "certified_slack": slack})
             continue
         realisations = [("identity_T", name)]
         if name == "theorem3":
             realisations.append(("S21_identity", "theorem3_S21I"))
         for real, dname in realisations:
-            gains, _ = recover_gains(sol.values, real)
+            if opts.get("output_slack"):
+                gains, real = recover_output_gains(sol.values), "identity_T + output L̄"
+            else:
+                gains, _ = recover_gains(sol.values, real)
             tables.append(gains_table(dname, gains))
-            method = ("Theorem 3 " + ("+ bound min " if opts["performance"] else "feasibility ")
-                      + ("scheduled" if opts["scheduled"] else "fixed (Gf=Hf=0)"))
+            method = methods[name] + (" (S21 = I realisation)" if dname == "theorem3_S21I" else "")
+            cost = certified_cost(sol.values, X0, sys.p1, sys.p2) if opts["performance"] else np.nan
             rows.append({"design": dname, "method": method, "status": sol.status, "margin": sol.margin,
+                         "certified_cost": cost if verdict == "feasible" else np.nan,
                          "objective": sol.objective, "solver_feasible": sol.solver_feasible,
                          "solve_time_s": sol.solve_time_s, "n_scalar_variables": sol.n_scalar_variables,
-                         "realisation": real})
+                         "realisation": real, "verdict": verdict, "certified_slack": slack})
     tune = params["tuning"]
     p_seq = p_sequence(params, sys, tune["horizon"])
     tuned = None
@@ -171,12 +186,34 @@ def design_step(params, inputs, outputs):
                      "solve_time_s": time.perf_counter() - start, "n_scalar_variables": len(MATRICES) and
                      (tuned.G0.size + tuned.H0.size) * (2 if sched else 1), "realisation": "direct",
                      "n_evaluations": info["n_eval"]})
-    tables.append(gains_table("trivial", zero_gains(sys)))
-    rows.append({"design": "trivial", "method": "x_f = 0", "status": "given", "margin": np.nan, "objective": np.nan,
+    # a filter tuned on the exact cost (f = (F1+F2)/2 z, x(0) ~ N(0, I), the configured p(k)), from the
+    # performance design: what the structure (9) achieves for one f, without a guarantee for the others
+    start = time.perf_counter()
+    p_full = p_sequence(params, sys)
+    mid = 0.5 * (sys.F1 + sys.F2)
+    perf = gains_from_table(pd.concat(tables, ignore_index=True), "performance", sys)
+    tuned_ex, info = tune_gains_exact(sys, p_full, mid, augmented_initial_moment(np.eye(sys.n), sys.n), True,
+                                      int(tune["maxiter"]), start=perf)
+    tables.append(gains_table("tuned_exact", tuned_ex))
+    rows.append({"design": "tuned_exact", "method": "tuned on the exact sum E||e||^2 (f = mid, x0 ~ N(0, I)), "
+                 "Nelder-Mead from the performance design", "status": "tuned", "margin": np.nan,
+                 "objective": info["cost"], "solver_feasible": np.nan, "solve_time_s": time.perf_counter() - start,
+                 "n_scalar_variables": 2 * (tuned_ex.G0.size + tuned_ex.H0.size), "realisation": "direct",
+                 "n_evaluations": info["n_eval"]})
+    tables.append(gains_table("zero", zero_gains(sys)))
+    rows.append({"design": "zero", "method": "x_f = 0 (trivial estimate)", "status": "given", "margin": np.nan, "objective": np.nan,
                  "solver_feasible": np.nan, "solve_time_s": np.nan, "n_scalar_variables": 0, "realisation": ""})
     return {"gains": pd.concat(tables, ignore_index=True), "designs": pd.DataFrame(rows),
             "solutions": pd.DataFrame(lmi_rows, columns=["problem", "variable", "row", "col", "value"]),
             "provenance": {"solver_status": {k: v.status for k, v in solutions.items()}}}
+
+
+def decide_point(prob, sol, sys):
+    """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve), by the shared engine."""
+    from .feasibility import necessary_condition
+
+    v = prob.certifier.certify(sol.status, necessary=necessary_condition(sys, sys.sigma2))
+    return v.verdict, (v.point.slack if v.point is not None else np.nan)
 
 
 def load_solutions(path) -> dict:
@@ -199,13 +236,13 @@ def _certificate_for(design, sys, gains, params):
     res = theorem1_lmi(sys, gains, n_grid=int(lmi["theorem1_grid"]), bound=float(lmi["bound"]),
                        margin_cap=float(lmi["margin_cap"]))
     out = {"design": design, "thm1_status": res.status, "thm1_margin": res.margin,
-           "thm1_solver_feasible": res.solver_feasible, "thm1_pairs": res.n_pairs}
+           "thm1_solver_feasible": res.solver_feasible, "thm1_pairs": res.n_pairs, "thm1_verdict": res.verdict}
     if res.Q0 is not None:
         worst, qmin, wv = theorem1_grid_check(sys, gains, res.Q0, res.Qp, res.S, int(lmi["check_grid"]))
     else:
         worst, qmin, wv = np.nan, np.nan, np.nan
     out.update({"thm1_max_eig_grid": worst, "thm1_max_eig_vertices": wv, "thm1_min_eig_Q": qmin,
-                "thm1_certified": bool(res.Q0 is not None and worst < 0 and qmin > 0)})
+                "thm1_certified": bool(res.verdict == "feasible" and res.Q0 is not None and worst < 0 and qmin > 0)})
     return out
 
 
@@ -218,7 +255,7 @@ def stability_step(params, inputs, outputs):
     check of the Theorem 3 certificate itself (rebuilt Q, S of (23), (27)),
     and the growth rate of E||z||^2 along the scheduled p(k).
     """
-    from .design import certificate_from_solution, recover_gains
+    from .design import certificate_from_solution, output_certificate, recover_gains, recover_output_gains
 
     sys = _sys(params)
     table = read_table(inputs["gains"])
@@ -233,6 +270,11 @@ def stability_step(params, inputs, outputs):
     for name, values in load_solutions(inputs["solutions"]).items():
         perf = name.startswith("performance")
         reals = [("identity_T", name)] + ([("S21_identity", "theorem3_S21I")] if name == "theorem3" else [])
+        if "Lbar" in values:  # full-slack performance design: certificate in the coordinates of its gains
+            c = output_certificate(values)
+            cert[name] = theorem1_grid_check(sys, recover_output_gains(values), c["Q0"], c["Qp"], c["S"],
+                                             int(lmi["check_grid"]), performance=True)
+            continue
         for real, dname in reals:
             g, _ = recover_gains(values, real)
             c = certificate_from_solution(values, real)
@@ -259,7 +301,13 @@ def simulation_step(params, inputs, outputs):
     Runs are vectorised, time is looped; the same random numbers (seed) for
     every design. ``errors``: mean over runs of e1, e2 with a 95% band (2.5 and
     97.5 percentiles over runs) and mse(k) = E||e(k)||^2 for the fixed initial
-    state; ``error_summary``: sum_k mse(k) for the fixed x0 and for x0 ~ N(0, initial_cov).
+    state with its standard error ``mse_se``; ``error_summary``: sum_k mse(k) for the fixed x0
+    and for x0 ~ N(0, initial_cov), with the standard error of the per-run sum.
+
+    This Monte Carlo is for the configured (nonlinear) f only; for linear f the exact
+    second moments are in ``exact_moments.csv`` (:func:`exact_moments_step`). With a
+    multiplicative noise ||e||^2 is heavy-tailed: the standard errors are sample
+    standard errors and understate the uncertainty where the fourth moment is large.
     """
     sys = _sys(params)
     sim = params["simulation"]
@@ -278,57 +326,148 @@ def simulation_step(params, inputs, outputs):
         e = _mc_errors(sys, gains, p_seq, x0_fixed, int(sim["seed"]), sim["nonlinearity"], sim.get("xf0"))
         mean = e.mean(0)
         lo, hi = np.percentile(e, q_lo, axis=0), np.percentile(e, q_hi, axis=0)
-        mse = (e ** 2).sum(-1).mean(0)
+        sq = (e ** 2).sum(-1)
+        mse = sq.mean(0)
+        mse_se = sq.std(0, ddof=1) / np.sqrt(R)
         for k in ks:
-            erows.append({"design": d, "k": int(k), "e1_mean": mean[k, 0], "e2_mean": mean[k, 1], "e1_lo": lo[k, 0],
-                          "e1_hi": hi[k, 0], "e2_lo": lo[k, 1], "e2_hi": hi[k, 1], "mse": mse[k]})
+            erows.append({"design": d, "initial_state": "fixed_x0", "k": int(k), "e1_mean": mean[k, 0],
+                          "e2_mean": mean[k, 1], "e1_lo": lo[k, 0], "e1_hi": hi[k, 0], "e2_lo": lo[k, 1],
+                          "e2_hi": hi[k, 1], "mse": mse[k], "mse_se": mse_se[k]})
             prow.append({"design": d, "k": int(k), "p": float(p_seq[k]) if k < len(p_seq) else np.nan,
                          "e1": e[0, k, 0], "e2": e[0, k, 1]})
-        srows.append({"design": d, "initial_state": "fixed_x0", "sum_mse": float(mse.sum())})
+        srows.append({"design": d, "initial_state": "fixed_x0", "sum_mse": float(mse.sum()),
+                      "sum_mse_se": float(sq.sum(1).std(ddof=1) / np.sqrt(R))})
         er = _mc_errors(sys, gains, p_seq, x0_rand, int(sim["seed"]) + 1, sim["nonlinearity"])
-        srows.append({"design": d, "initial_state": "gaussian", "sum_mse": float((er ** 2).sum(-1).mean(0).sum())})
+        sr = (er ** 2).sum(-1)
+        gmean = er.mean(0)
+        glo, ghi = np.percentile(er, q_lo, axis=0), np.percentile(er, q_hi, axis=0)
+        gse = sr.std(0, ddof=1) / np.sqrt(R)
+        for k in ks:
+            erows.append({"design": d, "initial_state": "gaussian", "k": int(k), "e1_mean": gmean[k, 0],
+                          "e2_mean": gmean[k, 1], "e1_lo": glo[k, 0], "e1_hi": ghi[k, 0], "e2_lo": glo[k, 1],
+                          "e2_hi": ghi[k, 1], "mse": sr.mean(0)[k], "mse_se": gse[k]})
+        srows.append({"design": d, "initial_state": "gaussian", "sum_mse": float(sr.mean(0).sum()),
+                      "sum_mse_se": float(sr.sum(1).std(ddof=1) / np.sqrt(R))})
     return {"errors": pd.DataFrame(erows), "error_summary": pd.DataFrame(srows), "paths": pd.DataFrame(prow)}
 
 
-def sensitivity_step(params, inputs, outputs):
-    """Theorem 3 margin against sigma^2 (one parametrised problem per variant) and the largest feasible sigma^2.
+def exact_moments_step(params, inputs, outputs):
+    """Exact E||e(k)||^2 of every design for linear f = F z, F in {F1, F2, mid}, by the recursion of :mod:`.moments`.
 
-    Also the true mean-square stability limit of the plant (linear sector
-    vertices): the criterion can never certify beyond it.
+    Initial states: ``gaussian`` (x(0) ~ N(0, I), x_f(0) = 0) and ``x0`` (the configured x0 and
+    x_f(0) = xf0; the ``zero`` design keeps x_f = 0 throughout). ``exact_moments``: design,
+    nonlinearity, initial_state, sum_mse (k = 0..K), final_mse (k = K); ``exact_mse``: the same
+    per k.
     """
-    from ...engines.lmi import bisect_monotone
+    sys = _sys(params)
+    sim = params["simulation"]
+    table = read_table(inputs["gains"])
+    designs = list(dict.fromkeys(table["design"]))
+    p_seq = p_sequence(params, sys)
+    n = sys.n
+    x0 = np.asarray(sim["x0"], dtype=float)
+    xf0 = np.asarray(sim.get("xf0", np.zeros(n)), dtype=float)
+    starts = {"gaussian": lambda d: initial_moment(np.zeros(n), np.eye(n), np.zeros(n)),
+              "x0": lambda d: initial_moment(x0, np.zeros((n, n)), np.zeros(n) if d == "zero" else xf0)}
+    keys, M1s, M0s, X0s = [], [], [], []
+    for d in designs:
+        gains = gains_from_table(table, d, sys)
+        for fname, F in linear_gains(sys).items():
+            M1, M0, W = mode_matrices(sys, gains, p_seq, F)
+            for sname, start in starts.items():
+                keys.append((d, fname, sname))
+                M1s.append(M1)
+                M0s.append(M0)
+                X0s.append(start(d))
+    X = second_moments(np.array(M1s), np.array(M0s), W, p_seq, sys.sigma2, np.array(X0s))
+    mse = error_mse(X)
+    ks = np.arange(mse.shape[1])
+    summary = pd.DataFrame([{"design": d, "nonlinearity": f, "initial_state": s, "sum_mse": float(m.sum()),
+                             "final_mse": float(m[-1])} for (d, f, s), m in zip(keys, mse)])
+    # the comparison of issue 17: certified cost (only where the LMI point is certified) beside the exact errors
+    designs_tab = read_table(inputs["designs"]).set_index("design")
+    comp = []
+    for d in designs:
+        sub = summary[summary["design"] == d].set_index(["initial_state", "nonlinearity"])["sum_mse"]
+        row = {"design": d, "method": designs_tab.loc[d, "method"] if d in designs_tab.index else "",
+               "certified_cost": float(designs_tab["certified_cost"].get(d, np.nan))
+               if "certified_cost" in designs_tab else np.nan}
+        for st in starts:
+            for f in linear_gains(sys):
+                row[f"sum_mse_{st}_{f}"] = float(sub.loc[(st, f)])
+            row[f"sum_mse_{st}_worst"] = float(max(sub.loc[(st, f)] for f in linear_gains(sys)))
+        comp.append(row)
+    per_k = pd.DataFrame({"design": np.repeat([k[0] for k in keys], ks.size),
+                          "nonlinearity": np.repeat([k[1] for k in keys], ks.size),
+                          "initial_state": np.repeat([k[2] for k in keys], ks.size),
+                          "k": np.tile(ks, len(keys)), "mse": mse.ravel()})
+    return {"table": summary, "per_k": per_k, "performance": pd.DataFrame(comp)}
+
+
+def sensitivity_step(params, inputs, outputs):
+    """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter) and the plant.
+
+    Every decision comes from the shared engine (:mod:`netrepro.engines.certify`): ``feasible``
+    (its eigenvalue check of the returned point), ``infeasible`` (the plant's vertex
+    second-moment radius >= 1, a necessary condition of every criterion, or a checked dual
+    certificate) or ``undecided``; the solver status and margin are information.
+    ``table``: the sigma^2 grid per design. ``limits`` (feasibility_limit.csv): per design the
+    certified-feasible end ``sigma2_lo`` (= ``sigma2_max``) and certified-infeasible end
+    ``sigma2_hi`` of the engine's certified bisection, the undecided points between them, and
+    whether both ends are certified.
+    """
+    from ...engines.certify import bisect_certified
 
     from .design import Theorem3
+    from .feasibility import PlantLMI, necessary_limit
 
     base = _sys(params)
     lmi = params["lmi"]
     sens = params["sensitivity"]
     grid = np.asarray(sens["sigma2_grid"], dtype=float)
-    rows = []
-    for variant, sched in (("scheduled", True), ("fixed", False)):
-        prob = Theorem3(base, scheduled=sched, eps=float(lmi["eps"]), bound=float(lmi["bound"]),
-                        qp_positive=bool(lmi["qp_positive"]), margin_cap=float(lmi["margin_cap"]),
-                        gamma3_top=lmi.get("gamma3_top", "HC"))
+    lo0, hi0, tol = float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), float(sens["tol"])
+    _, nec_above = necessary_limit(base, lo0, hi0)
+    common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
+                  margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
+    problems = {"scheduled": Theorem3(base, scheduled=True, **common),
+                "fixed_gain": Theorem3(base, scheduled=False, **common),
+                "zero": Theorem3(base, zero_filter=True, **common)}
+    plant = PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]))
+
+    def decider(name):
+        if name == "plant":
+            def decide(s2):
+                v = plant.certify(s2)
+                return v, (float(plant.t.value) if plant.t.value is not None else np.nan)
+        else:
+            def decide(s2, prob=problems[name]):
+                v, sol = prob.certify(s2)
+                return v, sol.margin
+        return decide
+
+    methods = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
+               "zero": "Theorem 3 with all gains 0 (x_f = 0)", "plant": "plant Lyapunov + S-procedure LMI"}
+    rows, limits = [], []
+    top = nec_above if np.isfinite(nec_above) else hi0
+    guess = None  # the previous design's threshold: a guess changes the number of solves, never the answer
+    for name in ("scheduled", "fixed_gain", "zero", "plant"):
+        decide = decider(name)
         for s2 in grid:
-            sol = prob.solve(float(s2))
-            rows.append({"variant": variant, "sigma2": float(s2), "status": sol.status, "margin": sol.margin,
-                         "solver_feasible": sol.solver_feasible, "kind": "grid"})
-
-        def infeasible(s2, prob=prob):
-            return not prob.solve(float(s2)).solver_feasible
-
-        b = bisect_monotone(infeasible, float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), tol=float(sens["tol"]))
-        rows.append({"variant": variant, "sigma2": b.lower, "status": f"bisection ({b.n_evals} solves)",
-                     "margin": np.nan, "solver_feasible": True, "kind": "sigma2_max"})
-    # plant MS stability limit: radius of A+BFZ (x) itself + sigma2 D(x)D crosses 1
-    def plant_unstable(s2):
-        sysv = System(base.A, base.B, base.C, base.D, base.Z, base.F1, base.F2, float(s2), base.p1, base.p2)
-        return plant_ms_radius(sysv) >= 1.0
-
-    b = bisect_monotone(plant_unstable, float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), tol=float(sens["tol"]))
-    rows.append({"variant": "plant_ms_limit", "sigma2": b.lower, "status": "bisection on spectral radius",
-                 "margin": np.nan, "solver_feasible": np.nan, "kind": "sigma2_max"})
-    return {"table": pd.DataFrame(rows)}
+            v, margin = decide(float(s2))
+            rows.append({"variant": name, "sigma2": float(s2), "status": v.solver_status, "margin": margin,
+                         "certified_slack": v.point.slack if v.point is not None else np.nan,
+                         "verdict": v.verdict, "evidence": v.evidence, "kind": "grid"})
+        b = bisect_certified(lambda s2, decide=decide: decide(s2)[0], lo0, top, tol=tol, feasible_above=False,
+                             guess=guess, width=2 * tol)
+        guess = b.feasible_end if b.certified else None
+        ends = (b.feasible_end, b.infeasible_end)
+        between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
+        limits.append({"design": name, "sigma2_max": b.feasible_end, "sigma2_lo": b.feasible_end,
+                       "sigma2_hi": b.infeasible_end, "certified": bool(b.certified),
+                       "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
+                       "n_solves": b.n_evals, "method": methods[name],
+                       "infeasible_by": b.verdicts[b.infeasible_end].evidence if b.certified else ""})
+    return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
 
 
 def timing_step(params, inputs, outputs):
