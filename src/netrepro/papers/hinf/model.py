@@ -17,11 +17,10 @@ import math
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, ModelError
 from .algebra import I2, min_eig2, sym2
 from .consensus import adjacency, laplacian, pi_consensus_step
 from .evader import evader_move, min_fused_trace
-from ...errors import ModelError
 from .filters import FilterDoesNotExist, decentralized_update, hinf_update, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise

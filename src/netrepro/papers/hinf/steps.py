@@ -44,6 +44,25 @@ Tables (all under ``results/hinf/``)
 ``sensitivity_evasive.csv``
     same columns: ``parameter = gamma_evasive``, the H-infinity gamma against the evasive target
     (``value = inf``: the Kalman-driven scenario ``evasive_kalman``).
+``paired_evasive.csv`` (issue 17)
+    ``target, filter_a, filter_b, gamma, runs, mean_diff, se, z, gamma0, gamma_ratio, label_a, driver,
+    frac_a_better, error_a, error_b`` — every filter on the same target, agents and measurements;
+    ``mean_diff`` = error of a minus error of b over ``late_start <= k <= horizon`` (paired per run).
+``per_agent.csv`` (issue 17)
+    ``scenario, agent, horizon, local, decentralized, ratio, z, K_i`` — Fig 2-3 per agent and horizon
+    (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``; ``ratio`` = decentralized / local.
+``per_agent_errors.csv``
+    ``scenario, agent, filter, k, error_mean`` — Monte Carlo mean error of the end and an interior agent.
+``consensus_modes.csv``
+    ``scenario, K_i, mode, laplacian_eigenvalue, modulus, time_constant_steps`` — modes of eq (5) on the
+    Fig-2 graph.
+``evader_convergence.csv`` (issue 17)
+    ``solver, n_iter, configured, decisions, certified_fraction, same_as_reference, median_gap, max_gap,
+    median_margin, median_value, max_loss, mean_loss, loss_above_tolerance_fraction, ...`` — replayed
+    evader decisions, each candidate's value bracketed by a duality-gap certificate.
+``network.csv``, ``connectivity.csv``
+    ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
+    connected_fraction, min_lambda2`` per trajectory run.
 """
 
 from __future__ import annotations
