@@ -191,6 +191,7 @@ rule hinf_evader_check:
         code=code("netrepro.papers.hinf.steps:evader_check_step"),
     output:
         table="results/hinf/evader_convergence.csv",
+        paired="results/hinf/evader_paired.csv",
     log:
         "logs/hinf/evader_check.log",
     conda:
@@ -273,6 +274,7 @@ rule hinf_claims:
         paired_evasive=rules.hinf_paired_evasive.output.table,
         per_agent=rules.hinf_fig2_horizon.output.table,
         modes=rules.hinf_fig2_horizon.output.modes,
+        evader_paired=rules.hinf_evader_check.output.paired,
     output:
         table="results/claims/hinf.csv",
     log:
@@ -306,6 +308,7 @@ if enabled("hinf"):
         rules.hinf_fig2_horizon.output.series,
         rules.hinf_fig2_horizon.output.modes,
         rules.hinf_evader_check.output.table,
+        rules.hinf_evader_check.output.paired,
         rules.hinf_network.output.table,
         rules.hinf_network.output.connectivity,
     ]

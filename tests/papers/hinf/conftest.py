@@ -70,8 +70,10 @@ def hinf_run(tmp_path_factory):
     files["paired_evasive"] = files.pop("table")
     run(steps.fig2_horizon_step, cfg, {}, ["table", "series", "modes"])
     files["per_agent"] = files.pop("table")
-    run(steps.evader_check_step, cfg, {}, ["table"])
-    files["evader"] = files.pop("table")
+    paired = files["paired"]
+    run(steps.evader_check_step, cfg, {}, ["table", "paired"])
+    files["evader"], files["evader_paired"] = files.pop("table"), files.pop("paired")
+    files["paired"] = paired
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

@@ -29,7 +29,7 @@ def test_reconstructions_cover_sweeps(hinf_run):
 def test_claims_table(hinf_run):
     cfg, files = hinf_run
     inputs = {k: files[k] for k in ("noise_fit", "consensus", "attenuation", "checks", "summary", "paired",
-                                    "paired_evasive", "per_agent", "modes")}
+                                    "paired_evasive", "per_agent", "modes", "evader_paired")}
     c = claims.claims_step(cfg, inputs, {})["table"]
     assert list(c.columns) == CLAIM_COLUMNS
     assert set(c["verdict"]) <= set(VERDICTS)
@@ -37,3 +37,4 @@ def test_claims_table(hinf_run):
     for key in ("hinf_to_kalman", "decentralized_exact_equals_centralized", "below_gamma0_no_filter"):
         assert v[key] == "reproduced", key
     assert isinstance(c, pd.DataFrame)
+    assert "pairwise" in c.set_index("claim_id").loc["future_hinf_beats_kalman_evasive", "note"]

@@ -121,6 +121,9 @@ def test_certified_evader_choice_is_the_true_argmax():
             vals.append(_slsqp_min(noise_information(r, th, MODEL)))
         assert int(np.argmax(vals)) == d["choice"][i]
     assert d["certified"].any()
+    from netrepro.papers.hinf.evader import evader_move
+    moved, _ = evader_move(x, agents, MODEL, 0.5, 6, 200, "pairwise")
+    np.testing.assert_allclose(moved, x + offs[d["choice"]])
 
 
 def test_consensus_time_constants_against_full_matrix_and_simulation():

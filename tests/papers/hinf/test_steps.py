@@ -92,7 +92,10 @@ def test_issue17_steps_columns(hinf_run):
 
 def test_evader_and_network_steps(hinf_run):
     cfg, files = hinf_run
-    ev = steps.evader_check_step(cfg, {}, {})["table"]
+    both = steps.evader_check_step(cfg, {}, {})
+    ev = both["table"]
+    ep = both["paired"]
+    assert set(ep["solver"]) == {"mirror", "pairwise"} and len(ep) == 6
     assert ev["configured"].sum() == 1
     ref = ev[ev["solver"] == "pairwise"].iloc[0]
     assert ref["same_as_reference"] == 1.0 and ref["max_loss"] == 0.0

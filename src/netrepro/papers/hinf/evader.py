@@ -244,7 +244,8 @@ def evader_decisions(x_t, agents, model: NoiseModel, step: float, n_headings: in
             "gap": (upper - lower).max(axis=1), "margin": upper[idx, choice] - second}
 
 
-def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_iter: int = 60):
+def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_iter: int = 60,
+                solver: str = "mirror"):
     """Greedy evasive move, eqs (19) and (21): maximise ``tr Q_fused`` over the next position.
 
     Candidates are ``x_t`` itself and ``x_t + step (cos phi, sin phi)`` for ``n_headings``
@@ -262,7 +263,9 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     n_headings : int
         Number of headings.
     n_iter : int
-        Iterations of :func:`min_fused_trace`.
+        Iterations of the inner solver.
+    solver : {"mirror", "pairwise"}
+        :func:`min_fused_trace` (the configured evader) or :func:`min_fused_trace_pairwise`.
 
     Returns
     -------
@@ -275,7 +278,7 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     cand = x_t[:, None, :] + offs[None]  # (R, H+1, 2)
     r, th = geometry(cand, agents[:, None, :, :])  # (R, H+1, N)
     Minv = noise_information(r, th, model)
-    tr, _ = min_fused_trace(Minv, n_iter)
+    tr, _ = (min_fused_trace_pairwise if solver == "pairwise" else min_fused_trace)(Minv, n_iter)
     best = np.argmax(tr, axis=1)
     idx = np.arange(len(x_t))
     return cand[idx, best], tr[idx, best]

@@ -119,7 +119,7 @@ def simulate(sc: dict) -> dict:
         ``W_true``, ``W_filter``, ``A`` (2x2),
         ``gamma``, ``Lbar`` (= L^T Q L), ``P0``, ``model`` (:class:`NoiseModel`), ``radius``,
         ``consensus`` (``gamma_c, h, K_p, K_i, iters``), ``mobile``, ``driver``, ``control``
-        (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``), ``filters``,
+        (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``, optional ``solver``), ``filters``,
         ``horizon``, ``runs``, ``seed``, ``psd_floor``. Optional: ``filter_base`` (label -> filter
         name, to run several copies of one filter), ``filter_gamma`` (label -> its own gamma),
         ``record_information``. Every filter sees the same target, agents and measurements; the
@@ -209,7 +209,8 @@ def simulate(sc: dict) -> dict:
         if sc["target"] == "random":
             x = x @ A.T + rng_t.multivariate_normal(np.zeros(2), Wt, size=R) if np.any(Wt) else x @ A.T
         elif sc["target"] == "evasive":
-            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]))
+            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
+                                ev.get("solver", "mirror"))
             fused[:, k] = fz
         elif sc["target"] == "replay":  # a recorded path (the other streams of random numbers are unaffected)
             x = np.asarray(sc["target_path"], dtype=float)[:, k]
