@@ -330,7 +330,10 @@ def claims_step(params, inputs, outputs):
                           "Fig 4: the error of the mobile decentralized agent approaches zero quicker than the stationary local one",
                           True, bool(0 <= md["settle_k"] < (sl["settle_k"] if sl["settle_k"] >= 0 else np.inf)), 0,
                           f"boolean: settling step (mean error stays below {cfg['claims']['settle_threshold']})",
-                          note=f"settle k: stationary local {int(sl['settle_k'])}, mobile decentralized {int(md['settle_k'])} (-1: never)"))
+                          note=f"settle k: stationary local {int(sl['settle_k'])}, mobile decentralized {int(md['settle_k'])} (-1: never); "
+                               f"separating motion from decentralization (Fig 4, green): stationary decentralized settles at "
+                               f"k = {int(sd['settle_k'])}, so the quicker settling comes from decentralization; motion lowers "
+                               f"the late error ({sd['late_mean']:.3f} -> {md['late_mean']:.3f})"))
     rows.append(claim_row(PAPER, "fig4_mobile_smoother", "Fig 4: the error of the mobile agent is smoother",
                           True, bool(md["total_variation"] < sl["total_variation"]), 0,
                           "boolean: mean total variation per step of the error path",
