@@ -144,6 +144,88 @@ rule hinf_sensitivity_evasive:
         step("netrepro.papers.hinf.steps:sensitivity_evasive_step")
 
 
+rule hinf_paired_evasive:
+    input:
+        code=code("netrepro.papers.hinf.steps:paired_evasive_step"),
+    output:
+        table="results/hinf/paired_evasive.csv",
+    log:
+        "logs/hinf/paired_evasive.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:paired_evasive_step")
+
+
+rule hinf_fig2_horizon:
+    input:
+        code=code("netrepro.papers.hinf.steps:fig2_horizon_step"),
+    output:
+        table="results/hinf/per_agent.csv",
+        series="results/hinf/per_agent_errors.csv",
+        modes="results/hinf/consensus_modes.csv",
+    log:
+        "logs/hinf/fig2_horizon.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:fig2_horizon_step")
+
+
+rule hinf_evader_check:
+    input:
+        code=code("netrepro.papers.hinf.steps:evader_check_step"),
+    output:
+        table="results/hinf/evader_convergence.csv",
+        paired="results/hinf/evader_paired.csv",
+    log:
+        "logs/hinf/evader_check.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:evader_check_step")
+
+
+rule hinf_network:
+    input:
+        code=code("netrepro.papers.hinf.steps:network_step"),
+        trajectories=rules.hinf_tables.output.trajectories,
+    output:
+        table="results/hinf/network.csv",
+        connectivity="results/hinf/connectivity.csv",
+    log:
+        "logs/hinf/network.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:network_step")
+
+
 rule hinf_errata:
     input:
         code=code("netrepro.papers.hinf.claims:errata_step"),
@@ -165,6 +247,7 @@ rule hinf_reconstructions:
         code=code("netrepro.papers.hinf.claims:reconstructions_step"),
         sensitivity=rules.hinf_sensitivity.output.table,
         sensitivity_evasive=rules.hinf_sensitivity_evasive.output.table,
+        evader=rules.hinf_evader_check.output.table,
     output:
         table="results/reconstructions/hinf.csv",
     log:
@@ -188,6 +271,10 @@ rule hinf_claims:
         checks=rules.hinf_attenuation.output.checks,
         summary=rules.hinf_tables.output.summary,
         paired=rules.hinf_tables.output.paired,
+        paired_evasive=rules.hinf_paired_evasive.output.table,
+        per_agent=rules.hinf_fig2_horizon.output.table,
+        modes=rules.hinf_fig2_horizon.output.modes,
+        evader_paired=rules.hinf_evader_check.output.paired,
     output:
         table="results/claims/hinf.csv",
     log:
@@ -216,4 +303,12 @@ if enabled("hinf"):
         rules.hinf_attenuation.output.checks,
         rules.hinf_sensitivity.output.table,
         rules.hinf_sensitivity_evasive.output.table,
+        rules.hinf_paired_evasive.output.table,
+        rules.hinf_fig2_horizon.output.table,
+        rules.hinf_fig2_horizon.output.series,
+        rules.hinf_fig2_horizon.output.modes,
+        rules.hinf_evader_check.output.table,
+        rules.hinf_evader_check.output.paired,
+        rules.hinf_network.output.table,
+        rules.hinf_network.output.connectivity,
     ]

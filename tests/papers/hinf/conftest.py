@@ -26,6 +26,8 @@ def tiny_section() -> dict:
     sv = sec["sensitivity"]
     sv.update(runs=4, horizon=30, gamma=[1.5, 3.0], gamma_c=[0.5], K_p=[0.4], K_i=[0.2], h=[0.5], iters=[1])
     sec["claims"]["late_start"] = 20
+    sec["paired"].update(runs=6)
+    sec["fig2_horizon"].update(runs=4, horizons=[30, 40])
     return sec
 
 
@@ -64,6 +66,16 @@ def hinf_run(tmp_path_factory):
     files["sensitivity"] = files.pop("table")
     run(steps.sensitivity_evasive_step, cfg, {}, ["table"])
     files["sensitivity_evasive"] = files.pop("table")
+    run(steps.paired_evasive_step, cfg, {}, ["table"])
+    files["paired_evasive"] = files.pop("table")
+    run(steps.fig2_horizon_step, cfg, {}, ["table", "series", "modes"])
+    files["per_agent"] = files.pop("table")
+    paired = files["paired"]
+    run(steps.evader_check_step, cfg, {}, ["table", "paired"])
+    files["evader"], files["evader_paired"] = files.pop("table"), files.pop("paired")
+    files["paired"] = paired
+    run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
+    files["network"] = files.pop("table")
     return cfg, files
 
 

@@ -19,14 +19,17 @@ def test_errata_corrected_forms_beat_printed(hinf_run):
 def test_reconstructions_cover_sweeps(hinf_run):
     cfg, files = hinf_run
     r = claims.reconstructions_step(cfg, {"sensitivity": files["sensitivity"],
-                                          "sensitivity_evasive": files["sensitivity_evasive"]}, {})["table"]
+                                          "sensitivity_evasive": files["sensitivity_evasive"],
+                                          "evader": files["evader"]}, {})["table"]
+    assert r.loc[r["key"] == "hinf.evader.n_iter", "sensitivity"].str.contains("certified").all()
     assert r["key"].is_unique
     assert r.loc[r["key"] == "hinf.filter.gamma", "sensitivity"].str.contains("sweep").all()
 
 
 def test_claims_table(hinf_run):
     cfg, files = hinf_run
-    inputs = {k: files[k] for k in ("noise_fit", "consensus", "attenuation", "checks", "summary", "paired")}
+    inputs = {k: files[k] for k in ("noise_fit", "consensus", "attenuation", "checks", "summary", "paired",
+                                    "paired_evasive", "per_agent", "modes", "evader_paired")}
     c = claims.claims_step(cfg, inputs, {})["table"]
     assert list(c.columns) == CLAIM_COLUMNS
     assert set(c["verdict"]) <= set(VERDICTS)
@@ -34,3 +37,4 @@ def test_claims_table(hinf_run):
     for key in ("hinf_to_kalman", "decentralized_exact_equals_centralized", "below_gamma0_no_filter"):
         assert v[key] == "reproduced", key
     assert isinstance(c, pd.DataFrame)
+    assert "pairwise" in c.set_index("claim_id").loc["future_hinf_beats_kalman_evasive", "note"]

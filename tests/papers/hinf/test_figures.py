@@ -11,7 +11,9 @@ SPECS = load_figure_specs("hinf")
 INPUT_FILES = {  # figures.yaml input (rule[.output]) -> file of the tiny run
     "noise_model": "noise_model", "tables.errors": "errors", "tables.single": "single",
     "tables.trajectories": "trajectories", "tables.summary": "summary", "sensitivity": "sensitivity",
-    "sensitivity_evasive": "sensitivity_evasive", "consensus_check": "consensus",
+    "sensitivity_evasive": "sensitivity_evasive", "consensus_check": "consensus", "fig2_horizon": "per_agent",
+    "fig2_horizon.series": "series", "paired_evasive": "paired_evasive", "network": "network",
+    "network.connectivity": "connectivity",
 }
 
 

@@ -64,3 +64,48 @@ def test_sensitivity_tables(hinf_run):
     assert not s.loc[(s["parameter"] == "gamma") & (s["value"] == 1.5), "exists"].any()
     ev = pd.read_csv(files["sensitivity_evasive"])
     assert (ev["parameter"] == "gamma_evasive").all() and np.isinf(ev["value"]).any()
+
+
+def test_issue17_steps_columns(hinf_run):
+    cfg, files = hinf_run
+    pe = steps.paired_evasive_step(cfg, {}, {})["table"]
+    assert list(pe.columns[:8]) == ["target", "filter_a", "filter_b", "gamma", "runs", "mean_diff", "se", "z"]
+    assert set(pe["target"]) == {"evasive", "random"}
+    names = {"local", "decentralized", "centralized", "kalman_local", "kalman_decentralized", "kalman_centralized"}
+    assert set(pe["filter_a"]) | set(pe["filter_b"]) <= names
+    assert (pe["runs"] == cfg["paired"]["runs"]).all()
+    np.testing.assert_allclose(pe["z"], pe["mean_diff"] / pe["se"])
+    hk = pe[np.isfinite(pe["gamma_ratio"]) & (pe["filter_b"] == "kalman_" + pe["filter_a"])]
+    assert (hk["gamma_ratio"] > 1).all()
+    fh = steps.fig2_horizon_step(cfg, {}, {})
+    pa = fh["table"]
+    assert list(pa.columns[:7]) == ["scenario", "agent", "horizon", "local", "decentralized", "ratio", "z"]
+    assert set(pa["scenario"]) == {"fig2", "fig2_ki0"}
+    np.testing.assert_allclose(pa["ratio"], pa["decentralized"] / pa["local"])
+    # the local filter does not use the consensus: identical with and without the integral gain
+    a = pa[pa["scenario"] == "fig2"].reset_index()
+    b = pa[pa["scenario"] == "fig2_ki0"].reset_index()
+    np.testing.assert_allclose(a["local"], b["local"])
+    modes = fh["modes"]
+    assert (modes["modulus"] < 1).all()
+
+
+def test_evader_and_network_steps(hinf_run):
+    cfg, files = hinf_run
+    both = steps.evader_check_step(cfg, {}, {})
+    ev = both["table"]
+    ep = both["paired"]
+    assert set(ep["solver"]) == {"mirror", "pairwise"} and len(ep) == 6
+    assert ev["configured"].sum() == 1
+    ref = ev[ev["solver"] == "pairwise"].iloc[0]
+    assert ref["same_as_reference"] == 1.0 and ref["max_loss"] == 0.0
+    assert ((ev["certified_fraction"] >= 0) & (ev["certified_fraction"] <= 1)).all()
+    net = steps.network_step(cfg, {"trajectories": files["trajectories"]}, {})
+    conn = net["connectivity"]
+    # the ten-agent arc is a connected path: connected at every step, lambda_2 = 2 (1 - cos(pi / 10))
+    fixed = conn[conn["scenario"] == "fig2"]
+    assert (fixed["connected_fraction"] == 1.0).all()
+    np.testing.assert_allclose(fixed["min_lambda2"], 2 * (1 - np.cos(np.pi / 10)), rtol=1e-9)
+    links = net["table"]
+    k0 = links[(links["scenario"] == "fig2") & (links["run"] == 0) & (links["k"] == 0)]
+    assert len(k0) == 9

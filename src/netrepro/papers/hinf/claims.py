@@ -15,7 +15,7 @@ from .motion import control_law, printed_control_law, printed_sigma_gradient, si
 from .noise import (NoiseModel, fit_noise_model, geometry, noise_covariance, noise_information, noise_variances,
                     printed_dinfo_dtheta, sample_noise)
 
-__all__ = ["PAPER", "RECON", "errata_step", "sensitivity_text", "reconstructions_step", "claims_step"]
+__all__ = ["PAPER", "RECON", "errata_step", "sensitivity_text", "evader_text", "evader_robustness", "reconstructions_step", "claims_step"]
 
 PAPER = "hinf"
 
@@ -185,6 +185,38 @@ def sensitivity_text(sens: pd.DataFrame, parameter: str) -> str:
     return "sweep (results/hinf/sensitivity.csv): " + "; ".join(parts)
 
 
+def evader_robustness(inputs) -> str:
+    """Note on the premise: the H-infinity vs Kalman z-scores with the configured and the better-converged evader."""
+    if "evader_paired" not in inputs:
+        return ""
+    ep = pd.read_csv(inputs["evader_paired"])
+    parts = []
+    for (solver, n_iter, runs), g in ep.groupby(["solver", "n_iter", "runs"], sort=False):
+        parts.append(f"{solver} x{n_iter} ({runs} runs): " + ", ".join(f"{r.filter_a} {r.z:.1f}" for r in g.itertuples()))
+    return " Evader's inner solver (results/hinf/evader_paired.csv, z at the configured gamma): " + "; ".join(parts) + "."
+
+
+def evader_text(ev: pd.DataFrame) -> str:
+    """A sentence summarising ``evader_convergence.csv``: is the evader's inner minimisation converged?"""
+    parts = []
+    for r in ev.itertuples():
+        parts.append(f"{r.solver} x{r.n_iter}{' (configured)' if r.configured else ''}: choice certified in "
+                     f"{r.certified_fraction:.1%} of {r.decisions} decisions, same as the certified reference in "
+                     f"{r.same_as_reference:.1%}, objective lost mean {r.mean_loss:.2g} / max {r.max_loss:.2g} "
+                     f"(median value {r.median_value:.3g})")
+    conf = ev[ev["configured"]]
+    verdict = ""
+    if len(conf):
+        c = conf.iloc[0]
+        state = "converged" if c["certified_fraction"] >= 0.99 else "NOT converged"
+        verdict = (f". The configured solver is {state}: its certified tolerance (median duality gap {c['median_gap']:.2g}) "
+                   f"is far above the median difference {c['median_margin']:.2g} between the best and second-best candidate "
+                   f"steps, so {1 - c['certified_fraction']:.1%} of its choices are uncertified and "
+                   f"{c['loss_above_tolerance_fraction']:.0%} lose more than the reference's tolerance; raising the "
+                   f"mirror-descent iterations tenfold does not fix it (see the rows above)")
+    return "convergence check (results/hinf/evader_convergence.csv): " + "; ".join(parts) + verdict
+
+
 def reconstructions_step(params, inputs, outputs):
     """Every parameter the paper leaves unstated: key, value, reason, sensitivity."""
     sens = pd.concat([pd.read_csv(inputs["sensitivity"]), pd.read_csv(inputs["sensitivity_evasive"])], ignore_index=True)
@@ -193,6 +225,8 @@ def reconstructions_step(params, inputs, outputs):
         sensitivity = sensitivity_text(sens, sweep) if sweep else "not swept; see the reason"
         if sweep == "gamma":
             sensitivity += " | evasive target (gamma = inf: Kalman-driven agents): " + sensitivity_text(sens, "gamma_evasive")
+        if key == "evader.n_iter" and "evader" in inputs:
+            sensitivity = evader_text(pd.read_csv(inputs["evader"]))
         rows.append({"paper": PAPER, "key": f"hinf.{key}", "value": _get(params, key), "reason": reason,
                      "sensitivity": sensitivity})
     return {"table": reconstructions_frame(rows)}
@@ -296,7 +330,10 @@ def claims_step(params, inputs, outputs):
                           "Fig 4: the error of the mobile decentralized agent approaches zero quicker than the stationary local one",
                           True, bool(0 <= md["settle_k"] < (sl["settle_k"] if sl["settle_k"] >= 0 else np.inf)), 0,
                           f"boolean: settling step (mean error stays below {cfg['claims']['settle_threshold']})",
-                          note=f"settle k: stationary local {int(sl['settle_k'])}, mobile decentralized {int(md['settle_k'])} (-1: never)"))
+                          note=f"settle k: stationary local {int(sl['settle_k'])}, mobile decentralized {int(md['settle_k'])} (-1: never); "
+                               f"separating motion from decentralization (Fig 4, green): stationary decentralized settles at "
+                               f"k = {int(sd['settle_k'])}, so the quicker settling comes from decentralization; motion lowers "
+                               f"the late error ({sd['late_mean']:.3f} -> {md['late_mean']:.3f})"))
     rows.append(claim_row(PAPER, "fig4_mobile_smoother", "Fig 4: the error of the mobile agent is smoother",
                           True, bool(md["total_variation"] < sl["total_variation"]), 0,
                           "boolean: mean total variation per step of the error path",
@@ -312,12 +349,47 @@ def claims_step(params, inputs, outputs):
                           "Fig 6: the agents move to align themselves for better sensor readings (range error |r - a1| shrinks)",
                           True, bool(ev["range_error_end"] < ev["range_error_start"]), 0, "boolean",
                           note=f"mean |r_i - a1|: start {ev['range_error_start']:.2f}, end {ev['range_error_end']:.2f}"))
-    b, z = better("evasive_hinf_vs_kalman")
-    eh, ek = summ.loc[("evasive_hinf", "decentralized"), "late_mean"], summ.loc[("evasive_kalman", "kalman_decentralized"), "late_mean"]
+    # the premise, decided on one set of trajectories (results/hinf/paired_evasive.csv)
+    pe = pd.read_csv(inputs["paired_evasive"])
+    hk = pe[pe["filter_b"] == "kalman_" + pe["filter_a"]]
+    ev_rows, rnd_rows = hk[hk["target"] == "evasive"], hk[hk["target"] == "random"]
+    used = float(cfg["filter"]["gamma"])
+
+    def zs(df):
+        return ", ".join(f"{r.filter_a} {r.z:.1f}" for r in df[df["label_a"] == df["filter_a"]].itertuples())
+
+    runs = int(ev_rows["runs"].iloc[0]) if len(ev_rows) else 0
     rows.append(claim_row(PAPER, "future_hinf_beats_kalman_evasive",
                           "premise (Section VII): the H-infinity filter outperforms the Kalman filter against an evasive target",
-                          True, b, 0, f"boolean: paired late-error difference below -{z_sig} standard errors",
-                          note=f"decentralized, each filter driving its own agents: H-inf {eh:.4f}, Kalman {ek:.4f} (z = {z:.1f})"))
+                          True, bool(len(ev_rows) and (ev_rows["z"] < -z_sig).all()), 0,
+                          f"boolean: for every filter kind and every swept gamma, the paired difference (H-inf minus Kalman, "
+                          f"same trajectories and measurements, {runs} runs) is below -{z_sig} standard errors",
+                          note=f"all filters on the same trajectories (agents moved by {ev_rows['driver'].iloc[0] if len(ev_rows) else '?'}); "
+                               f"z at gamma = {used:g}: {zs(ev_rows)}; over gamma/gamma_0 in "
+                               f"[{ev_rows['gamma_ratio'].min():.2f}, {ev_rows['gamma_ratio'].max():.2f}] the largest z is "
+                               f"{ev_rows['z'].max():.1f}. Against the random-walk target (same agents' driver): z at gamma = "
+                               f"{used:g}: {zs(rnd_rows)}, i.e. H-infinity pays off only against the evasive target. "
+                               "(The earlier unpaired design, each filter driving its own agents, gave z = -1.6: undecided.)"
+                               + evader_robustness(inputs)))
+    # Fig 2 by horizon, agent and integral gain (results/hinf/per_agent.csv)
+    pa = pd.read_csv(inputs["per_agent"])
+    modes = pd.read_csv(inputs["modes"])
+    f2 = pa[pa["scenario"] == "fig2"]
+    f2k = pa[pa["scenario"] == "fig2_ki0"]
+    slow = modes[(modes["scenario"] == "fig2") & (modes["laplacian_eigenvalue"] > 1e-9)]["time_constant_steps"].max()
+    by_h = "; ".join(f"H={h}: ratio dec/local {g['ratio'].min():.2f}..{g['ratio'].max():.2f}, "
+                     f"{int((g['z'] < -z_sig).sum())}/{len(g)} agents better" for h, g in f2.groupby("horizon"))
+    by_hk = "; ".join(f"H={h}: {g['ratio'].min():.2f}..{g['ratio'].max():.2f}, {int((g['z'] < -z_sig).sum())}/{len(g)}"
+                      for h, g in f2k.groupby("horizon"))
+    rows.append(claim_row(PAPER, "fig2_decentralized_beats_local_every_agent_horizon",
+                          "Fig 2 read robustly: the decentralized filter beats the local one for every agent, not only on "
+                          "average over the first 200 steps",
+                          True, bool(len(f2) and (f2["z"] < -z_sig).all()), 0,
+                          f"boolean: paired per-agent difference below -{z_sig} standard errors at every agent and horizon "
+                          f"(window late_start..H)",
+                          note=f"PI consensus (K_i = {cfg['consensus']['K_i']}): {by_h}. The slow mode of (5) on the path graph "
+                               f"has time constant {slow:.0f} steps, so the consensus estimates drift over the horizon and the end "
+                               f"agents lose first. With K_i = 0: {by_hk}."))
     return {"table": claims_frame(rows)}
 
 

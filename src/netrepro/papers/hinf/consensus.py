@@ -10,7 +10,7 @@ import numpy as np
 
 __all__ = [
     "adjacency", "laplacian", "pi_consensus_step", "pi_consensus_modes", "pi_consensus_spectral_radius",
-    "consensus_h_max", "run_pi_consensus",
+    "consensus_h_max", "run_pi_consensus", "pi_consensus_time_constants",
 ]
 
 
@@ -214,3 +214,34 @@ def run_pi_consensus(u, lap, gamma_c, h, K_p, K_i, n_iter: int, v0=None):
     with np.errstate(over="ignore", invalid="ignore"):
         z = np.linalg.matrix_power(aug, int(n_iter)) @ z0
     return z[:n]
+
+
+def pi_consensus_time_constants(lam, gamma_c: float, h: float, K_p: float, K_i: float):
+    """Time constants (in iterations of eq (5)) of the consensus error on each Laplacian eigenvector.
+
+    The error ``v - mean(u)`` on the eigenvector of eigenvalue ``lam > 0`` decays like ``rho^k`` with
+    ``rho`` the spectral radius of the block of :func:`pi_consensus_modes`; its time constant is
+    ``tau = -1 / ln rho``. For small ``lam`` the slow root is ``1 - h K_i^2 lam^2 / (gamma + K_p lam) + O(h^2)``:
+    on a path graph (small algebraic connectivity ``lam_2``) the integral action is very slow.
+    ``lam = 0`` gives the decay ``1 - gamma h`` of the mean. With ``K_i = 0`` the ``w`` states stay at
+    zero and only ``1 - gamma h - h K_p lam`` acts on ``v``.
+
+    Parameters
+    ----------
+    lam : array_like
+        Laplacian eigenvalues.
+    gamma_c, h, K_p, K_i : float
+        Parameters of eq (5).
+
+    Returns
+    -------
+    rho, tau : ndarray, shape ``lam.shape`` (at least 1-d)
+        Mode moduli and time constants (inf for ``rho >= 1``).
+    """
+    if K_i == 0:
+        rho = np.abs(1.0 - gamma_c * h - h * K_p * np.atleast_1d(np.asarray(lam, dtype=float)))
+    else:
+        rho = pi_consensus_modes(lam, gamma_c, h, K_p, K_i)
+    with np.errstate(divide="ignore"):
+        tau = np.where(rho < 1.0, -1.0 / np.log(np.minimum(rho, 1.0)), np.inf)
+    return rho, tau

@@ -12,8 +12,8 @@ import pandas as pd
 
 from ...plotting import new_figure, save_figure
 
-__all__ = ["figure_noise", "figure_errors", "figure_trajectories", "figure_hinf_vs_kalman", "figure_sensitivity",
-           "figure_consensus"]
+__all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
+           "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired"]
 
 
 def figure_noise(params, inputs, outputs):
@@ -45,7 +45,7 @@ def figure_errors(params, inputs, outputs):
     err = pd.read_csv(inputs["errors"])
     single = pd.read_csv(inputs["single"])
     fig, axes = new_figure(1, 2, figsize=(11, 4), sharey=False)
-    for (scen, filt, label), color in zip(params["series"], ("C0", "C3")):
+    for (scen, filt, label), color in zip(params["series"], ("C0", "C3", "C2")):
         s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
         axes[0].plot(s["k"], s["error"], color=color, lw=1, label=label)
         e = err[(err["scenario"] == scen) & (err["filter"] == filt)]
@@ -61,28 +61,6 @@ def figure_errors(params, inputs, outputs):
     if params.get("log"):
         axes[1].set_yscale("log")
     fig.suptitle(params["title"])
-    save_figure(fig, outputs["figure"])
-    return {}
-
-
-def figure_trajectories(params, inputs, outputs):
-    """Fig 6: trajectories of the agents (circles) and the evasive target (square), with tails."""
-    tr = pd.read_csv(inputs["trajectories"], dtype={"who": str})
-    tr = tr[(tr["scenario"] == params["scenario"]) & (tr["run"] == int(params.get("run", 0)))]
-    fig, ax = new_figure(figsize=(6.5, 6.0))
-    for i, (who, g) in enumerate(tr.groupby("who", sort=True)):
-        g = g.sort_values("k")
-        is_t = who == "target"
-        color = "k" if is_t else f"C{i}"
-        ax.plot(g["x"], g["y"], "-", color=color, lw=1, alpha=0.7)
-        ax.plot(g["x"].iloc[0], g["y"].iloc[0], "s" if is_t else "o", color=color, mfc="none", ms=8)
-        ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=8,
-                label="target" if is_t else f"agent {who}")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_title(params["title"] + " (open: start, filled: end)")
-    ax.legend(fontsize=8)
     save_figure(fig, outputs["figure"])
     return {}
 
@@ -167,5 +145,114 @@ def figure_consensus(params, inputs, outputs):
     for ax in axes:
         ax.set_xlabel("h")
     axes[0].legend()
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_fig2(params, inputs, outputs):
+    """Fig 2 with its dependence on agent, horizon and integral gain (issue 17).
+
+    (a) one agent of one run, as the paper; (b) Monte Carlo mean error of the end agent 0 and an
+    interior agent over the longest horizon; (c) per-agent ratio decentralized / local error for each
+    horizon, with the PI consensus (K_i > 0) and with K_i = 0.
+    """
+    single = pd.read_csv(inputs["single"])
+    series = pd.read_csv(inputs["series"])
+    per = pd.read_csv(inputs["per_agent"])
+    scen = params["scenario"]
+    fig, axes = new_figure(1, 3, figsize=(16, 4.2))
+    for filt, color in (("local", "C0"), ("decentralized", "C3")):
+        s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
+        axes[0].plot(s["k"], s["error"], color=color, lw=1, label=filt)
+    axes[0].set_title(f"one run (run {int(single['run'].iloc[0])}), agent {int(single['agent'].iloc[0])} (end of the path)")
+    sub = series[series["scenario"] == scen]
+    for (agent, filt), g in sub.groupby(["agent", "filter"]):
+        color = "C0" if filt == "local" else "C3"
+        ls = "-" if agent == 0 else "--"
+        where = "end" if agent == 0 else "interior"
+        axes[1].plot(g["k"], g["error_mean"], color=color, ls=ls, lw=1.2, label=f"{filt}, agent {agent} ({where})")
+    axes[1].set_title("Monte Carlo mean error, end vs interior agent")
+    for ax in axes[:2]:
+        ax.set_xlabel("time step k")
+        ax.set_ylabel("estimation error |x_hat - x|")
+        ax.legend(fontsize=7)
+    hs = sorted(per["horizon"].unique())
+    for j, (variant, marker) in enumerate(((scen, "o"), (scen + "_ki0", "s"))):
+        for i, h in enumerate(hs):
+            g = per[(per["scenario"] == variant) & (per["horizon"] == h)].sort_values("agent")
+            if len(g):
+                ki = g["K_i"].iloc[0]
+                axes[2].plot(g["agent"], g["ratio"], marker=marker, ls="-" if j == 0 else ":", color=f"C{i}",
+                             label=f"H = {h}, K_i = {ki:g}")
+    axes[2].axhline(1.0, color="k", lw=0.8)
+    axes[2].set_xlabel("agent (0 and 9: ends of the path)")
+    axes[2].set_ylabel("decentralized / local error (window late_start..H)")
+    axes[2].set_title("below 1: decentralized better")
+    axes[2].legend(fontsize=7, ncol=2)
+    fig.suptitle(params["title"])
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_network(params, inputs, outputs):
+    """Fig 6 over several runs: trajectories, communication links and time marks, connected fraction per run."""
+    tr = pd.read_csv(inputs["trajectories"], dtype={"who": str})
+    links = pd.read_csv(inputs["links"], dtype={"i": str, "j": str})
+    conn = pd.read_csv(inputs["connectivity"])
+    scen = params["scenario"]
+    tr = tr[tr["scenario"] == scen]
+    runs = sorted(tr["run"].unique())
+    fig, axes = new_figure(1, len(runs), figsize=(5.5 * len(runs), 5.2), squeeze=False)
+    for ax, run in zip(axes[0], runs):
+        t = tr[tr["run"] == run]
+        marks = sorted(links.loc[(links["scenario"] == scen) & (links["run"] == run), "k"].unique())
+        marks = marks or [int(t["k"].min()), int(t["k"].max())]
+        pos = {(who, k): (x, y) for who, k, x, y in zip(t["who"], t["k"], t["x"], t["y"])}
+        for i, (who, g) in enumerate(t.groupby("who", sort=True)):
+            g = g.sort_values("k")
+            is_t = who == "target"
+            color = "k" if is_t else f"C{i}"
+            ax.plot(g["x"], g["y"], "-", color=color, lw=0.8, alpha=0.6)
+            ax.plot(g["x"].iloc[0], g["y"].iloc[0], "s" if is_t else "o", color=color, mfc="none", ms=7)
+            ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=7,
+                    label="target" if is_t else f"agent {who}")
+            gm = g[g["k"].isin(marks)]
+            ax.plot(gm["x"], gm["y"], "+" if is_t else ".", color=color, ms=8)
+            if is_t:
+                for k, x, y in zip(gm["k"], gm["x"], gm["y"]):
+                    ax.annotate(f"k={k}", (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+        lk = links[(links["scenario"] == scen) & (links["run"] == run)]
+        for k, i, j in zip(lk["k"], lk["i"], lk["j"]):
+            (x1, y1), (x2, y2) = pos[(i, k)], pos[(j, k)]
+            ax.plot([x1, x2], [y1, y2], "-", color="0.5", lw=0.8, alpha=0.8)
+        c = conn[(conn["scenario"] == scen) & (conn["run"] == run)]
+        frac = float(c["connected_fraction"].iloc[0]) if len(c) else float("nan")
+        ax.set_title(f"run {run}: connected {frac:.0%} of steps", fontsize=9)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(params["title"] + " (open: start, filled: end; grey: links at the time marks)")
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_paired(params, inputs, outputs):
+    """Fig S4: H-infinity minus Kalman error on the same trajectories, against gamma / gamma_0 (issue 17)."""
+    pe = pd.read_csv(inputs["table"])
+    pe = pe[pe["filter_b"] == "kalman_" + pe["filter_a"]]
+    targets = list(dict.fromkeys(pe["target"]))
+    fig, axes = new_figure(1, len(targets), figsize=(5.5 * len(targets), 4), squeeze=False)
+    for ax, target in zip(axes[0], targets):
+        for i, (kind, g) in enumerate(pe[pe["target"] == target].groupby("filter_a", sort=False)):
+            g = g.sort_values("gamma_ratio")
+            ax.errorbar(g["gamma_ratio"], g["mean_diff"], yerr=2 * g["se"], fmt="o-", color=f"C{i}", capsize=3,
+                        label=kind)
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xscale("log")
+        ax.set_xlabel("gamma / gamma_0 of the filter")
+        ax.set_ylabel("error(H-inf) - error(Kalman), +- 2 SE")
+        ax.set_title(f"{target} target, {int(pe['runs'].iloc[0])} paired runs (below 0: H-inf better)", fontsize=9)
+        ax.legend(fontsize=7)
     save_figure(fig, outputs["figure"])
     return {}

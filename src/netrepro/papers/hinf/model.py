@@ -17,15 +17,18 @@ import math
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, ModelError
 from .algebra import I2, min_eig2, sym2
 from .consensus import adjacency, laplacian, pi_consensus_step
 from .evader import evader_move, min_fused_trace
-from .filters import FilterDoesNotExist, decentralized_update, hinf_update
+from .filters import FilterDoesNotExist, decentralized_update, hinf_update, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
 
-__all__ = ["FILTER_KINDS", "SCENARIOS", "layout_positions", "resolve_scenario", "simulate", "FilterDoesNotExist"]
+__all__ = ["FILTER_KINDS", "SCENARIOS", "KINDS", "layout_positions", "resolve_scenario", "simulate",
+           "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired"]
+
+KINDS = ("local", "decentralized", "centralized")
 
 FILTER_KINDS = {
     "local": ("local", False), "decentralized": ("decentralized", False), "centralized": ("centralized", False),
@@ -112,11 +115,15 @@ def simulate(sc: dict) -> dict:
     ----------
     sc : dict
         Resolved scenario: ``agents0 (N, 2)``, ``target0 (2,)``, ``target`` in
-        {``random``, ``stationary``, ``evasive``}, ``W_true``, ``W_filter``, ``A`` (2x2),
+        {``random``, ``stationary``, ``evasive``, ``replay``} (``replay``: the path ``target_path (R, K+1, 2)``),
+        ``W_true``, ``W_filter``, ``A`` (2x2),
         ``gamma``, ``Lbar`` (= L^T Q L), ``P0``, ``model`` (:class:`NoiseModel`), ``radius``,
         ``consensus`` (``gamma_c, h, K_p, K_i, iters``), ``mobile``, ``driver``, ``control``
-        (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``), ``filters``,
-        ``horizon``, ``runs``, ``seed``, ``psd_floor``.
+        (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``, optional ``solver``), ``filters``,
+        ``horizon``, ``runs``, ``seed``, ``psd_floor``. Optional: ``filter_base`` (label -> filter
+        name, to run several copies of one filter), ``filter_gamma`` (label -> its own gamma),
+        ``record_information``. Every filter sees the same target, agents and measurements; the
+        agents are moved by ``driver`` alone (a paired design).
 
     Returns
     -------
@@ -125,7 +132,10 @@ def simulate(sc: dict) -> dict:
         (``n = N`` for local/decentralized, 1 for centralized); ``target (runs, K+1, 2)``;
         ``agents (runs, K+1, N, 2)``; ``connected (K+1,)`` fraction of runs with a connected
         graph; ``max_degree``; ``fused_trace (runs, K+1)`` (min over lambda of tr Q_fused, eq (22));
-        ``trace_sigma[name] (runs, K+1)`` mean over agents of ``tr Sigma``; ``n_psd_fix``.
+        ``trace_sigma[name] (runs, K+1)`` mean over agents of ``tr Sigma``; ``n_psd_fix``;
+        ``connected_runs (runs, K+1)`` whether each run's graph is connected; ``information``: with
+        ``record_information``, ``{"local": C^T M_k^{-1} C, "decentralized": N C~_k}`` of shape
+        ``(K, runs, N, 2, 2)`` (the S sequences of eqs (6) and (9), for gamma_0), else None.
 
     Raises
     ------
@@ -147,9 +157,14 @@ def simulate(sc: dict) -> dict:
     ctrl = sc.get("control", {})
     ev = sc.get("evader", {})
     names = list(sc["filters"])
+    base = sc.get("filter_base", {})  # label -> filter name of FILTER_KINDS (extra copies of a filter)
     for name in names:
-        if name not in FILTER_KINDS:
+        if base.get(name, name) not in FILTER_KINDS:
             raise InputError(f"unknown filter {name!r}; expected one of {sorted(FILTER_KINDS)}")
+    kind_of = {n: FILTER_KINDS[base.get(n, n)] for n in names}
+    own_gamma = sc.get("filter_gamma", {})  # label -> its own H-infinity gamma (default sc['gamma'])
+    gi_of = {n: 0.0 if kind_of[n][1] else (float(own_gamma[n]) ** -2.0 if n in own_gamma else g2) for n in names}
+    record = bool(sc.get("record_information", False))
     mobile = bool(sc.get("mobile", False))
     driver = sc.get("driver", "decentralized")
     if mobile and driver not in names:
@@ -162,14 +177,14 @@ def simulate(sc: dict) -> dict:
     Sig0 = float(sc["P0"]) * I2
     est, cov = {}, {}
     for name in names:
-        kind, _ = FILTER_KINDS[name]
+        kind, _ = kind_of[name]
         shape = (R,) if kind == "centralized" else (R, N)
         est[name] = np.broadcast_to(x0hat[:, None, :] if kind != "centralized" else x0hat, shape + (2,)).copy()
         cov[name] = np.broadcast_to(Sig0, shape + (2, 2)).copy()
-    errors = {n: np.empty((R, 1 if FILTER_KINDS[n][0] == "centralized" else N, K + 1)) for n in names}
+    errors = {n: np.empty((R, 1 if kind_of[n][0] == "centralized" else N, K + 1)) for n in names}
     trace_sigma = {n: np.empty((R, K + 1)) for n in names}
     for n in names:
-        e = np.linalg.norm(est[n] - (x if FILTER_KINDS[n][0] == "centralized" else x[:, None, :]), axis=-1)
+        e = np.linalg.norm(est[n] - (x if kind_of[n][0] == "centralized" else x[:, None, :]), axis=-1)
         errors[n][..., 0] = e if e.ndim == 2 else e[:, None]
         trace_sigma[n][:, 0] = 2 * float(sc["P0"])
     tgt = np.empty((R, K + 1, 2))
@@ -178,11 +193,14 @@ def simulate(sc: dict) -> dict:
     ags[:, 0] = P
     fused = np.full((R, K + 1), np.nan)
     connected = np.empty(K + 1)
+    conn_runs = np.empty((R, K + 1), dtype=bool)
     adj = adjacency(P, sc["radius"])
     lap = laplacian(adj)
-    connected[0] = _connected(adj).mean()
+    conn_runs[:, 0] = _connected(adj)
+    connected[0] = conn_runs[:, 0].mean()
+    info_hist = {"local": np.empty((K, R, N, 2, 2)), "decentralized": np.empty((K, R, N, 2, 2))} if record else None
     max_degree = int(adj.sum(-1).max())
-    need_cons = any(FILTER_KINDS[n][0] == "decentralized" for n in names)
+    need_cons = any(kind_of[n][0] == "decentralized" for n in names)
     v = w = None
     dsig = np.zeros((2, R, N, 2, 2))  # local copies of Sigma^r_i, Sigma^theta_i (eq (14))
     n_psd_fix = 0
@@ -191,8 +209,11 @@ def simulate(sc: dict) -> dict:
         if sc["target"] == "random":
             x = x @ A.T + rng_t.multivariate_normal(np.zeros(2), Wt, size=R) if np.any(Wt) else x @ A.T
         elif sc["target"] == "evasive":
-            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]))
+            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
+                                ev.get("solver", "mirror"))
             fused[:, k] = fz
+        elif sc["target"] == "replay":  # a recorded path (the other streams of random numbers are unaffected)
+            x = np.asarray(sc["target_path"], dtype=float)[:, k]
         elif sc["target"] != "stationary":
             raise InputError(f"unknown target mode {sc['target']!r}")
         # 2. measurements (2)-(4) from the true geometry
@@ -210,11 +231,15 @@ def simulate(sc: dict) -> dict:
             Ct, nfix = _psd_floor(v[..., :4].reshape(R, N, 2, 2), float(sc.get("psd_floor", 1e-9)))
             n_psd_fix += nfix
             yt = v[..., 4:]
+            if record:
+                info_hist["decentralized"][k - 1] = N * Ct
+        if record:
+            info_hist["local"][k - 1] = Minv
         # 4. filters (6), (9) and their Kalman counterparts
         deltas = {}
         for n in names:
-            kind, is_kf = FILTER_KINDS[n]
-            gi = 0.0 if is_kf else g2
+            kind, _ = kind_of[n]
+            gi = gi_of[n]
             if kind == "local":
                 out = hinf_update(est[n], cov[n], yinfo, Minv, A, BWB, gi, Lbar)
             elif kind == "centralized":
@@ -230,14 +255,14 @@ def simulate(sc: dict) -> dict:
                 trace_sigma[n][:, k] = (cov[n][..., 0, 0] + cov[n][..., 1, 1]).mean(1)
         # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
         if mobile:
-            gi = 0.0 if FILTER_KINDS[driver][1] else g2
+            gi = gi_of[driver]
             xh = est[driver]  # (R, N, 2)
             d = xh - P
             rh, thh = np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])
             rh = np.maximum(rh, 1e-6)
             _, dMr, dMt = noise_information(rh, thh, model, derivatives=True)
             Delta = deltas[driver]
-            S_hat = N * Ct if FILTER_KINDS[driver][0] == "decentralized" else Minv
+            S_hat = N * Ct if kind_of[driver][0] == "decentralized" else Minv
             grads = []
             for z, dM in enumerate((dMr, dMt)):
                 dDelta = A @ dsig[z] @ A.T if ctrl.get("recursion", True) else np.zeros_like(Delta)
@@ -248,11 +273,132 @@ def simulate(sc: dict) -> dict:
             adj = adjacency(P, sc["radius"])
             lap = laplacian(adj)
             max_degree = max(max_degree, int(adj.sum(-1).max()))
-        connected[k] = _connected(adj).mean() if mobile else connected[0]
+        conn_runs[:, k] = _connected(adj) if mobile else conn_runs[:, 0]
+        connected[k] = conn_runs[:, k].mean() if mobile else connected[0]
         tgt[:, k] = x
         ags[:, k] = P
     if sc["target"] == "evasive" or sc.get("fused_all", True):
         r, th = geometry(tgt[:, 0], ags[:, 0])
         fused[:, 0] = min_fused_trace(noise_information(r, th, model), int(ev.get("n_iter", 40)))[0]
     return {"errors": errors, "target": tgt, "agents": ags, "connected": connected, "max_degree": max_degree,
-            "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix}
+            "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix, "connected_runs": conn_runs,
+            "information": info_hist}
+
+
+def attenuation_levels(information, P0: float, A, BWB, Lbar) -> dict:
+    """Minimum attenuation level gamma_0 of each H-infinity filter kind along recorded informations.
+
+    gamma_0 is the smallest gamma for which ``Sigma_k^{-1} > 0`` at every step of every run and
+    agent (eq (6) for ``local`` and ``centralized``, eq (9) for ``decentralized``); the
+    covariance recursion does not depend on the measurements, only on the sequence ``S_k``.
+
+    Parameters
+    ----------
+    information : dict
+        ``simulate(...)["information"]``: ``local`` ``(K, R, N, 2, 2)`` the agents' ``M_k^{-1}``,
+        ``decentralized`` ``(K, R, N, 2, 2)`` their ``N C~_k``.
+    P0 : float
+        ``Sigma_0 = P0 I``.
+    A, BWB, Lbar : ndarray, shape ``(2, 2)``
+
+    Returns
+    -------
+    dict
+        ``{kind: gamma_0}`` for ``local`` (worst agent), ``decentralized`` (worst agent), ``centralized``.
+    """
+    Sig0 = float(P0) * I2
+    loc = information["local"]
+    return {
+        "local": minimum_attenuation(loc, Sig0, A, BWB, Lbar),
+        "decentralized": minimum_attenuation(information["decentralized"], Sig0, A, BWB, Lbar),
+        "centralized": minimum_attenuation(loc.sum(2), Sig0, A, BWB, Lbar),
+    }
+
+
+def window_means(errors, start: int, stop: int | None = None):
+    """Mean error of each run over the steps ``start <= k <= stop`` (the claims' window) and the agents.
+
+    Parameters
+    ----------
+    errors : ndarray, shape ``(R, n, K + 1)``
+    start : int
+    stop : int, optional
+        Last step included (default ``K``).
+
+    Returns
+    -------
+    ndarray, shape ``(R,)``
+    """
+    stop = errors.shape[-1] - 1 if stop is None else int(stop)
+    return errors[..., int(start):stop + 1].mean(axis=(1, 2))
+
+
+def paired_z(a, b):
+    """Paired comparison of per-run values: mean of ``a - b``, its standard error and ``z = mean / se``.
+
+    Parameters
+    ----------
+    a, b : ndarray, shape ``(R,)``
+        Values of the two arms on the same runs (common random numbers).
+
+    Returns
+    -------
+    mean, se, z : float
+        ``se`` is the sample standard deviation of the differences over ``sqrt(R)``.
+    """
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    se = d.std(ddof=1) / math.sqrt(len(d)) if len(d) > 1 else np.nan
+    return float(d.mean()), float(se), float(d.mean() / se) if se > 0 else np.nan
+
+
+def run_paired(sc: dict, factors) -> dict:
+    """Every filter on the same target, agents and measurements, with gamma swept relative to each gamma_0.
+
+    Pass 1 runs the driver alone (it alone moves the agents) and records the informations; gamma_0 of
+    each kind follows from them (:func:`attenuation_levels`). Pass 2 repeats the same seed with the
+    driver, the six filters of ``FILTER_KINDS`` and one extra H-infinity copy of each kind per factor
+    ``c`` at ``gamma = c gamma_0(kind)`` (labels ``"<kind>@<c>"``), replaying the target's path of pass 1.
+    Since only the driver moves the agents and the measurement noise has its own random stream, both
+    passes have identical target and agent trajectories and measurements; this is checked (the
+    driver's errors must agree to the bit).
+
+    Parameters
+    ----------
+    sc : dict
+        Resolved scenario (see :func:`simulate`); ``driver`` must be one of the six filter names.
+    factors : sequence of float
+        Multiples of gamma_0 (each > 1).
+
+    Returns
+    -------
+    dict
+        ``gamma0 {kind: float}``, ``gammas {label: gamma or inf}``, ``base {label: filter name}``,
+        ``out``: the pass-2 output of :func:`simulate`.
+
+    Raises
+    ------
+    ModelError
+        If the two passes do not share their trajectories.
+    """
+    first = simulate({**sc, "filters": [sc["driver"]], "record_information": True})
+    gamma0 = attenuation_levels(first["information"], sc["P0"], np.asarray(sc["A"], float),
+                                np.asarray(sc["W_filter"], float), np.asarray(sc["Lbar"], float))
+    names = list(FILTER_KINDS)
+    base = {n: n for n in names}
+    gammas = {n: (np.inf if FILTER_KINDS[n][1] else float(sc["gamma"])) for n in names}
+    for kind in KINDS:
+        for c in factors:
+            label = f"{kind}@{c:g}"
+            base[label], gammas[label] = kind, float(c) * gamma0[kind]
+            names.append(label)
+    own = {n: g for n, g in gammas.items() if np.isfinite(g)}
+    # the target's path is replayed (the evader's moves depend only on the target and the agents, which the
+    # driver alone moves); the measurement noise has its own stream of random numbers
+    out = simulate({**sc, "filters": names, "filter_base": base, "filter_gamma": own, "target": "replay",
+                    "target_path": first["target"]})
+    same = (np.array_equal(out["target"], first["target"]) and np.array_equal(out["agents"], first["agents"])
+            and np.array_equal(out["errors"][sc["driver"]], first["errors"][sc["driver"]]))
+    if not same:
+        raise ModelError("paired design broken: trajectories or measurements depend on the set of filters")
+    out["fused_trace"] = first["fused_trace"]
+    return {"gamma0": gamma0, "gammas": gammas, "base": base, "out": out}

@@ -44,6 +44,28 @@ Tables (all under ``results/hinf/``)
 ``sensitivity_evasive.csv``
     same columns: ``parameter = gamma_evasive``, the H-infinity gamma against the evasive target
     (``value = inf``: the Kalman-driven scenario ``evasive_kalman``).
+``paired_evasive.csv`` (issue 17)
+    ``target, filter_a, filter_b, gamma, runs, mean_diff, se, z, gamma0, gamma_ratio, label_a, driver,
+    frac_a_better, error_a, error_b`` — every filter on the same target, agents and measurements;
+    ``mean_diff`` = error of a minus error of b over ``late_start <= k <= horizon`` (paired per run).
+``per_agent.csv`` (issue 17)
+    ``scenario, agent, horizon, local, decentralized, ratio, z, K_i`` — Fig 2-3 per agent and horizon
+    (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``; ``ratio`` = decentralized / local.
+``per_agent_errors.csv``
+    ``scenario, agent, filter, k, error_mean`` — Monte Carlo mean error of the end and an interior agent.
+``consensus_modes.csv``
+    ``scenario, K_i, mode, laplacian_eigenvalue, modulus, time_constant_steps`` — modes of eq (5) on the
+    Fig-2 graph.
+``evader_convergence.csv`` (issue 17)
+    ``solver, n_iter, configured, decisions, certified_fraction, same_as_reference, median_gap, max_gap,
+    median_margin, median_value, max_loss, mean_loss, loss_above_tolerance_fraction, ...`` — replayed
+    evader decisions, each candidate's value bracketed by a duality-gap certificate.
+``evader_paired.csv``
+    ``solver, n_iter, runs, filter_a, filter_b, gamma, mean_diff, se, z, error_a, error_b`` — the H-infinity
+    vs Kalman comparison repeated with the configured and the better-converged evader.
+``network.csv``, ``connectivity.csv``
+    ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
+    connected_fraction, min_lambda2`` per trajectory run.
 """
 
 from __future__ import annotations
@@ -54,14 +76,18 @@ import numpy as np
 import pandas as pd
 
 from .algebra import rotation
-from .consensus import adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius, run_pi_consensus
+from .consensus import (adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius,
+                        pi_consensus_time_constants, run_pi_consensus)
+from .evader import evader_decisions
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
-from .model import FilterDoesNotExist, layout_positions, resolve_scenario, simulate
+from .model import (KINDS, FilterDoesNotExist, layout_positions, paired_z, resolve_scenario, run_paired, simulate,
+                    window_means)
 from .noise import NoiseModel, geometry, noise_covariance, noise_information, noise_variances, sample_noise
 
 __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
-    "tables_step", "sensitivity_step", "sensitivity_evasive_step",
+    "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
+    "evader_check_step", "network_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
@@ -338,3 +364,168 @@ def _sensitivity(params, evasive):
         for val in sv[key]:
             run(key, val, sv["mobile_scenario"], {"control": {key: val}})
     return pd.DataFrame(rows)
+
+
+# --------------------------------------------------------------------------- issue 17: comparisons that can decide
+def paired_evasive_step(params, inputs, outputs):
+    """Every filter on the same target, agents and measurements; gamma swept relative to each gamma_0.
+
+    For each target model, :func:`~netrepro.papers.hinf.model.run_paired` runs the six filters and the
+    gamma-swept H-infinity copies on one set of trajectories (agents moved by the scenario's driver).
+    Rows: each H-infinity kind against its Kalman counterpart at the configured gamma and at
+    ``factor x gamma_0``; and the structural comparisons (decentralized vs local, centralized vs
+    decentralized) for both families. ``mean_diff`` = error of ``filter_a`` minus error of ``filter_b``,
+    each the mean over the claims' window ``late_start <= k <= horizon`` and the agents, paired per run.
+    """
+    cfg, pc = params, params["paired"]
+    start = int(cfg["claims"]["late_start"])
+    rows, prov = [], {}
+    for target in pc["targets"]:
+        sc = resolve_scenario(cfg, pc["scenario"], runs=int(pc["runs"]), seed=int(pc["seed"]))
+        sc["target"] = target
+        res = run_paired(sc, [float(c) for c in pc["gamma_factors"]])
+        per_run = {lab: window_means(e, start) for lab, e in res["out"]["errors"].items()}
+        g0 = res["gamma0"]
+        prov[target] = {"gamma0": g0, "driver": sc["driver"]}
+
+        def row(a, b, gamma, kind):
+            mean, se, z = paired_z(per_run[a], per_run[b])
+            return {"target": target, "filter_a": res["base"][a], "filter_b": b, "gamma": gamma, "runs": sc["runs"],
+                    "mean_diff": mean, "se": se, "z": z, "gamma0": g0.get(kind, np.nan),
+                    "gamma_ratio": gamma / g0[kind] if kind in g0 else np.nan, "label_a": a, "driver": sc["driver"],
+                    "frac_a_better": float(np.mean(per_run[a] < per_run[b])),
+                    "error_a": float(per_run[a].mean()), "error_b": float(per_run[b].mean())}
+
+        for kind in KINDS:
+            labels = [kind] + [f"{kind}@{float(c):g}" for c in pc["gamma_factors"]]
+            for lab in sorted(labels, key=lambda s: res["gammas"][s]):
+                rows.append(row(lab, "kalman_" + kind, res["gammas"][lab], kind))
+        g = float(cfg["filter"]["gamma"])
+        for a, b, gam in (("decentralized", "local", g), ("centralized", "decentralized", g),
+                          ("kalman_decentralized", "kalman_local", np.inf),
+                          ("kalman_centralized", "kalman_decentralized", np.inf)):
+            rows.append(row(a, b, gam, a if np.isfinite(gam) else ""))
+    return {"table": pd.DataFrame(rows), "provenance": {"paired": prov}}
+
+
+def fig2_horizon_step(params, inputs, outputs):
+    """Fig 2's comparison (decentralized vs local) by horizon, agent and integral gain, and the consensus modes.
+
+    Each scenario of ``fig2_horizon.scenarios`` is simulated once to the longest horizon with its own
+    seed and ``fig2_horizon.runs`` runs, with the configured ``K_i`` and
+    with ``K_i = 0`` (scenario ``<name>_ki0``); a horizon ``H`` uses the window ``late_start <= k <= H``.
+    """
+    cfg, fh = params, params["fig2_horizon"]
+    start = int(cfg["claims"]["late_start"])
+    K = max(int(h) for h in fh["horizons"])
+    rows, series, modes = [], [], []
+    interior = int(fh["interior_agent"])
+    for scen in fh["scenarios"]:
+        for suffix, over in (("", {}), ("_ki0", {"consensus": {"K_i": 0.0}})):
+            sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]), **over)
+            sc["filters"] = ["local", "decentralized"]
+            out = simulate(sc)
+            e_loc, e_dec = out["errors"]["local"], out["errors"]["decentralized"]
+            for H in fh["horizons"]:
+                H = int(H)
+                for agent in range(e_loc.shape[1]):
+                    a = e_dec[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
+                    b = e_loc[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
+                    _, _, z = paired_z(a, b)
+                    rows.append({"scenario": scen + suffix, "agent": agent, "horizon": H, "local": b.mean(),
+                                 "decentralized": a.mean(), "ratio": a.mean() / b.mean(), "z": z,
+                                 "K_i": sc["consensus"]["K_i"]})
+            for agent in sorted({0, min(interior, e_loc.shape[1] - 1)}):
+                for fname, e in (("local", e_loc), ("decentralized", e_dec)):
+                    series.append(pd.DataFrame({"scenario": scen + suffix, "agent": agent, "filter": fname,
+                                                "k": np.arange(K + 1), "error_mean": e[:, agent].mean(0)}))
+            if scen == fh["scenarios"][0]:
+                lap = laplacian(adjacency(sc["agents0"], sc["radius"]))
+                lam = np.linalg.eigvalsh(lap)
+                c = sc["consensus"]
+                rho, tau = pi_consensus_time_constants(lam, c["gamma_c"], c["h"], c["K_p"], c["K_i"])
+                modes.append(pd.DataFrame({"scenario": scen + suffix, "K_i": c["K_i"], "mode": np.arange(len(lam)),
+                                           "laplacian_eigenvalue": lam, "modulus": rho,
+                                           "time_constant_steps": tau / int(c["iters"])}))
+    return {"table": pd.DataFrame(rows), "series": pd.concat(series, ignore_index=True),
+            "modes": pd.concat(modes, ignore_index=True)}
+
+
+def evader_check_step(params, inputs, outputs):
+    """Has the evader's inner minimisation (eq (24), over lambda) converged? Decisions replayed and certified.
+
+    The decisions of the first ``evader_check.runs`` runs of ``evasive_hinf`` are replayed with the
+    evader's mirror descent at several iteration counts (the configured one included) and with a
+    certified reference (pairwise Frank-Wolfe; every candidate's value bracketed by its duality gap).
+    A choice is certified when its lower bound beats every other candidate's upper bound. The loss
+    of a choice is the reference value of the best candidate minus that of the chosen one: a wrong
+    choice matters only if this exceeds the reference's tolerance (the candidates are otherwise tied).
+    Second table: the H-infinity vs Kalman comparison of ``paired_evasive`` (configured gamma) repeated on
+    ``paired_runs`` runs with the configured evader and with the pairwise (better converged) evader.
+    """
+    cfg, ec = params, params["evader_check"]
+    sc = resolve_scenario(cfg, "evasive_hinf", runs=int(ec["runs"]))
+    sc["filters"] = [sc["driver"]]
+    out = simulate(sc)
+    N = out["agents"].shape[2]
+    x = out["target"][:, :-1].reshape(-1, 2)
+    P = out["agents"][:, :-1].reshape(-1, N, 2)
+    ev = sc["evader"]
+    ref = evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"], int(ec["reference_iterations"]),
+                           "pairwise")
+    idx = np.arange(len(x))
+    best_ref = ref["upper"][idx, ref["choice"]]
+    rows = []
+    mirror = sorted({int(n) for n in ec["mirror_iterations"]} | {int(ev["n_iter"])})  # the configured one always
+    for solver, n_iter in [("mirror", n) for n in mirror] + [
+            ("pairwise", int(ec["reference_iterations"]))]:
+        d = ref if solver == "pairwise" else evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"],
+                                                              n_iter, solver)
+        loss = best_ref - ref["upper"][idx, d["choice"]]
+        tol = ref["gap"]
+        rows.append({"solver": solver, "n_iter": n_iter, "configured": solver == "mirror" and n_iter == int(ev["n_iter"]),
+                     "decisions": len(x), "certified_fraction": float(d["certified"].mean()),
+                     "same_as_reference": float(np.mean(d["choice"] == ref["choice"])),
+                     "median_gap": float(np.median(d["gap"])), "max_gap": float(d["gap"].max()),
+                     "median_margin": float(np.median(d["margin"])),
+                     "median_value": float(np.median(best_ref)),
+                     "max_loss": float(loss.max()), "mean_loss": float(loss.mean()),
+                     "loss_above_tolerance_fraction": float(np.mean(loss > tol)),
+                     "reference_certified_fraction": float(ref["certified"].mean()),
+                     "reference_max_gap": float(ref["gap"].max())})
+    # does the premise's verdict depend on the evader's unconverged inner solver? same seeds, both evaders
+    prows = []
+    for solver, n_iter in (("mirror", int(ev["n_iter"])), ("pairwise", int(ec["pairwise_iterations"]))):
+        sp = resolve_scenario(cfg, "evasive_hinf", runs=int(ec["paired_runs"]), seed=int(cfg["paired"]["seed"]))
+        sp["evader"] = {**sp["evader"], "solver": solver, "n_iter": n_iter}
+        res = run_paired(sp, [])
+        start = int(cfg["claims"]["late_start"])
+        for kind in KINDS:
+            a = window_means(res["out"]["errors"][kind], start)
+            b = window_means(res["out"]["errors"]["kalman_" + kind], start)
+            mean, se, z = paired_z(a, b)
+            prows.append({"solver": solver, "n_iter": n_iter, "runs": sp["runs"], "filter_a": kind,
+                          "filter_b": "kalman_" + kind, "gamma": float(sp["gamma"]), "mean_diff": mean, "se": se, "z": z,
+                          "error_a": float(a.mean()), "error_b": float(b.mean())})
+    return {"table": pd.DataFrame(rows), "paired": pd.DataFrame(prows)}
+
+
+def network_step(params, inputs, outputs):
+    """Communication links (eq (25)) at the time marks of Fig 6, and the connected fraction of each run."""
+    tr = pd.read_csv(inputs["trajectories"], dtype={"who": str})
+    radius = float(params["comm_radius"])
+    marks = [int(m) for m in params["network"]["marks"]]
+    links, conn = [], []
+    for (scen, run), g in tr[tr["who"] != "target"].groupby(["scenario", "run"], sort=True):
+        g = g.sort_values(["k", "who"])
+        ids = sorted(g["who"].unique(), key=int)
+        K = int(g["k"].max())
+        pos = np.stack([g[g["who"] == i].sort_values("k")[["x", "y"]].to_numpy() for i in ids], 1)  # (K+1, N, 2)
+        adj = adjacency(pos, radius)
+        lam2 = np.linalg.eigvalsh(laplacian(adj))[:, 1]
+        conn.append({"scenario": scen, "run": int(run), "steps": K + 1, "connected_fraction": float(np.mean(lam2 > 1e-9)),
+                     "min_lambda2": float(lam2.min())})
+        for k in [m for m in marks if m <= K]:
+            for i, j in zip(*np.nonzero(np.triu(adj[k]))):
+                links.append({"scenario": scen, "run": int(run), "k": k, "i": ids[i], "j": ids[j]})
+    return {"table": pd.DataFrame(links, columns=["scenario", "run", "k", "i", "j"]), "connectivity": pd.DataFrame(conn)}
