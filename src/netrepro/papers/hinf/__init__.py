@@ -14,3 +14,5 @@ Modules
 ``figures``    plotting only (reads tables); ``figures.yaml`` lists the figures.
 ``checks``     configuration checks the schema cannot express.
 """
+
+__all__: list[str] = []

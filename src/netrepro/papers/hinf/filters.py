@@ -22,6 +22,11 @@ class FilterDoesNotExist(ModelError):
 
     Raised when the information matrix ``Sigma_k^{-1} = Delta_k^{-1} + C^T M^{-1} C - gamma^{-2} L^T Q L``
     of eq (6) (or (9)) is not positive definite at some step.
+
+    Parameters
+    ----------
+    *args
+        The message, as for any exception: it names gamma and the step.
     """
 
 
