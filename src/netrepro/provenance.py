@@ -10,6 +10,7 @@ netrepro verify``).
 
 from __future__ import annotations
 
+import datetime as _dt
 import hashlib
 import json
 import logging
@@ -153,6 +154,7 @@ def write_sidecar(output: str | Path, record: StepRecord) -> Path:
         "packages": package_versions(),
         "machine": {"platform": platform.platform(), "processor": platform.machine()},
         "wall_time_s": round(record.wall_time_s, 3),
+        "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command": command,
         **({"extra": record.extra} if record.extra else {}),
     }
