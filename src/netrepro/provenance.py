@@ -92,7 +92,19 @@ def job_command() -> str:
     Snakemake's console shows one line per job; the full command of a step is kept here, in the
     sidecar of each output and once in the job's log (see :func:`write_sidecar`).
     """
-    return shlex.join(getattr(sys, "orig_argv", None) or [sys.executable, *sys.argv])
+    argv = getattr(sys, "orig_argv", None) or [sys.executable, *sys.argv]
+    return shlex.join(_relative(arg) for arg in argv)
+
+
+def _relative(arg: str) -> str:
+    """A path under the working directory (the checkout) as a relative path: sidecars name no
+    absolute path of the machine (the interpreter is ``.venv/bin/python`` after ``make``)."""
+    if not arg.startswith("/"):
+        return arg
+    try:
+        return str(Path(arg).relative_to(Path.cwd()))
+    except ValueError:
+        return arg
 
 
 def find_seeds(params, prefix="") -> dict:
