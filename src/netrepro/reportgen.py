@@ -837,7 +837,18 @@ def main(argv=None) -> int:
     ex.add_argument("--slug", required=True)
     ex.add_argument("--notebook", required=True)
     ex.add_argument("--html", required=True)
+    rel = sub.add_parser("relocate", help="rewrite files so they name no path of this checkout "
+                                          "(e.g. Snakemake's own report, which shows the rules' commands)")
+    rel.add_argument("files", nargs="+")
     args = parser.parse_args(argv)
+    if args.command == "relocate":
+        for name in args.files:
+            path = Path(name)
+            text = path.read_text()
+            new = relocate(text, Path.cwd())
+            if new != text:
+                path.write_text(new)
+        return 0
     if args.command == "make-notebook":
         out = args.out or f"workflow/notebooks/{args.slug}.ipynb"
         print(make_notebook(args.slug, out))
