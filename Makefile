@@ -53,7 +53,7 @@ lock: $(STAMP)
 	$(BIN)/python -m pip install --quiet 'uv==$(UV_VERSION)'
 	$(BIN)/uv pip compile $(LOCK)/bootstrap.in $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/bootstrap.txt
 	$(BIN)/uv pip compile pyproject.toml $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/default.txt
-	$(BIN)/uv pip compile pyproject.toml --extra test $(LOCK_FLAGS) -c $(LOCK)/default.txt -o $(LOCK)/test.txt
+	$(BIN)/uv pip compile pyproject.toml --extra test $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/test.txt
 	$(BIN)/python -m netrepro.lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
 
 # Rewrite the results table of README.md from the claims, errata and figures of the last build.
