@@ -1,38 +1,78 @@
 # Two commands do everything: `make report` and `make test`.
-# Each creates .venv/ on first use (from the package registry only).
+# Each creates .venv/ on first use from the lock files in requirements/ (exact versions and
+# hashes, from the package registry only); `make lock` refreshes the lock files.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-STAMP := $(VENV)/.installed
+LOCK := requirements
+# default environment (make report) and test environment (make test, make lint: default + test extra)
+STAMP := $(VENV)/.installed-default
+STAMP_TEST := $(VENV)/.installed-test
 JOBS ?= 2
+# the lock tool (used by `make lock` only; installing from the lock needs pip alone)
+UV_VERSION ?= 0.13.9
+LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
+	--custom-compile-command 'make lock'
+# `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
+UPGRADE ?=
 
-.PHONY: report test lint bench verify clean-results
+.PHONY: report test lint lock bench verify clean clean-results readme
 
-$(STAMP): pyproject.toml
+$(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/bootstrap.txt
+	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/default.txt
+	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	$(BIN)/python -m ipykernel install --prefix $(VENV) --name python3 >/dev/null
 	touch $(STAMP)
 
+$(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
+	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/test.txt
+	touch $(STAMP_TEST)
+
+# Console: one line per finished job and the warnings (workflow/profiles/default); each job's
+# full command is in its log (logs/) and its provenance sidecar (*.meta.json).
 report: $(STAMP)
 	$(BIN)/snakemake --profile workflow/profiles/default -j$(JOBS) report
 	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html report
+	$(BIN)/python -m netrepro.reportgen relocate report/snakemake_report.html
 
-test: $(STAMP)
+test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
 
 # Check every result table against the checksum in its provenance sidecar.
 verify: $(STAMP)
 	$(BIN)/python -m netrepro verify
 
-lint: $(STAMP)
+lint: $(STAMP_TEST)
+	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/snakemake --lint
+
+# Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
+lock: $(STAMP)
+	$(BIN)/python -m pip install --quiet 'uv==$(UV_VERSION)'
+	$(BIN)/uv pip compile $(LOCK)/bootstrap.in $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/bootstrap.txt
+	$(BIN)/uv pip compile pyproject.toml $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/default.txt
+	$(BIN)/uv pip compile pyproject.toml --extra test $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/test.txt
+	$(BIN)/python -m netrepro.lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
+
+# Rewrite the results table of README.md from the claims, errata and figures of the last build.
+readme: $(STAMP)
+	$(BIN)/python -m netrepro.readme README.md
 
 # Benchmarks with ratios against simple references (issue 9); `make bench BENCH_ARGS=--quick` skips the pipeline.
 BENCH_ARGS ?=
 bench: $(STAMP)
 	$(BIN)/python -m netrepro.bench --out results/benchmarks.csv $(BENCH_ARGS)
 
-clean-results:
-	rm -rf results logs .snakemake/metadata
+# Everything the pipeline makes: tables, logs, figures (committed, but rebuilt), the report and
+# Snakemake's metadata (its conda/container caches stay). `make report` afterwards runs every job.
+CLEAN_PATHS = results logs report/*.html report/*.ipynb report/*.meta.json report/files \
+	report/ro-crate-metadata.json report/*.png figures/*/*.png figures/*/*.meta.json
+clean:
+	rm -rf $(CLEAN_PATHS)
+	test ! -d .snakemake || find .snakemake -mindepth 1 -maxdepth 1 ! -name conda ! -name singularity \
+		-exec rm -rf {} +
+
+# Kept for old habits: a rebuild needs the figures and the report gone too, so this is `make clean`.
+clean-results: clean

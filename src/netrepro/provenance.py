@@ -10,10 +10,14 @@ netrepro verify``).
 
 from __future__ import annotations
 
+import datetime as _dt
 import hashlib
 import json
+import logging
 import platform
+import shlex
 import subprocess
+import sys
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -26,6 +30,7 @@ __all__ = [
     "git_state",
     "package_versions",
     "find_seeds",
+    "job_command",
     "sidecar_path",
     "write_sidecar",
     "read_sidecar",
@@ -38,6 +43,9 @@ __all__ = [
 
 # Marker in the names of the temporary files of :func:`netrepro.io.atomic_path`.
 PARTIAL_MARK = ".part"
+
+_LOG = logging.getLogger("netrepro.provenance")
+_COMMAND_LOGGED = False
 
 TRACKED_PACKAGES = (
     "numpy", "scipy", "cvxpy", "clarabel", "numba", "matplotlib", "pandas", "snakemake", "papermill",
@@ -78,6 +86,27 @@ def package_versions(names=TRACKED_PACKAGES) -> dict:
     return versions
 
 
+def job_command() -> str:
+    """The command line of this process, as the shell would run it again (``sys.orig_argv``).
+
+    Snakemake's console shows one line per job; the full command of a step is kept here, in the
+    sidecar of each output and once in the job's log (see :func:`write_sidecar`).
+    """
+    argv = getattr(sys, "orig_argv", None) or [sys.executable, *sys.argv]
+    return shlex.join(_relative(arg) for arg in argv)
+
+
+def _relative(arg: str) -> str:
+    """A path under the working directory (the checkout) as a relative path: sidecars name no
+    absolute path of the machine (the interpreter is ``.venv/bin/python`` after ``make``)."""
+    if not arg.startswith("/"):
+        return arg
+    try:
+        return str(Path(arg).relative_to(Path.cwd()))
+    except ValueError:
+        return arg
+
+
 def find_seeds(params, prefix="") -> dict:
     """All entries of a nested parameter dict whose key contains 'seed'."""
     seeds = {}
@@ -112,7 +141,12 @@ class StepRecord:
 
 def write_sidecar(output: str | Path, record: StepRecord) -> Path:
     """Write the provenance sidecar of ``output`` (which must exist)."""
+    global _COMMAND_LOGGED
     output = Path(output)
+    command = job_command()
+    if not _COMMAND_LOGGED:  # once per job, into its log (the runner's stderr)
+        _LOG.info("command: %s", command)
+        _COMMAND_LOGGED = True
     meta = {
         "output": str(output),
         "output_sha256": sha256_file(output),
@@ -132,6 +166,8 @@ def write_sidecar(output: str | Path, record: StepRecord) -> Path:
         "packages": package_versions(),
         "machine": {"platform": platform.platform(), "processor": platform.machine()},
         "wall_time_s": round(record.wall_time_s, 3),
+        "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "command": command,
         **({"extra": record.extra} if record.extra else {}),
     }
     return write_json(meta, sidecar_path(output))

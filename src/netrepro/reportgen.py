@@ -29,6 +29,8 @@ import pandas as pd
 from .io import atomic_path
 from .papers import PAPERS
 from .provenance import git_state, package_versions, params_hash, sidecar_path
+from .crate import iso, write_crate
+from .references import references_html
 
 __all__ = ["make_notebook", "execute_notebook", "strip_external_scripts", "build_index", "provenance_chain",
            "scorecard", "rule_for", "workflow_producers", "config_keys", "main"]
@@ -135,21 +137,46 @@ def strip_external_scripts(text: str) -> str:
     return _INLINE_SCRIPT.sub(lambda m: "" if _REMOTE_IMPORT.search(m.group(1)) else m.group(0), text)
 
 
+_PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
+
+
+def relocate(text: str, root: str | Path) -> str:
+    """``text`` with no absolute path of the build machine: paths under ``root`` become relative
+    to it (``root`` itself ``.``), and interpreter paths (``/.../bin/python3``) their last part."""
+    root = str(Path(root).resolve())
+    text = text.replace(root + "/", "").replace(root, ".")
+    return _PYTHON_PATH.sub(r"\1", text)
+
+
+def relocate_json(obj, root: str | Path):
+    """:func:`relocate` applied to every string of a JSON value (sidecars copied into the report)."""
+    if isinstance(obj, str):
+        return relocate(obj, root)
+    if isinstance(obj, list):
+        return [relocate_json(v, root) for v in obj]
+    if isinstance(obj, dict):
+        return {k: relocate_json(v, root) for k, v in obj.items()}
+    return obj
+
+
 def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root: str | Path = ".") -> Path:
     """Run ``notebook`` with papermill (parameters ``slug``, ``root``) and export static HTML."""
     import nbformat
     import papermill
     from nbconvert import HTMLExporter
 
+    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
+    # path of the machine that built it (and any path a warning prints is made relative too).
+    print("command:", shlex.join(getattr(sys, "orig_argv", sys.argv)), flush=True)
     root = Path(root).resolve()
     html_out = Path(html_out)
     executed = html_out.with_suffix(".ipynb")
-    papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": str(root)},
+    papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
                                kernel_name="python3", cwd=str(root), progress_bar=False)
     exporter = HTMLExporter()
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
     with atomic_path(html_out) as tmp:
-        tmp.write_text(strip_external_scripts(body))
+        tmp.write_text(relocate(strip_external_scripts(body), root))
     os.chmod(html_out, 0o644)
     return html_out
 
@@ -346,6 +373,7 @@ class _Site:
         self.out_dir = out_dir
         self.sources: set[str] = set()
         self.tables: set[str] = set()
+        self.raw: dict[str, str] = {}  # copy target under files/ -> source file (workflow, config)
 
     def source_link(self, source_file: str, line=None) -> str:
         rel = _repo_relative(source_file)
@@ -371,8 +399,13 @@ class _Site:
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(self.root / rel, target)
             side = sidecar_path(self.root / rel)
-            if side.is_file():
-                shutil.copyfile(side, sidecar_path(target))
+            if side.is_file():  # relocated: no absolute path of the build machine in the report
+                meta = relocate_json(json.loads(side.read_text()), self.root)
+                sidecar_path(target).write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+        for rel, source in sorted(self.raw.items()):
+            target = self.out_dir / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(self.root / source, target)
         for rel in sorted(self.sources):
             target = self.out_dir / "source" / f"{rel}.html"
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -722,7 +755,7 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         f'<p class="sub">{len(papers)} papers recomputed from their equations by one Snakemake workflow. Every figure '
         "carries its provenance; every number the papers state is checked.</p></header>",
         f'<nav class="toc"><a href="#scorecard">Scorecard</a><a href="#identity">Run</a>{nav}'
-        + ('<a href="#benchmarks">Benchmarks</a>' if bench is not None else "") + "</nav>",
+        + ('<a href="#benchmarks">Benchmarks</a>' if bench is not None else "") + '<a href="#cite">Cite</a></nav>',
         '<h2 id="scorecard">Scorecard</h2>', _scorecard_html(score, papers, ctx),
         '<h3 id="identity">Run identity</h3>', _identity_html(identity, versions),
     ]
@@ -732,15 +765,61 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         parts.append(f'<section id="benchmarks"><h2>Benchmarks</h2><p class="sub">From <code>{_esc(bench_path)}</code> '
                      "(written by <code>make bench</code>; not a pipeline output, shown as found when the report was "
                      f"built).</p>{_table_html(bench, table_id='benchmarks-table')}</section>")
+    parts.append(references_html(papers))
     parts.append("<footer>Built by the <code>report</code> rule (<code>netrepro.reportgen:build_index</code>). "
                  "Figures are embedded; linked tables and source files are copies under <code>files/</code>, so the "
                  "report works offline. Snakemake's own report: <code>snakemake --report report/snakemake_report.html</code>."
                  "</footer></body></html>")
+    sidecars = _run_sidecars(papers)
+    if outputs.get("crate") and files_dir is not None:
+        site.tables.update(sidecars)  # the crate describes copies inside report/ (self-contained)
+        workflow_files = _workflow_sources(root)
+        configs = list(dict.fromkeys(["config/config.yaml", *ctx["configfiles"]]))
+        for rel in [*workflow_files, *configs]:
+            if (root / rel).is_file() and not Path(rel).is_absolute() and not rel.startswith(".."):
+                site.raw[f"workflow/{rel}"] = rel
     site.write()
     with atomic_path(outputs["html"]) as tmp:
         tmp.write_text("\n".join(parts))
     os.chmod(outputs["html"], 0o644)
+    if outputs.get("crate") and files_dir is not None:
+        crate_root = Path(outputs["crate"]).parent
+        prefix = files_dir.relative_to(crate_root).as_posix() if files_dir.is_relative_to(crate_root) else "files"
+        pages = [Path(outputs["html"]).name] + [Path(spec["notebook"]).name for spec in papers.values()
+                                                if spec.get("notebook") and Path(spec["notebook"]).is_file()]
+        write_crate(crate_root, sidecars={p: relocate_json(m, root) for p, m in sidecars.items()},
+                    rule_of=lambda meta: _rule_name(meta, ctx["producers"]),
+                    run={"end": iso(_dt.datetime.now(_dt.timezone.utc).timestamp()), "config_hash": params["config_hash"],
+                         "commit": commit, "dirty": git["dirty"]},
+                    workflow_files=[f"{prefix}/workflow/{rel}" for rel in workflow_files if f"workflow/{rel}" in site.raw],
+                    config_files=[f"{prefix}/workflow/{rel}" for rel in configs if f"workflow/{rel}" in site.raw],
+                    pages=pages, versions=versions, out=outputs["crate"])
     return {"provenance": {"scorecard": score.to_dict(orient="records")}}
+
+
+def _run_sidecars(papers: dict) -> dict[str, dict]:
+    """Every result table and figure of the run with its sidecar: the registered outputs of each
+    paper and everything upstream of them (path -> sidecar, in the order found)."""
+    seen: set[str] = set()
+    found: dict[str, dict] = {}
+    for spec in papers.values():
+        paths = [*spec.get("figures", []), *spec.get("tables", []),
+                 *(spec.get(k) for k in ("claims", "errata", "reconstructions"))]
+        for path in paths:
+            if not path:
+                continue
+            for meta in provenance_chain(path, seen):
+                out = str(meta.get("output", ""))
+                if out and Path(out).is_file():
+                    found.setdefault(out, meta)
+    return found
+
+
+def _workflow_sources(root: Path) -> list[str]:
+    """The Snakefiles of the workflow, the root entry point first (repository-relative)."""
+    files = ["Snakefile", "workflow/Snakefile", *sorted(p.relative_to(root).as_posix()
+                                                         for p in (root / "workflow" / "rules").glob("*.smk"))]
+    return [f for f in files if (root / f).is_file()]
 
 
 def config_hash(config: dict) -> str:
@@ -758,7 +837,18 @@ def main(argv=None) -> int:
     ex.add_argument("--slug", required=True)
     ex.add_argument("--notebook", required=True)
     ex.add_argument("--html", required=True)
+    rel = sub.add_parser("relocate", help="rewrite files so they name no path of this checkout "
+                                          "(e.g. Snakemake's own report, which shows the rules' commands)")
+    rel.add_argument("files", nargs="+")
     args = parser.parse_args(argv)
+    if args.command == "relocate":
+        for name in args.files:
+            path = Path(name)
+            text = path.read_text()
+            new = relocate(text, Path.cwd())
+            if new != text:
+                path.write_text(new)
+        return 0
     if args.command == "make-notebook":
         out = args.out or f"workflow/notebooks/{args.slug}.ipynb"
         print(make_notebook(args.slug, out))

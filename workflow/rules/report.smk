@@ -1,6 +1,7 @@
 # The combined report: report/index.html from every paper's claims, errata, figures and sidecars,
-# plus report/files/ (copies of the linked tables and browsable source files), so that report/
-# works offline as static files. `snakemake --report` uses the description below.
+# plus report/files/ (copies of every table and figure with their sidecars, the workflow and its
+# configuration, browsable source files), so that report/ works offline as static files, and
+# report/ro-crate-metadata.json, the Workflow Run Crate of the run (netrepro.crate). `snakemake --report` uses the description below.
 import os
 import platform
 
@@ -18,6 +19,7 @@ rule report:
     output:
         html="report/index.html",
         files=directory("report/files"),
+        crate="report/ro-crate-metadata.json",
     log:
         "logs/report.log",
     conda:

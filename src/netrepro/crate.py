@@ -1,0 +1,204 @@
+"""RO-Crate of a report build: ``report/ro-crate-metadata.json``, a Workflow Run Crate.
+
+The research-object standard for "this run produced these files from these inputs with this
+software" (https://w3id.org/ro/crate/1.1 with the Workflow Run Crate and Process Run Crate
+profiles 0.5, https://w3id.org/ro/wfrun/workflow/0.5). The crate's root is ``report/``, which
+holds copies of everything it describes (the report is self-contained, see ``reportgen``):
+
+* the workflow (``files/workflow/``: the Snakefiles and the configuration files), the crate's
+  ``mainEntity``, a ``ComputationalWorkflow`` in Snakemake with the package versions as
+  ``softwareRequirements`` and the commit as ``version``;
+* one ``CreateAction`` for the whole run (instrument: the workflow; start, end, configuration
+  hash and commit; result: every table, figure and page);
+* one ``CreateAction`` per job, from the provenance sidecars (instrument: its Snakemake rule;
+  object: the tables it read; result: what it wrote; start and end time);
+* every result table and figure (``files/data/``) with its SHA-256 and size.
+
+Written as JSON-LD directly (no library needed to write it); ``tests/test_release_crate.py``
+reads it back, checks it against the sidecars and, where the ``rocrate`` library is installed
+(the test environment), loads it with it.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import mimetypes
+import os
+from pathlib import Path
+
+from .io import atomic_path, sha256_file
+
+__all__ = ["PROFILES", "CONTEXT", "iso", "write_crate", "data_id", "action_id"]
+
+CONTEXT = ["https://w3id.org/ro/crate/1.1/context", "https://w3id.org/ro/terms/workflow-run/context"]
+PROFILES = {
+    "https://w3id.org/ro/wfrun/process/0.5": ("Process Run Crate", "0.5"),
+    "https://w3id.org/ro/wfrun/workflow/0.5": ("Workflow Run Crate", "0.5"),
+    "https://w3id.org/workflowhub/workflow-ro-crate/1.0": ("Workflow RO-Crate", "1.0"),
+}
+SNAKEMAKE_LANGUAGE = "https://w3id.org/workflowhub/workflow-ro-crate#snakemake"
+LICENSE = "https://spdx.org/licenses/BSD-3-Clause"
+
+
+def iso(timestamp: float) -> str:
+    """A POSIX time as ISO 8601 in UTC (``2026-11-23T04:15:17+00:00``)."""
+    return _dt.datetime.fromtimestamp(timestamp, _dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def data_id(path: str) -> str:
+    """The crate identifier of a pipeline file (its copy under ``files/data/``)."""
+    return f"files/data/{Path(path).as_posix()}"
+
+
+def action_id(rule: str, index: int) -> str:
+    return f"#job-{index:03d}-{rule}"
+
+
+def _ref(ids):
+    return [{"@id": i} for i in ids]
+
+
+def _file_entity(crate_root: Path, rel_id: str, name: str, **extra) -> dict:
+    path = crate_root / rel_id
+    kind = mimetypes.guess_type(path.name)[0] or ("application/json" if path.suffix == ".json" else
+                                                   "application/octet-stream")
+    entity = {"@id": rel_id, "@type": "File", "name": name, "encodingFormat": kind}
+    if path.is_file():
+        entity.update(contentSize=str(path.stat().st_size), sha256=sha256_file(path),
+                      dateModified=iso(path.stat().st_mtime))
+    entity.update(extra)
+    return entity
+
+
+def _job_key(meta: dict) -> str:
+    """Sidecars written by one job share its command (several outputs of one job, one action)."""
+    if meta.get("command"):
+        return str(meta["command"])
+    inputs = sorted(str(v.get("path")) for v in (meta.get("inputs") or {}).values())
+    return json.dumps([meta.get("rule"), meta.get("params_hash"), inputs])
+
+
+def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, run: dict,
+                workflow_files: list[str], config_files: list[str], pages: list[str],
+                versions: dict, out: str | Path | None = None) -> Path:
+    """Write ``ro-crate-metadata.json`` into ``crate_root`` (the report folder).
+
+    Parameters
+    ----------
+    sidecars : dict
+        Pipeline file (repository-relative path, copied to ``files/data/<path>``) -> its
+        provenance sidecar.
+    rule_of : callable
+        Sidecar -> name of the Snakemake rule that wrote it.
+    run : dict
+        ``start``, ``end`` (ISO 8601), ``config_hash``, ``commit``, ``dirty``, ``name``.
+    workflow_files, config_files : list of str
+        Crate-relative copies of the Snakefiles (the first is the main one) and configuration files.
+    pages : list of str
+        Crate-relative report pages (``index.html``, the notebooks).
+    versions : dict
+        Package -> version of the software that computed the results.
+    """
+    root = Path(crate_root)
+    graph: list[dict] = []
+    main = workflow_files[0]
+    packages = []
+    for name, version in versions.items():
+        if version is None:
+            continue
+        packages.append({"@id": f"#software-{name}", "@type": "SoftwareApplication", "name": name,
+                         "version": str(version)})
+
+    # one action per job, from the sidecars
+    jobs: dict[str, list[tuple[str, dict]]] = {}
+    for path, meta in sidecars.items():
+        jobs.setdefault(_job_key(meta), []).append((path, meta))
+    actions, rules, files = [], {}, {}
+    starts, ends = [], []
+    for index, (_, members) in enumerate(sorted(jobs.items(), key=lambda kv: sorted(p for p, _ in kv[1]))):
+        meta = members[0][1]
+        rule = rule_of(meta)
+        rules.setdefault(rule, {"@id": f"#rule-{rule}", "@type": "SoftwareApplication", "name": rule,
+                                "description": f"Snakemake rule {rule}: calls {meta.get('function', '?')}",
+                                "isPartOf": {"@id": main}})
+        results = [data_id(p) for p, _ in sorted(members)]
+        objects = sorted({data_id(item["path"]) for _, m in members for item in (m.get("inputs") or {}).values()
+                          if item.get("path") in sidecars})
+        action = {"@id": action_id(rule, index), "@type": "CreateAction", "name": f"rule {rule}",
+                  "instrument": {"@id": f"#rule-{rule}"}, "object": _ref(objects), "result": _ref(results),
+                  "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"}}
+        end = meta.get("finished")  # sidecars before "finished" was recorded: the file's time
+        first = Path(sorted(members)[0][0])
+        if not end and first.is_file():
+            end = iso(first.stat().st_mtime)
+        if end:
+            action["endTime"] = end
+            wall = float(meta.get("wall_time_s") or 0)
+            start = iso(_dt.datetime.fromisoformat(end).timestamp() - wall)
+            action["startTime"] = start
+            starts.append(start)
+            ends.append(end)
+        if meta.get("params_hash"):
+            action["description"] = f"{meta.get('function', '?')}, parameters hash {meta['params_hash']}"
+        actions.append(action)
+        for path, m in members:
+            files[path] = _file_entity(root, data_id(path), path, description=f"written by rule {rule}")
+    run_id = "#run"
+    run_action = {
+        "@id": run_id, "@type": "CreateAction", "name": run.get("name", "netrepro workflow run"),
+        "instrument": {"@id": main},
+        "startTime": min([run["start"], *starts]) if run.get("start") else (min(starts) if starts else run["end"]),
+        "endTime": run["end"],
+        "object": _ref([*config_files, "#config-hash", "#commit"]),
+        "result": _ref([*pages, *sorted(data_id(p) for p in sidecars)]),
+        "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"},
+    }
+    values = [
+        {"@id": "#config-hash", "@type": "PropertyValue", "name": "config_hash", "value": str(run.get("config_hash")),
+         "description": "SHA-256 (16 hex digits) of the run's configuration (netrepro.provenance.params_hash)"},
+        {"@id": "#commit", "@type": "PropertyValue", "name": "git_commit", "value": str(run.get("commit")),
+         "description": "git commit of the workflow" + (" (working tree dirty)" if run.get("dirty") else "")},
+    ]
+    workflow = {
+        **_file_entity(root, main, "netrepro: reproducing five papers on networked estimation and control",
+                       encodingFormat="text/x-snakemake"),
+        "@type": ["File", "SoftwareSourceCode", "ComputationalWorkflow"],
+        "programmingLanguage": {"@id": SNAKEMAKE_LANGUAGE},
+        "version": str(run.get("commit")), "license": {"@id": LICENSE},
+        "hasPart": _ref(workflow_files[1:]),
+        "softwareRequirements": _ref(p["@id"] for p in packages),
+    }
+    has_part = [*workflow_files, *config_files, *pages, *sorted(files)]
+    graph.append({"@id": "ro-crate-metadata.json", "@type": "CreativeWork", "about": {"@id": "./"},
+                  "conformsTo": _ref(["https://w3id.org/ro/crate/1.1",
+                                      "https://w3id.org/workflowhub/workflow-ro-crate/1.0"])})
+    graph.append({"@id": "./", "@type": "Dataset", "name": "Reproduction report: networked estimation and control",
+                  "description": "The report, its tables and figures, and how one run of the netrepro workflow made them.",
+                  "datePublished": run["end"], "license": {"@id": LICENSE},
+                  "conformsTo": _ref(PROFILES), "mainEntity": {"@id": main},
+                  "hasPart": _ref(data_id(p) if p in sidecars else p for p in has_part),
+                  "mentions": _ref([run_id, *(a["@id"] for a in actions)])})
+    graph.extend({"@id": url, "@type": "CreativeWork", "name": name, "version": version}
+                 for url, (name, version) in PROFILES.items())
+    graph.append({"@id": LICENSE, "@type": "CreativeWork", "name": "BSD 3-Clause License"})
+    graph.append({"@id": SNAKEMAKE_LANGUAGE, "@type": "ComputerLanguage", "name": "Snakemake",
+                  "identifier": {"@id": "https://doi.org/10.12688/f1000research.29032.2"},
+                  "url": {"@id": "https://snakemake.readthedocs.io"},
+                  **({"version": versions["snakemake"]} if versions.get("snakemake") else {})})
+    graph.append(workflow)
+    graph.extend(_file_entity(root, f, Path(f).name, encodingFormat="text/x-snakemake" if not f.endswith(".yaml")
+                              else "application/yaml") for f in workflow_files[1:])
+    graph.extend(_file_entity(root, f, Path(f).name, description="configuration file of the run") for f in config_files)
+    graph.extend(_file_entity(root, p, Path(p).name, description="report page") for p in pages)
+    graph.extend(files[p] for p in sorted(files))
+    graph.append(run_action)
+    graph.extend(values)
+    graph.extend(actions)
+    graph.extend(rules[r] for r in sorted(rules))
+    graph.extend(packages)
+    out = Path(out) if out else root / "ro-crate-metadata.json"
+    with atomic_path(out) as tmp:
+        tmp.write_text(json.dumps({"@context": CONTEXT, "@graph": graph}, indent=1) + "\n")
+    os.chmod(out, 0o644)
+    return out

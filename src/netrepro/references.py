@@ -1,0 +1,129 @@
+"""The original papers, for citing: the report's "Cite the originals" section and CITATION.cff.
+
+The data are in ``references.yaml`` beside this module (titles and authors from the source
+texts). :func:`citation_cff` builds the whole ``CITATION.cff`` (this software, with the papers
+as ``references``); ``python -m netrepro.references CITATION.cff`` rewrites it, and
+``tests/test_release_files.py`` checks that the committed file is this output and that it
+validates against the Citation File Format 1.2.0 schema.
+"""
+
+from __future__ import annotations
+
+import argparse
+import html
+import sys
+from functools import lru_cache
+from pathlib import Path
+
+import yaml
+
+__all__ = ["load_references", "format_reference", "references_html", "cff_reference", "citation_cff",
+           "SOFTWARE", "main"]
+
+REFERENCES_FILE = Path(__file__).with_name("references.yaml")
+
+# This software as CITATION.cff describes it (title, licence, version: keep in step with pyproject.toml).
+SOFTWARE = {
+    "title": "netrepro: reproducing five papers on networked estimation and control",
+    "version": "0.1.0",
+    "license": "BSD-3-Clause",
+    "authors": [{"name": "The netrepro maintainers"}],
+    "abstract": ("One Snakemake workflow recomputes every figure and every stated number of five papers on "
+                 "Kalman filtering over lossy networks, gain-scheduled filtering, 1-bit Bayesian bounds and "
+                 "decentralized H-infinity filtering, checks each number the papers state, and lists every "
+                 "equation they print wrong."),
+    "keywords": ["reproducibility", "Kalman filtering", "networked control", "Snakemake", "RO-Crate"],
+}
+
+
+@lru_cache(maxsize=None)
+def _load(path: str) -> dict:
+    return yaml.safe_load(Path(path).read_text())
+
+
+def load_references(path: str | Path = REFERENCES_FILE) -> dict:
+    """Slug -> reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``underlying``)."""
+    return _load(str(path))
+
+
+def _author(person: dict) -> str:
+    given = " ".join(f"{part[0]}." for part in str(person.get("given-names", "")).replace(".", " ").split())
+    return f"{person['family-names']}, {given}".rstrip(", ") if given else str(person.get("family-names", person))
+
+
+def format_reference(ref: dict) -> str:
+    """One reference as plain text: ``Wei, G., Wang, Z. (2011). Title. Venue.``"""
+    authors = "; ".join(_author(a) for a in ref.get("authors", []))
+    year = f" ({ref['year']})" if ref.get("year") else ""
+    venue = f" {ref['venue']}." if ref.get("venue") else ""
+    return f"{authors}{year}. {ref['title']}.{venue}"
+
+
+def references_html(slugs) -> str:
+    """The report's "Cite the originals" section for the papers ``slugs``."""
+    refs = load_references()
+    items = []
+    for slug in slugs:
+        ref = refs.get(slug)
+        if not ref:
+            continue
+        note = "" if ref.get("venue_checked", True) or not ref.get("venue") else \
+            ' <small class="sha">(venue not in the source text: check before citing)</small>'
+        under = "".join(f"<li>{html.escape(format_reference(u))}</li>" for u in ref.get("underlying", []))
+        items.append(f'<li id="cite-{html.escape(slug)}"><code>{html.escape(slug)}</code> '
+                     f"{html.escape(format_reference(ref))}{note}"
+                     + (f"<br><small>which reproduces</small><ul>{under}</ul>" if under else "") + "</li>")
+    return ('<section id="cite"><h2>Cite the originals</h2><p class="sub">The results above are ours; the '
+            "questions, models and stated numbers are the authors'. Cite the original papers, and this "
+            "workflow (<code>CITATION.cff</code>) for the reproduction.</p>"
+            f"<ol class=\"refs\">{''.join(items)}</ol></section>")
+
+
+def cff_reference(ref: dict) -> dict:
+    """A reference in the Citation File Format (``references`` entry)."""
+    out = {"type": ref["type"], "title": ref["title"], "authors": [dict(a) for a in ref["authors"]]}
+    if ref.get("year"):
+        out["year"] = int(ref["year"])
+    venue = ref.get("venue")
+    if venue and ref["type"] == "article":
+        out["journal"] = venue
+    elif venue and ref["type"] == "conference-paper":
+        out["conference"] = {"name": venue}
+    elif venue:
+        out["notes"] = venue
+    if ref.get("affiliation"):
+        out["notes"] = (out.get("notes", "") + " " if out.get("notes") else "") + f"Authors' affiliation: {ref['affiliation']}"
+    return out
+
+
+def citation_cff() -> dict:
+    """The content of ``CITATION.cff``: this software, with the reproduced papers as references."""
+    refs = load_references()
+    references = []
+    for ref in refs.values():
+        references.append(cff_reference(ref))
+        references.extend(cff_reference(u) for u in ref.get("underlying", []))
+    return {
+        "cff-version": "1.2.0",
+        "message": ("If you use this reproduction, please cite it as below, and cite the original papers "
+                    "listed under references."),
+        "type": "software",
+        **SOFTWARE,
+        "references": references,
+    }
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m netrepro.references",
+                                     description="write CITATION.cff from references.yaml")
+    parser.add_argument("out", nargs="?", default="CITATION.cff")
+    args = parser.parse_args(argv)
+    text = ("# Written by `python -m netrepro.references` from src/netrepro/references.yaml: edit that, not this.\n"
+            + yaml.safe_dump(citation_cff(), sort_keys=False, allow_unicode=True, width=100))
+    Path(args.out).write_text(text)
+    print(args.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
