@@ -92,11 +92,15 @@ def _snakemake(workdir, configfile, *options, targets=TABLES):
 
 
 def _local_rules(workdir: Path) -> set[str]:
-    """Rules declared in `localrules:` blocks: they run in the main process, not as Slurm jobs."""
+    """Rules marked `localrule: True` (or listed in `localrules:`): they run in the main process, not on Slurm."""
     names = set()
     for smk in sorted((Path(workdir) / "workflow" / "rules").glob("*.smk")):
-        for block in re.findall(r"^localrules:\n((?:[ \t]+\w+,?[ \t]*\n?)+)", smk.read_text(), re.MULTILINE):
+        text = smk.read_text()
+        for block in re.findall(r"^localrules:\n((?:[ \t]+\w+,?[ \t]*\n?)+)", text, re.MULTILINE):
             names.update(re.findall(r"\w+", block))
+        for name, body in re.findall(r"^rule (\w+):\n(.*?)(?=^\S|\Z)", text, re.MULTILINE | re.DOTALL):
+            if re.search(r"^\s+localrule:\s*True", body, re.MULTILINE):
+                names.add(name)
     return names
 
 
