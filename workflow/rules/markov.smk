@@ -156,7 +156,9 @@ rule markov_reconstructions:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(pick(MCFG, "examples", "paths", "checks", "exact", "map", "curves")),
+        cfg=as_json(
+            pick(MCFG, "examples", "paths", "checks", "exact", "map", "curves", "expectations")
+        ),
         io=io_json,
     shell:
         step("netrepro.papers.markov.claims:reconstructions_step")
