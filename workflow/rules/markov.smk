@@ -108,6 +108,26 @@ rule markov_sample_paths:
         step("netrepro.papers.markov.steps:sample_paths_step")
 
 
+rule markov_expectations:
+    input:
+        code=code("netrepro.papers.markov.steps:expectations_step"),
+        moments=rules.markov_exact_moments.output.table,
+    output:
+        table="results/markov/expectations.csv",
+    log:
+        "logs/markov/expectations.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+    params:
+        cfg=as_json(pick(MCFG, "examples", "paths", "expectations")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.markov.steps:expectations_step")
+
+
 rule markov_errata:
     input:
         code=code("netrepro.papers.markov.claims:errata_step"),
@@ -136,7 +156,9 @@ rule markov_reconstructions:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(pick(MCFG, "examples", "paths", "checks", "exact", "map", "curves")),
+        cfg=as_json(
+            pick(MCFG, "examples", "paths", "checks", "exact", "map", "curves", "expectations")
+        ),
         io=io_json,
     shell:
         step("netrepro.papers.markov.claims:reconstructions_step")
@@ -175,4 +197,5 @@ if enabled("markov"):
         rules.markov_stability_map.output.sensitivity,
         rules.markov_sample_paths.output.table,
         rules.markov_sample_paths.output.check,
+        rules.markov_expectations.output.table,
     ]

@@ -12,7 +12,7 @@ __all__ = ["tiny_config", "run_all", "NAMES"]
 
 ROOT = Path(__file__).resolve().parents[3]
 NAMES = ("curves", "bench", "checks", "iid", "moments", "map", "sensitivity", "paths", "check", "claims", "errata",
-         "recon")
+         "recon", "expectations")
 
 
 def tiny_config() -> dict:
@@ -44,6 +44,7 @@ def run_all(cfg: dict, tmp: Path) -> dict:
     _run(steps.exact_moments_step, cfg, {}, {"table": t["moments"]})
     _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"], "sensitivity": t["sensitivity"]})
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
+    _run(steps.expectations_step, cfg, {"moments": t["moments"]}, {"table": t["expectations"]})
     _run(claims.claims_step, cfg, {"checks": t["checks"], "curves": t["curves"], "iid": t["iid"], "map": t["map"],
                                    "moments": t["moments"]}, {"table": t["claims"]})
     _run(claims.errata_step, cfg, {"checks": t["checks"]}, {"table": t["errata"]})

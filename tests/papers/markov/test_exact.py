@@ -7,6 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
+from netrepro.errors import InputError
 from netrepro.papers.markov import exact, model
 from .systems import EX1, EX2
 
@@ -39,3 +40,32 @@ def test_exact_moments_against_enumeration(system):
     grid = em.mean(np.array([0.3, 0.95]), np.array([0.6, 0.2]))
     assert grid.shape == (2, 9)
 
+
+
+@pytest.mark.parametrize("Sigma0", [np.eye(3), np.diag([2.0, 2.0, 0.5])])
+def test_block_split_against_full_recursion(Sigma0):
+    """Example II on its decoupled blocks (2-D + scalar) equals the full 3-D tree recursion."""
+    split = exact.example2_split()
+    full = exact.exact_moments(EX2, Sigma0, 12)
+    blk = exact.exact_moments_split(EX2, Sigma0, 12, split)
+    assert exact.find_split(EX2, Sigma0) is not None
+    for p, q in ((0.45, 0.5), (0.99, 0.5), (0.2, 0.9)):
+        for which in ("norm", "trace"):
+            assert np.allclose(blk.mean(p, q, which), full.mean(p, q, which), rtol=1e-12)
+    # and against brute-force enumeration of the paths
+    assert blk.mean(0.45, 0.5)[8] == pytest.approx(_brute_force_mean(EX2, Sigma0, 0.45, 0.5, 9), rel=1e-10)
+
+
+def test_block_split_rejected_when_coupled():
+    Qc = np.eye(3)
+    Qc[0, 2] = Qc[2, 0] = 0.3  # couples w = (e1 - e2)/sqrt 2 with e3
+    coupled = model.LinearSystem(EX2.A, EX2.C, Qc, EX2.R)
+    # a uniform correlation keeps the split (u, e3 | w)
+    uniform = model.LinearSystem(EX2.A, EX2.C, np.eye(3) + 0.3 * (np.ones((3, 3)) - np.eye(3)), EX2.R)
+    assert exact.find_split(uniform, np.eye(3)) is not None
+    assert exact.find_split(coupled, np.eye(3)) is None
+    assert exact.find_split(EX2, np.array([[1.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 1.0]])) is not None
+    assert exact.find_split(EX2, np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.0], [0.5, 0.0, 1.0]])) is None
+    assert exact.find_split(EX1, np.eye(2)) is None
+    with pytest.raises(InputError):
+        exact.example2_split().blocks(coupled, np.eye(3))

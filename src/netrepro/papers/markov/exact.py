@@ -8,9 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...errors import InputError
 from .model import LinearSystem, riccati_g, riccati_h, sym_norm
 
-__all__ = ["ExactMoments", "exact_moments"]
+__all__ = ["ExactMoments", "exact_moments", "BlockSplit", "example2_split", "exact_moments_split", "find_split", "exact_moments_auto"]
 
 
 @dataclass
@@ -121,3 +122,186 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
     return ExactMoments(coef, float(sym_norm(P1[None])[0]), float(np.trace(P1)))
 
 
+
+
+# ----------------------------------------------------------------------------- block split
+@dataclass
+class BlockSplit:
+    """An orthogonal change of state basis ``T`` and of output basis ``U`` that splits the system into
+    decoupled blocks: ``T A T'``, ``T Q T'``, ``T Sigma0 T'`` block-diagonal over ``state_blocks`` and
+    ``U C T'`` block-diagonal over ``(output_blocks, state_blocks)``, ``U R U'`` over ``output_blocks``.
+
+    Then every ``P_k`` (eqs. 4-5) is block-diagonal in the new basis along every channel path (both
+    maps preserve the block structure), ``||P_k|| = max_b ||P_k^b||`` and ``tr P_k = sum_b tr P_k^b``
+    (``T`` orthogonal preserves both).
+
+    Parameters
+    ----------
+    T : ndarray
+        ``(n, n)`` orthogonal, rows are the new state coordinates.
+    U : ndarray
+        ``(m, m)`` orthogonal, rows are the new output coordinates.
+    state_blocks, output_blocks : list of list of int
+        Index sets of the blocks (same length; an output block may be empty).
+    """
+
+    T: np.ndarray
+    U: np.ndarray
+    state_blocks: list
+    output_blocks: list
+
+    def blocks(self, system: LinearSystem, Sigma0, tol: float = 1e-12):
+        """The block systems, after checking that the split is exact.
+
+        Parameters
+        ----------
+        system : LinearSystem
+            The system (eqs. 1-2).
+        Sigma0 : array_like
+            ``P_1``.
+        tol : float
+            Largest admissible off-block entry (relative to the largest entry).
+
+        Returns
+        -------
+        list of (A_b, C_b, Q_b, R_b, Sigma0_b)
+
+        Raises
+        ------
+        InputError
+            If ``T`` or ``U`` is not orthogonal or a matrix has an off-block entry.
+        """
+        T, U = np.asarray(self.T, float), np.asarray(self.U, float)
+        for name, M in (("T", T), ("U", U)):
+            if not np.allclose(M @ M.T, np.eye(len(M)), atol=tol):
+                raise InputError(f"BlockSplit.{name} must be orthogonal")
+        At, Qt, St = T @ system.A @ T.T, T @ system.Q @ T.T, T @ np.asarray(Sigma0, float) @ T.T
+        Ct, Rt = U @ system.C @ T.T, U @ system.R @ U.T
+        sb, ob = self.state_blocks, self.output_blocks
+        smask = np.zeros(At.shape, bool)
+        cmask = np.zeros(Ct.shape, bool)
+        rmask = np.zeros(Rt.shape, bool)
+        for s, o in zip(sb, ob):
+            smask[np.ix_(s, s)] = True
+            cmask[np.ix_(o, s)] = True
+            rmask[np.ix_(o, o)] = True
+        for name, M, mask in (("A", At, smask), ("Q", Qt, smask), ("Sigma0", St, smask), ("C", Ct, cmask),
+                              ("R", Rt, rmask)):
+            if np.any(np.abs(M[~mask]) > tol * max(np.abs(M).max(), 1.0)):
+                raise InputError(f"BlockSplit does not split {name}: off-block entries")
+        return [(At[np.ix_(s, s)], Ct[np.ix_(o, s)], Qt[np.ix_(s, s)], Rt[np.ix_(o, o)], St[np.ix_(s, s)])
+                for s, o in zip(sb, ob)]
+
+
+def example2_split() -> BlockSplit:
+    """The split of Example II (eq. 13): ``A = 1.2 diag(1, 1, -1)``, ``C = [[1, 0, 1], [0, 1, 1]]``.
+
+    In the state basis ``u = (e_1 + e_2)/sqrt 2``, ``w = (e_1 - e_2)/sqrt 2``, ``e_3`` (``u, w`` span
+    the ``+1.2`` eigenspace) and the output basis ``(y_1 + y_2)/sqrt 2``, ``(y_1 - y_2)/sqrt 2``:
+    ``C -> [[1, 0, sqrt 2], [0, 1, 0]]``, ``A -> diag(1.2, 1.2, -1.2)``, and ``Q = R = Sigma0 = I`` stay
+    identities. So the dynamics split into a 2-D chain ``(u, e_3)`` with one output (the parity lock
+    ``v = sqrt 2 u - e_3``, ``C v = 0``, lives there) and a scalar chain ``w`` with one output.
+
+    Returns
+    -------
+    BlockSplit
+    """
+    s = 1.0 / np.sqrt(2.0)
+    T = np.array([[s, s, 0.0], [s, -s, 0.0], [0.0, 0.0, 1.0]])
+    U = np.array([[s, s], [s, -s]])
+    return BlockSplit(T, U, [[0, 2], [1]], [[0], [1]])
+
+
+def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSplit) -> ExactMoments:
+    """:func:`exact_moments` on the decoupled blocks of ``split``: the same tree of channel paths, each
+    block's covariance propagated by its own (smaller) Riccati maps (eqs. 4-5), and per path
+    ``||P|| = max_b ||P^b||``, ``tr P = sum_b tr P^b``.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        The system (eqs. 1-2).
+    Sigma0 : array_like
+        ``P_1``.
+    depth : int
+        Number of tree levels.
+    split : BlockSplit
+        A split checked by :meth:`BlockSplit.blocks`.
+
+    Returns
+    -------
+    ExactMoments
+        Identical (to rounding) to ``exact_moments(system, Sigma0, depth)``.
+    """
+    blocks = split.blocks(system, Sigma0)
+    Ps = [riccati_g(S[None], A, C, Q, R) for A, C, Q, R, S in blocks]
+    state = np.ones(1, dtype=bool)
+    counts = np.zeros((1, 4), dtype=np.int16)
+    coef = []
+    for d in range(1, depth + 1):
+        if d > 1:
+            n_par = len(state)
+            with np.errstate(over="ignore", invalid="ignore"):
+                Ps = [np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
+                      for P, (A, C, Q, R, _) in zip(Ps, blocks)]
+            new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
+            old = np.concatenate([state, state])
+            counts = np.concatenate([counts, counts])
+            idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
+            counts[np.arange(len(idx)), idx] += 1
+            state = new_state
+        key = ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
+        uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
+        norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)
+        tr = sum(np.trace(P, axis1=-2, axis2=-1) for P in Ps)
+        s_norm = np.bincount(inv, weights=norm, minlength=len(uniq))
+        s_tr = np.bincount(inv, weights=tr, minlength=len(uniq))
+        coef.append(np.column_stack([counts[first].astype(float), s_norm, s_tr]))
+    S0 = np.asarray(Sigma0, float)
+    return ExactMoments(coef, float(sym_norm(S0[None])[0]), float(np.trace(S0)))
+
+
+def find_split(system: LinearSystem, Sigma0):
+    """The known block split (:func:`example2_split`) if it splits this system exactly, else ``None``.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        The system (eqs. 1-2).
+    Sigma0 : array_like
+        ``P_1``.
+
+    Returns
+    -------
+    BlockSplit or None
+    """
+    if system.A.shape != (3, 3) or system.C.shape != (2, 3):
+        return None
+    split = example2_split()
+    try:
+        split.blocks(system, Sigma0)
+    except InputError:
+        return None
+    return split
+
+
+def exact_moments_auto(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
+    """:func:`exact_moments_split` where :func:`find_split` finds a split, else :func:`exact_moments`.
+
+    Parameters
+    ----------
+    system : LinearSystem
+        The system (eqs. 1-2).
+    Sigma0 : array_like
+        ``P_1``.
+    depth : int
+        Number of tree levels.
+
+    Returns
+    -------
+    ExactMoments
+    """
+    split = find_split(system, Sigma0)
+    if split is None:
+        return exact_moments(system, Sigma0, depth)
+    return exact_moments_split(system, Sigma0, depth, split)

@@ -48,21 +48,60 @@ def figure_plane(params, inputs, outputs):
     return {}
 
 
+_METHOD_STYLE = {
+    "exact": dict(color="tab:orange", lw=2.5, ls="-", label="E||P_k|| exact (all channel paths)"),
+    "estimate_conditional": dict(color="tab:red", lw=1.5, ls="-",
+                                 label="E||P_k|| conditional estimator (validated, 95% CI)"),
+    "asymptote": dict(color="tab:purple", lw=1.5, ls="--", label="E||P_k|| asymptote (derived rate, bracket)"),
+}
+
+
+def _draw_expectations(ax, x):
+    """The trustworthy E||P_k|| of expectations.csv, one style per method; gaps where not trustworthy."""
+    for method, style in _METHOD_STYLE.items():
+        sub = x[x.method == method]
+        if sub.empty:
+            continue
+        ax.plot(sub.k, sub.mean_norm, **style)
+        if method != "exact":
+            ax.fill_between(sub.k, sub.lo, sub.hi, color=style["color"], alpha=0.2, lw=0)
+    bad = x[x.method == "not_trustworthy"]
+    if len(bad):
+        ax.axvspan(bad.k.min(), bad.k.max(), color="0.85", alpha=0.5, label="E||P_k|| not trustworthy (omitted)")
+
+
+def _failed_estimates(ax, t, x, plain=False):
+    """The conditional (and plain) estimates where they are not the trusted method, labelled as failing."""
+    trusted = set(x.k[x.method == "estimate_conditional"]) | set(x.k[x.method == "exact"])
+    rb = t[t.rb_mean.notna()]
+    if not set(x.method) & {"estimate_conditional"}:
+        ax.plot(rb.k, rb.rb_mean, color="tab:red", lw=0.9, ls=":",
+                label="conditional estimator: misses the parity heavy tail (not used)")
+    else:
+        rb = rb[~rb.k.isin(trusted)]
+        if len(rb):
+            ax.plot(rb.k, rb.rb_mean, color="tab:red", lw=0.9, ls=":", label="conditional estimator (not validated)")
+    if plain:
+        ax.plot(t.k, t.plain_mean, color="tab:blue", lw=0.9, ls="--",
+                label="plain sample mean: misses the heavy tail (not used)")
+
+
 def figure_path(params, inputs, outputs):
-    """Figs. 3-5: a sample path of ||P_k|| and gamma_k, with Monte Carlo bands and trustworthy means."""
+    """Figs. 3-5: a sample path of ||P_k|| and gamma_k, Monte Carlo bands, and the trustworthy E||P_k||."""
     t = pd.read_csv(inputs["paths"])
     t = t[t.figure == params["figure"]]
+    x = _setting(inputs, t)
     fig, (ax, ax2) = new_figure(2, 1, figsize=(6.4, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
     ax.fill_between(t.k, t.q05, t.q95, color="tab:blue", alpha=0.15, label="5-95% of ||P_k|| (Monte Carlo)")
     ax.plot(t.k, t.q50, color="tab:blue", lw=1, ls="--", label="median")
     ax.plot(t.k, t.norm_path, color="k", lw=1.2, label="one sample path ||P_k||")
-    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.5, label="E||P_k|| (conditional estimator)")
-    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, ls=":", label="E||P_k|| (exact, all paths)")
+    _draw_expectations(ax, x)
+    _failed_estimates(ax, t, x)
     ax.set_yscale("log")
     ax.set_ylabel("||P_k||")
     p, q = t.p.iloc[0], t.q.iloc[0]
     ax.set_title(f"Example {t.example.iloc[0]}, p = {p}, q = {q}")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=6.5)
     g = t.dropna(subset=["gamma"])
     ax2.step(g.k, g.gamma, where="post", color="k", lw=0.8)
     ax2.set_ylim(-0.2, 1.2)
@@ -73,14 +112,21 @@ def figure_path(params, inputs, outputs):
     return {}
 
 
+def _setting(inputs, t):
+    """Rows of expectations.csv for the setting of the sample-path rows ``t``."""
+    x = pd.read_csv(inputs["expectations"])
+    ex, p, q = str(t.example.iloc[0]), t.p.iloc[0], t.q.iloc[0]
+    return x[(x.example.astype(str) == ex) & np.isclose(x.p, p) & np.isclose(x.q, q)].sort_values("k")
+
+
 def figure_mean(params, inputs, outputs):
-    """Fig. 6: divergence of E||P_k|| at (0.99, 0.5) on Example II (exact, conditional, plain)."""
+    """Fig. 6: divergence of E||P_k|| at (0.99, 0.5) on Example II (trustworthy values; failing estimates)."""
     t = pd.read_csv(inputs["paths"])
     t = t[t.figure == params["figure"]]
+    x = _setting(inputs, t)
     fig, ax = new_figure()
-    ax.plot(t.k, t.exact_mean, color="tab:orange", lw=2.5, label="E||P_k|| exact (all channel paths)")
-    ax.plot(t.k, t.rb_mean, color="tab:red", lw=1.2, label="conditional estimator (trailing loss run integrated)")
-    ax.plot(t.k, t.plain_mean, color="tab:blue", lw=1, ls="--", label="plain sample mean")
+    _draw_expectations(ax, x)
+    _failed_estimates(ax, t, x, plain=True)
     ax.plot(t.k, t.q50, color="0.5", lw=1, ls=":", label="median ||P_k||")
     ax.set_yscale("log")
     ax.set_xlabel("k")
@@ -92,20 +138,31 @@ def figure_mean(params, inputs, outputs):
 
 
 def figure_estimators(params, inputs, outputs):
-    """Fig. S1: plain sample mean vs conditional estimator vs exact expectation."""
-    e = pd.read_csv(inputs["check"])
-    labels = [f"Ex {r.example}\n({r.p:g}, {r.q:g})" for r in e.itertuples()]
-    x = np.arange(len(e))
-    fig, ax = new_figure(figsize=(7.0, 4.0))
-    ax.bar(x - 0.27, e.plain_over_exact, 0.27, label="plain / exact  (k = depth+1)", color="tab:blue")
-    ax.bar(x, e.rb_over_exact, 0.27, label="conditional / exact  (k = depth+1)", color="tab:red")
-    ax.bar(x + 0.27, e.plain_over_rb_long, 0.27, label="plain / conditional  (long horizon)", color="0.5")
-    ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_yscale("log")
-    ax.set_xticks(x)
-    ax.set_xticklabels(labels, fontsize=7)
-    ax.set_ylabel("ratio of estimates of E||P_k||")
-    ax.legend(fontsize=7)
+    """Fig. S1: plain sample mean and conditional estimator against the trustworthy E||P_k|| over the horizon."""
+    t = pd.read_csv(inputs["paths"])
+    figs = list(dict.fromkeys(t.figure))
+    fig, axes = new_figure(1, len(figs), figsize=(3.0 * len(figs), 3.6), squeeze=False, sharey=True)
+    for ax, name in zip(axes[0], figs):
+        tf = t[t.figure == name]
+        x = _setting(inputs, tf).set_index("k")
+        ref = x.mean_norm.reindex(tf.k).to_numpy()
+        ok = x.method.reindex(tf.k).fillna("not_trustworthy").to_numpy()
+        lo = (x.lo.reindex(tf.k) / x.mean_norm.reindex(tf.k)).to_numpy()
+        hi = (x.hi.reindex(tf.k) / x.mean_norm.reindex(tf.k)).to_numpy()
+        ax.fill_between(tf.k, lo, hi, color="tab:purple", alpha=0.2, lw=0, label="trusted value: interval / bracket")
+        ax.plot(tf.k, tf.plain_mean.to_numpy() / ref, color="tab:blue", lw=1, label="plain sample mean / trusted")
+        ax.plot(tf.k, tf.rb_mean.to_numpy() / ref, color="tab:red", lw=1, label="conditional estimator / trusted")
+        for method, style in _METHOD_STYLE.items():
+            sel = ok == method
+            if sel.any():
+                ax.plot(tf.k[sel], np.ones(sel.sum()), color=style["color"], lw=3, alpha=0.6,
+                        label=f"trusted by: {method}")
+        ax.axhline(1.0, color="k", lw=0.5)
+        ax.set_yscale("log")
+        ax.set_xlabel("k")
+        ax.set_title(f"Ex {tf.example.iloc[0]} ({tf.p.iloc[0]:g}, {tf.q.iloc[0]:g})", fontsize=8)
+    axes[0][0].set_ylabel("estimate / trustworthy E||P_k||")
+    axes[0][-1].legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     save_figure(fig, outputs["figure"])
     return {}
 
