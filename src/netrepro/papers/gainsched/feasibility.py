@@ -20,6 +20,8 @@ Every decision goes through the shared solve-and-certify engine
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .model import System, sector_cases
@@ -49,7 +51,7 @@ def with_sigma2(sys: System, sigma2: float) -> System:
     -------
     System
     """
-    return System(sys.A, sys.B, sys.C, sys.D, sys.Z, sys.F1, sys.F2, float(sigma2), sys.p1, sys.p2)
+    return dataclasses.replace(sys, sigma2=float(sigma2))
 
 
 def plant_vertex_radius(sys: System, sigma2: float) -> float:

@@ -14,6 +14,27 @@ from .model import LinearSystem, riccati_g, riccati_h, sym_norm
 __all__ = ["ExactMoments", "exact_moments", "BlockSplit", "example2_split", "exact_moments_split", "find_split", "exact_moments_auto"]
 
 
+def _branch_channel(state, counts):
+    """Every path splits into a reception (first half) and a loss (second half).
+
+    ``state`` is the last channel state of each path (True = received); ``counts[:, i]``
+    counts its transitions 11 -> 0, 10 -> 1, 01 -> 2, 00 -> 3, which fix the path's probability.
+    """
+    n_par = len(state)
+    new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
+    old = np.concatenate([state, state])
+    counts = np.concatenate([counts, counts])
+    idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
+    counts[np.arange(len(idx)), idx] += 1
+    return new_state, counts
+
+
+def _transition_key(counts, d):
+    """One integer per path from its four transition counts (each at most ``d``): equal keys, equal probability."""
+    return ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
+
+
+
 @dataclass
 class ExactMoments:
     """``E||P_k||`` and ``E tr P_k`` for ``k = 1..depth+1`` as polynomials in the transition probabilities.
@@ -102,19 +123,12 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
     coef = []
     for d in range(1, depth + 1):
         if d > 1:
-            n_par = len(P)
             with np.errstate(over="ignore", invalid="ignore"):
                 P_recv = riccati_g(P, A, C, Q, R)
                 P_loss = riccati_h(P, A, Q)
             P = np.concatenate([P_recv, P_loss])
-            new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
-            old = np.concatenate([state, state])
-            counts = np.concatenate([counts, counts])
-            # transition index: 11 -> 0, 10 -> 1, 01 -> 2, 00 -> 3
-            idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
-            counts[np.arange(len(idx)), idx] += 1
-            state = new_state
-        key = ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
+            state, counts = _branch_channel(state, counts)
+        key = _transition_key(counts, d)
         uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
         s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(uniq))
         s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(uniq))
@@ -240,17 +254,11 @@ def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSp
     coef = []
     for d in range(1, depth + 1):
         if d > 1:
-            n_par = len(state)
             with np.errstate(over="ignore", invalid="ignore"):
                 Ps = [np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
                       for P, (A, C, Q, R, _) in zip(Ps, blocks)]
-            new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
-            old = np.concatenate([state, state])
-            counts = np.concatenate([counts, counts])
-            idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
-            counts[np.arange(len(idx)), idx] += 1
-            state = new_state
-        key = ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
+            state, counts = _branch_channel(state, counts)
+        key = _transition_key(counts, d)
         uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
         norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)
         tr = sum(np.trace(P, axis1=-2, axis2=-1) for P in Ps)
