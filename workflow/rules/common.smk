@@ -13,7 +13,7 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.reportgen import rule_for, workflow_producers
-    from netrepro.verdicts import load_claims
+    from netrepro.verdicts import DATA_FILES, load_paper_data, paper_dir, referenced_tables
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "
@@ -27,9 +27,8 @@ try:
     validate_config(config, schema_dir=Path(workflow.current_basedir).parent / "schemas")
     # the claims data files of the papers (issue 15), validated before any job starts
     for _slug in config["papers"]:
-        _claims_file = Path("src/netrepro/papers") / _slug / "claims.yaml"
-        if _claims_file.is_file():
-            load_claims(_claims_file)
+        if (paper_dir(_slug) / "claims.yaml").is_file():
+            load_paper_data(_slug)
 except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
 
@@ -107,6 +106,20 @@ def notebook(slug="{params.slug}"):
     )
 
 
+def paper_data_files(slug):
+    """The data files of a paper's claims layer (claims, errata, reconstructions, findings)."""
+    root = Path("src/netrepro/papers") / slug
+    return {f"{name}_file": str(root / f"{name}.yaml") for name in DATA_FILES}
+
+
+def paper_claim_tables(slug):
+    """The result tables a paper's claims read (named in its claims.yaml)."""
+    try:
+        return referenced_tables(slug)
+    except NetreproError as exc:
+        raise WorkflowError(str(exc)) from None
+
+
 def figure_specs(slug):
     """The paper's figure list (src/netrepro/papers/<slug>/figures.yaml), or a clear error."""
     try:
@@ -136,5 +149,6 @@ def report_inputs(wildcards):
         named[f"{slug}_claims"] = spec["claims"]
         named[f"{slug}_errata"] = spec["errata"]
         named[f"{slug}_reconstructions"] = spec["reconstructions"]
+        named[f"{slug}_findings"] = spec["findings"]
         named[f"{slug}_notebook"] = spec["notebook"]
     return named

@@ -32,9 +32,17 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
                 step()
 
     _figures = [_spec.path for _spec in _specs]
-    _claims = getattr(rules, f"{_slug}_claims").output.table
-    _errata = getattr(rules, f"{_slug}_errata").output.table
-    _reconstructions = getattr(rules, f"{_slug}_reconstructions").output.table
+    _verdicts = getattr(rules, f"{_slug}_claims").output
+    _claims = _verdicts.table
+    # papers not yet on the shared verdict step (issue 15) still have their own rules
+    _errata = (
+        getattr(_verdicts, "errata", None) or getattr(rules, f"{_slug}_errata").output.table
+    )
+    _reconstructions = (
+        getattr(_verdicts, "reconstructions", None)
+        or getattr(rules, f"{_slug}_reconstructions").output.table
+    )
+    _findings = getattr(_verdicts, "findings", None) or []
 
     rule:
         name:
@@ -47,6 +55,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             claims=_claims,
             errata=_errata,
             reconstructions=_reconstructions,
+            findings=_findings,
         output:
             html=f"report/{_slug}.html",
         log:
@@ -65,5 +74,6 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
         claims=_claims,
         errata=_errata,
         reconstructions=_reconstructions,
+        findings=_findings,
         notebook=f"report/{_slug}.html",
     )
