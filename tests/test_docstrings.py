@@ -30,7 +30,7 @@ import netrepro.engines
 import netrepro.papers
 
 SRC = Path(netrepro.__file__).resolve().parent
-NOT_MATH = {"__init__", "steps", "claims", "figures", "checks"}
+NOT_MATH = {"__init__", "steps", "claims", "evidence", "figures", "checks"}
 
 
 def numpydoc_sections(doc: str | None) -> dict:

@@ -9,6 +9,9 @@ arguments of the plot::
       inputs: {bounds: scalar_bounds}  # name -> <rule without the slug prefix>[.<output name>]
       params: {which: stable}          # optional
       caption: Figure 1 of the paper   # one line; the rule's report caption is workflow/report/<slug>/<id>.rst
+      layout:                          # which layout choices come from the paper, which are ours
+        from_paper: "k from 0 to 60 (caption); linear axes (text)"
+        ours: "y range 0 to 2: the axes are lost in extraction"
 
 The generated rule is ``<slug>_<id>``; it writes ``figures/<slug>/<id>.png``.
 """
@@ -27,7 +30,8 @@ __all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]
 
 _SRC = Path(__file__).resolve().parent
 _FIGURE_ID = re.compile(r"^fig(S?\d+)$")
-_KEYS = {"plot", "inputs", "params", "caption"}
+_KEYS = {"plot", "inputs", "params", "caption", "layout"}
+_LAYOUT_KEYS = {"from_paper", "ours"}
 
 
 @dataclass(frozen=True)
@@ -40,6 +44,7 @@ class FigureSpec:
     inputs: dict = field(default_factory=dict)
     params: dict = field(default_factory=dict)
     caption: str = ""
+    layout: dict = field(default_factory=dict)
 
     @property
     def rule(self) -> str:
@@ -90,9 +95,12 @@ def load_figure_specs(slug: str, src: Path = _SRC) -> list[FigureSpec]:
         unknown = set(entry) - _KEYS
         if unknown:
             raise ConfigError(f"{where}: unknown fields {sorted(unknown)} (allowed: {sorted(_KEYS)})")
-        for name in ("inputs", "params"):
+        for name in ("inputs", "params", "layout"):
             if not isinstance(entry.get(name, {}), dict):
                 raise ConfigError(f"{where}: field {name!r} must be a mapping")
+        layout = entry.get("layout", {})
+        if set(layout) - _LAYOUT_KEYS or not all(isinstance(v, str) for v in layout.values()):
+            raise ConfigError(f"{where}: field 'layout' maps {sorted(_LAYOUT_KEYS)} to text, got {layout!r}")
         specs.append(FigureSpec(slug, str(figure_id), entry["plot"], dict(entry.get("inputs", {})),
-                                dict(entry.get("params", {})), str(entry.get("caption", ""))))
+                                dict(entry.get("params", {})), str(entry.get("caption", "")), dict(layout)))
     return specs
