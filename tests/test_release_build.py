@@ -17,6 +17,7 @@ from netrepro.crate import PROFILES, data_id
 from netrepro.io import sha256_file
 from netrepro.papers import PAPERS
 from netrepro.readme import END, START
+from netrepro.verdicts import TESTABLE_VERDICTS, VERDICTS
 
 from .conftest import run_snakemake
 
@@ -129,10 +130,11 @@ def test_readme_results_table_from_the_claims(built_repo, tmp_path):
     for claims in (built_repo / "results/claims").glob("*.csv"):
         frame = pd.read_csv(claims)
         counts = frame["verdict"].value_counts()
+        testable = sum(int(counts.get(v, 0)) for v in TESTABLE_VERDICTS)
         row = next(line for line in text.splitlines() if line.startswith(f"| `{claims.stem}`"))
         cells = [c.strip() for c in row.strip("|").split("|")]
-        assert cells[2:6] == [str(len(frame)), *(str(int(counts.get(v, 0))) for v in ("reproduced", "differs",
-                                                                                        "erratum"))]
+        assert cells[2:4 + len(VERDICTS)] == [str(len(frame)), str(testable),
+                                              *(str(int(counts.get(v, 0))) for v in VERDICTS)]
     check = subprocess.run([sys.executable, "-m", "netrepro.readme", str(readme), "--root", str(built_repo),
                             "--check"], capture_output=True, text=True)
     assert check.returncode == 0

@@ -30,10 +30,11 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from netrepro.verdicts import VERDICTS  # every category of the vocabulary is a scorecard column
+
 from .conftest import run_snakemake
 
 ROOT = Path(__file__).resolve().parents[1]
-VERDICTS = ("reproduced", "differs", "erratum")
 CHROMIUM_FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                   "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
                   "--window-size=1280,1600")

@@ -2,8 +2,9 @@
 
 ``python -m netrepro.readme README.md`` (``make readme``) rewrites the part of README.md between
 the markers ``<!-- results:start -->`` and ``<!-- results:end -->`` with one row per paper: its
-figures (the paper's and ours), its claims by verdict, its errata and reconstructions, read
-from ``results/claims/``, ``results/errata/``, ``results/reconstructions/`` and ``figures/``.
+figures (the paper's and ours), its claims by verdict (every category; testable ones counted
+apart), its errata of substance, findings and reconstructions, read from ``results/claims/``,
+``results/errata/``, ``results/findings/``, ``results/reconstructions/`` and ``figures/``.
 ``--check`` exits 1 when the README is not what the tables give (for CI or a test).
 """
 
@@ -16,12 +17,13 @@ from pathlib import Path
 import pandas as pd
 
 from .papers import PAPERS
+from .summary import scorecard
+from .verdicts import VERDICTS
 
 __all__ = ["START", "END", "results_table", "rewrite", "main"]
 
 START = "<!-- results:start (written by `make readme`: python -m netrepro.readme README.md) -->"
 END = "<!-- results:end -->"
-VERDICTS = ("reproduced", "differs", "erratum")
 
 
 def _rows(path: Path) -> pd.DataFrame | None:
@@ -34,36 +36,39 @@ def _rows(path: Path) -> pd.DataFrame | None:
 
 
 def results_table(root: str | Path = ".", papers=None) -> str:
-    """The Markdown table: per paper figures, claims by verdict, errata, reconstructions."""
+    """The Markdown table: per paper figures, claims by verdict (testable and not), errata, findings, reconstructions.
+
+    The counts are :func:`netrepro.summary.scorecard`'s, so README and report agree.
+    """
     root = Path(root)
     papers = list(papers or PAPERS)
-    lines = ["| paper | figures (paper + ours) | claims | reproduced | differs | erratum | errata | reconstructions |",
-             "|---|---|---|---|---|---|---|---|"]
-    totals = dict.fromkeys(("figs", "ours", "claims", *VERDICTS, "errata", "recon"), 0)
+    table = {kind: {slug: _rows(root / "results" / kind / f"{slug}.csv") for slug in papers}
+             for kind in ("claims", "errata", "findings", "reconstructions")}
+    built = {slug: frame for slug, frame in table["claims"].items() if frame is not None}
+    score = scorecard(built, table["errata"], table["findings"]).set_index("paper")
+    head = ["paper", "figures (paper + ours)", "claims", "testable", *(v.replace("_", " ") for v in VERDICTS),
+            "errata", "findings", "reconstructions"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    n_figs = n_ours = n_recon = 0
     for slug in papers:
-        claims = _rows(root / "results" / "claims" / f"{slug}.csv")
-        errata = _rows(root / "results" / "errata" / f"{slug}.csv")
-        recon = _rows(root / "results" / "reconstructions" / f"{slug}.csv")
         figs = sorted((root / "figures" / slug).glob("*.png"))
         ours = sum(f.stem.startswith("figS") for f in figs)
-        if claims is None:
-            counts, n_claims = {}, "not built"
+        recon = table["reconstructions"][slug]
+        n_figs, n_ours, n_recon = n_figs + len(figs) - ours, n_ours + ours, n_recon + (0 if recon is None else len(recon))
+        name = f"`{slug}` {PAPERS.get(slug, {}).get('title', '')}".strip()
+        if slug not in score.index:
+            cells = [name, f"{len(figs) - ours} + {ours}", "not built", *[""] * (len(head) - 3)]
         else:
-            verdicts = claims["verdict"].astype(str).str.strip() if "verdict" in claims else pd.Series(dtype=str)
-            counts, n_claims = verdicts.value_counts().to_dict(), len(claims)
-        cells = [f"`{slug}` {PAPERS.get(slug, {}).get('title', '')}".strip(), f"{len(figs) - ours} + {ours}",
-                 str(n_claims), *(str(int(counts.get(v, 0))) for v in VERDICTS),
-                 "" if errata is None else str(len(errata)), "" if recon is None else str(len(recon))]
+            row = score.loc[slug]
+            cells = [name, f"{len(figs) - ours} + {ours}", str(int(row["claims"])), str(int(row["testable"])),
+                     *(str(int(row[v])) for v in VERDICTS), str(int(row["errata"])), str(int(row["findings"])),
+                     "" if recon is None else str(len(recon))]
         lines.append("| " + " | ".join(cells) + " |")
-        totals["figs"] += len(figs) - ours
-        totals["ours"] += ours
-        totals["claims"] += n_claims if isinstance(n_claims, int) else 0
-        for v in VERDICTS:
-            totals[v] += int(counts.get(v, 0))
-        totals["errata"] += 0 if errata is None else len(errata)
-        totals["recon"] += 0 if recon is None else len(recon)
-    lines.append(f"| **total** | {totals['figs']} + {totals['ours']} | {totals['claims']} | "
-                 + " | ".join(str(totals[v]) for v in VERDICTS) + f" | {totals['errata']} | {totals['recon']} |")
+    total = score.loc["total"] if "total" in score.index else None
+    if total is not None:
+        lines.append(f"| **total** | {n_figs} + {n_ours} | {int(total['claims'])} | {int(total['testable'])} | "
+                     + " | ".join(str(int(total[v])) for v in VERDICTS)
+                     + f" | {int(total['errata'])} | {int(total['findings'])} | {n_recon} |")
     return "\n".join(lines)
 
 

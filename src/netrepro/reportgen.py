@@ -26,16 +26,20 @@ from pathlib import Path
 
 import pandas as pd
 
+from .errors import ConfigError
 from .io import atomic_path
 from .papers import PAPERS
 from .provenance import git_state, package_versions, params_hash, sidecar_path
 from .crate import iso, write_crate
 from .references import references_html
+from .figurespec import load_figure_specs
+from .summary import replication_summary, scorecard, summary_sentences
+from .verdicts import TESTABLE_VERDICTS, VERDICTS
 
 __all__ = ["make_notebook", "execute_notebook", "strip_external_scripts", "build_index", "provenance_chain",
            "scorecard", "rule_for", "workflow_producers", "config_keys", "main"]
 
-SCORE_VERDICTS = ("reproduced", "differs", "erratum")
+SCORE_VERDICTS = VERDICTS
 
 
 # ----------------------------------------------------------------------------- notebooks
@@ -52,12 +56,14 @@ def _cells(slug: str):
             "root = Path(root)"
         ),
         nbf.new_markdown_cell(f"# Paper `{slug}`\nFigures (rendered by the pipeline's figure rules), then the claim, "
-                              "erratum and reconstruction tables. Every value below is read from `results/`."),
+                              "erratum, finding and reconstruction tables. Every value below is read from `results/`."),
         nbf.new_code_cell("show_figures(root, slug)"),
         nbf.new_markdown_cell("## Claims"),
         nbf.new_code_cell('show_table(root / "results" / "claims" / f"{slug}.csv")'),
         nbf.new_markdown_cell("## Errata"),
         nbf.new_code_cell('show_table(root / "results" / "errata" / f"{slug}.csv")'),
+        nbf.new_markdown_cell("## Findings (ours, beyond the paper)"),
+        nbf.new_code_cell('show_table(root / "results" / "findings" / f"{slug}.csv")'),
         nbf.new_markdown_cell("## Reconstructions"),
         nbf.new_code_cell('show_table(root / "results" / "reconstructions" / f"{slug}.csv")'),
         nbf.new_markdown_cell("## Result tables (first rows)"),
@@ -195,24 +201,6 @@ def provenance_chain(path: str | Path, seen=None) -> list[dict]:
     for item in meta.get("inputs", {}).values():
         chain.extend(provenance_chain(item["path"], seen))
     return chain
-
-
-def scorecard(claims: dict[str, pd.DataFrame]) -> pd.DataFrame:
-    """Counts of verdicts per paper (and a total row).
-
-    Verdicts outside :data:`SCORE_VERDICTS` are counted in an ``other`` column, so
-    the columns always add up to ``claims``.
-    """
-    rows = []
-    for slug, frame in claims.items():
-        verdicts = frame["verdict"].astype(str).str.strip() if "verdict" in frame else pd.Series(dtype=str)
-        counts = verdicts.value_counts()
-        row = {"paper": slug, "claims": len(frame), **{v: int(counts.get(v, 0)) for v in SCORE_VERDICTS}}
-        row["other"] = len(frame) - sum(row[v] for v in SCORE_VERDICTS)
-        rows.append(row)
-    table = pd.DataFrame(rows, columns=["paper", "claims", *SCORE_VERDICTS, "other"])
-    total = {"paper": "total", **{c: int(table[c].sum()) for c in table.columns[1:]}}
-    return pd.concat([table, pd.DataFrame([total])], ignore_index=True)
 
 
 def workflow_producers(rules) -> dict:
@@ -522,14 +510,19 @@ nav.toc{position:sticky;top:0;background:#fff;border-bottom:1px solid var(--line
 nav.toc a{margin-right:1.1em;text-decoration:none}
 .cards{display:flex;gap:1em;flex-wrap:wrap;margin:.6em 0}
 .card{border:1px solid var(--line);border-radius:6px;padding:.5em .9em;min-width:8.5em}
-.card .n{font-size:1.8em;font-weight:650;display:block} .card.reproduced .n{color:var(--ok)} .card.differs .n{color:var(--bad)} .card.erratum .n{color:var(--err)}
+.card .n{font-size:1.8em;font-weight:650;display:block} .card.reproduced .n{color:var(--ok)} .card.differs .n{color:var(--bad)} .card.erratum .n{color:var(--err)} .card.conditional .n{color:#2f6fb0}
+.card.untestable{color:var(--muted)}
 table{border-collapse:collapse;font-size:.86em;margin:.5em 0}
 td,th{border:1px solid var(--line);padding:3px 7px;vertical-align:top;text-align:left} thead th{background:#f3f4f7}
 td.num,th.num{text-align:right;font-variant-numeric:tabular-nums}
 table.score td.bar{min-width:180px} .bar span{display:inline-block;height:.9em;vertical-align:middle}
-.bar .reproduced{background:var(--ok)} .bar .differs{background:var(--bad)} .bar .erratum{background:#e0a800} .bar .other{background:#999}
+.bar .reproduced{background:var(--ok)} .bar .conditional{background:#6fa8dc} .bar .differs{background:var(--bad)} .bar .erratum{background:#e0a800} .bar .other{background:#999}
 .verdict{font-weight:600;white-space:nowrap;border-radius:3px;padding:0 .35em}
-tr.v-reproduced td.verdict-cell{background:var(--ok-bg)} tr.v-differs td.verdict-cell{background:var(--bad-bg)} tr.v-erratum td.verdict-cell{background:var(--err-bg)}
+tr.v-reproduced td.verdict-cell{background:var(--ok-bg)} tr.v-differs td.verdict-cell{background:var(--bad-bg)} tr.v-erratum td.verdict-cell{background:var(--err-bg)} tr.v-conditional td.verdict-cell{background:#e3eefa}
+tr.v-not_checkable td.verdict-cell,tr.v-not_identifiable td.verdict-cell,tr.v-context td.verdict-cell{background:#f0f0f0;color:var(--muted)}
+.summary{border-left:4px solid #2b4c7e;background:#f5f8fc;padding:.4em 1em .6em;margin:1em 0}
+.st-replicated{color:var(--ok);font-weight:600} .st-partially{color:#2f6fb0;font-weight:600} .st-not-replicated{color:var(--bad);font-weight:600}
+.st-not-testable,.st-no-claim{color:var(--muted)} .layout{font-size:.85em;color:#333;margin:.2em 0} .layout b{font-weight:600}
 .scroll{overflow-x:auto}
 figure{margin:1.4em 0 2em;border-top:1px solid var(--line);padding-top:.8em} figure img{max-width:100%;height:auto;border:1px solid #eee;display:block;margin:.3em 0}
 figcaption .fig-id{font-weight:650} figcaption p{margin:.25em 0}
@@ -558,7 +551,7 @@ def _num(value) -> str:
 
 
 def _claims_html(frame: pd.DataFrame, slug: str) -> str:
-    """Claims table: statement, paper's value, ours, tolerance and why, verdict, note."""
+    """Claims table: where, statement, paper's value, ours, tolerance and why, verdict (robust, condition), note."""
     def col(row, *names):
         for n in names:
             if n in row and not (isinstance(row[n], float) and pd.isna(row[n])):
@@ -569,15 +562,63 @@ def _claims_html(frame: pd.DataFrame, slug: str) -> str:
     for _, row in frame.iterrows():
         verdict = str(col(row, "verdict")).strip()
         why = col(row, "tolerance_reason", "tolerance_why")
+        test = col(row, "test")
+        where = col(row, "location")
+        robust = str(col(row, "robust"))
+        condition = col(row, "condition")
+        extra = ""
+        if robust:
+            extra += f"<br><small>robust: {_esc(robust)}</small>"
+        if condition != "":
+            extra += f"<br><small>{_esc(condition)}</small>"
+        if col(row, "erratum_id") != "":
+            extra += f'<br><small>see <a href="#{slug}-errata">{_esc(col(row, "erratum_id"))}</a></small>'
         rows.append(
             f'<tr class="claim v-{_esc(verdict)}" data-verdict="{_esc(verdict)}">'
-            f'<td><code>{_esc(col(row, "claim_id"))}</code></td><td>{_esc(col(row, "statement"))}</td>'
+            f'<td><code>{_esc(col(row, "claim_id"))}</code>{("<br><small>" + _esc(where) + "</small>") if where != "" else ""}</td>'
+            f'<td>{_esc(col(row, "statement"))}</td>'
             f'<td class="num">{_num(col(row, "paper_value"))}</td><td class="num">{_num(col(row, "reproduced_value"))}</td>'
-            f'<td><span class="num">{_esc(col(row, "tolerance"))}</span>{("<br><small>" + _esc(why) + "</small>") if why != "" else ""}</td>'
-            f'<td class="verdict-cell"><span class="verdict">{_esc(verdict)}</span></td><td>{_esc(col(row, "note"))}</td></tr>')
+            f'<td><span class="num">{_esc(col(row, "tolerance"))}</span>{("<br><small>" + _esc(why) + "</small>") if why != "" else ""}'
+            f'{("<br><small>test: " + _esc(test) + "</small>") if test != "" else ""}</td>'
+            f'<td class="verdict-cell"><span class="verdict">{_esc(verdict)}</span>{extra}</td><td>{_esc(col(row, "note"))}</td></tr>')
     return (f'<div class="scroll"><table class="data claims" id="{slug}-claims-table" data-paper="{slug}">'
-            "<thead><tr><th>id</th><th>statement</th><th>paper</th><th>ours</th><th>tolerance and why</th>"
+            "<thead><tr><th>id, where</th><th>statement</th><th>paper</th><th>ours</th><th>tolerance and why</th>"
             f"<th>verdict</th><th>note</th></tr></thead><tbody>{''.join(rows)}</tbody></table></div>")
+
+
+def _summary_html(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict) -> str:
+    """The replication summary that opens a paper's section (counted from its tables, see netrepro.summary)."""
+    if frame is None:
+        return ""
+    errata = _read_csv(spec["errata"]) if spec.get("errata") else None
+    findings = _read_csv(spec["findings"]) if spec.get("findings") else None
+    figure_ids = [Path(f).stem for f in spec.get("figures", [])]
+    table = replication_summary(frame, figure_ids)
+    sentences = summary_sentences(frame, errata, findings, table)
+    rows = "".join(
+        f'<tr data-item="{_esc(r["item"])}"><td>{_esc(r["item"])}</td><td>{_esc(r["kind"])}</td>'
+        f'<td class="st-{_esc(r["status"].replace(" ", "-"))}">{_esc(r["status"])}</td>'
+        f'<td class="num">{int(r["testable"])}</td><td>{_esc(r["why"])}</td></tr>' for _, r in table.iterrows())
+    return (f'<div class="summary" id="{slug}-summary"><h3>Replication summary</h3>'
+            + "".join(f"<p>{_esc(t)}</p>" for t in sentences)
+            + '<details open><summary>per figure and per claim group</summary><div class="scroll"><table class="data">'
+              "<thead><tr><th>figure / group</th><th>kind</th><th>status</th><th class=\"num\">testable claims</th>"
+              f"<th>why not fully</th></tr></thead><tbody>{rows}</tbody></table></div></details>"
+              f'<p class="sub">Status: <b>replicated</b> every testable claim reproduced; <b>partially</b> some hold '
+              "(reproduced, or only under a stated condition); <b>not replicated</b> none holds; <b>not testable</b> "
+              "only untestable rows; <b>no claim</b> the paper states nothing testable about the figure (it is "
+              "redrawn).</p></div>")
+
+
+def _layout_html(layout: dict) -> str:
+    if not layout:
+        return ""
+    parts = []
+    if layout.get("from_paper"):
+        parts.append(f"<b>from the paper:</b> {_esc(layout['from_paper'])}")
+    if layout.get("ours"):
+        parts.append(f"<b>our choice:</b> {_esc(layout['ours'])}")
+    return f'<p class="layout">Layout &mdash; {" &middot; ".join(parts)}</p>'
 
 
 def _figure_html(fig: Path, slug: str, captions: dict, ctx: dict) -> str:
@@ -585,9 +626,10 @@ def _figure_html(fig: Path, slug: str, captions: dict, ctx: dict) -> str:
     label = ("Figure " + fig.stem[3:]) if fig.stem.startswith("fig") else fig.stem
     badge = ' <span class="badge">beyond the paper</span>' if ours else ""
     caption = _rst_html(captions.get(fig.stem, "")) or "<p><em>no caption file</em></p>"
+    layout = _layout_html(ctx.get("layouts", {}).get(slug, {}).get(fig.stem, {}))
     image = _img(fig) if fig.is_file() else f'<p class="missing">{_esc(fig)} not built</p>'
     return (f'<figure id="{slug}-{fig.stem}" data-figure="{_esc(fig)}"><figcaption><span class="fig-id">{_esc(slug)} '
-            f"{_esc(label)}</span>{badge}{caption}</figcaption>{image}{_provenance_panel(fig, slug, ctx)}</figure>")
+            f"{_esc(label)}</span>{badge}{caption}{layout}</figcaption>{image}{_provenance_panel(fig, slug, ctx)}</figure>")
 
 
 def _tables_list(paths, ctx) -> str:
@@ -620,7 +662,9 @@ def _paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict)
            + (f' &middot; source text <code>{_esc(meta["file"])}</code>' if meta.get("file") else "")
            + (f' &middot; <a href="{_esc(Path(notebook).name)}">executed notebook</a>' if notebook else "")
            + f' &middot; <a href="#{slug}-claims">claims</a> &middot; <a href="#{slug}-errata">errata</a>'
+           f' &middot; <a href="#{slug}-findings">findings</a>'
            f' &middot; <a href="#{slug}-reconstructions">reconstructions</a> &middot; <a href="#{slug}-beyond">beyond the paper</a></p>']
+    out.append(_summary_html(slug, spec, frame, ctx))
     out.append(f'<h3 id="{slug}-figures">Figures of the paper</h3>')
     out.extend(_figure_html(f, slug, captions, ctx) for f in paper_figs)
     if not paper_figs:
@@ -631,11 +675,15 @@ def _paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict)
     else:
         counts = frame["verdict"].value_counts() if "verdict" in frame else {}
         out.append("<p>" + ", ".join(f"{int(counts.get(v, 0))} {v}" for v in SCORE_VERDICTS)
-                   + f" of {len(frame)} stated numbers. Table: "
+                   + f" of {len(frame)} claims. Table: "
                    f'<a class="data" href="{_esc(ctx["site"].table_link(spec["claims"]))}">{_esc(spec["claims"])}</a>.</p>')
         out.append(_claims_html(frame, slug))
     for title, key, intro in (
-            ("Errata", "errata", "Equations printed wrong: printed form, corrected form, numerical demonstration."),
+            ("Errata", "errata", "Errors of the text: printed form, corrected form, numerical demonstration, kind "
+                                 "(only equation and prose errors count as errata; notation and typesetting slips are "
+                                 "listed) and which of our results the printed form would change."),
+            ("Findings", "findings", "Our own discoveries beyond the paper's claims, with the evidence and the table "
+                                     "(and figure) that shows it. They are not errata of the text."),
             ("Reconstructions", "reconstructions",
              "Parameters the paper does not state or garbles: the value we chose, why, and where conclusions depend on it.")):
         out.append(f'<h3 id="{slug}-{key}">{title}</h3><p class="sub">{intro}</p>')
@@ -663,42 +711,58 @@ def _paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict)
 
 def _scorecard_html(score: pd.DataFrame, papers: dict, ctx: dict) -> str:
     total = score.iloc[-1]
-    cards = "".join(f'<div class="card {v}"><span class="n" id="total-{v}">{int(total[v])}</span>{v}</div>'
-                    for v in SCORE_VERDICTS)
-    cards = f'<div class="card"><span class="n" id="total-claims">{int(total["claims"])}</span>claims checked</div>' + cards
+    shown = list(SCORE_VERDICTS)
+    untestable = [v for v in shown if v not in TESTABLE_VERDICTS]
+    pct = total["scored_reproduced_pct"]
+    cards = (f'<div class="card"><span class="n" id="total-claims">{int(total["claims"])}</span>claims listed</div>'
+             f'<div class="card"><span class="n" id="total-testable">{int(total["testable"])}</span>testable</div>'
+             + "".join(f'<div class="card {v}{" untestable" if v in untestable else ""}"><span class="n" id="total-{v}">'
+                       f'{int(total[v])}</span>{v.replace("_", " ")}</div>' for v in shown)
+             + f'<div class="card"><span class="n" id="total-errata">{int(total["errata"])}</span>errata</div>'
+             + f'<div class="card"><span class="n" id="total-findings">{int(total["findings"])}</span>findings</div>')
     show_other = int(total["other"]) > 0
-    head = ("<tr><th>paper</th><th class=\"num\">claims</th>" + "".join(f'<th class="num">{v}</th>' for v in SCORE_VERDICTS)
+    head = ("<tr><th>paper</th><th class=\"num\">claims</th><th class=\"num\">testable</th>"
+            + "".join(f'<th class="num">{v.replace("_", " ")}</th>' for v in shown)
             + ('<th class="num">other</th>' if show_other else "")
-            + "<th></th><th class=\"num\">errata</th><th class=\"num\">reconstructions</th><th class=\"num\">figures</th>"
+            + "<th class=\"num\">reproduced of testable</th><th></th><th class=\"num\">errata</th>"
+              "<th class=\"num\">findings</th><th class=\"num\">reconstructions</th><th class=\"num\">figures</th>"
               "<th>claims table</th></tr>")
     rows = []
     for _, row in score.iterrows():
         slug = row["paper"]
         spec = papers.get(slug)
-        n = max(int(row["claims"]), 1)
+        n = max(int(row["testable"]), 1)
         bar = "".join(f'<span class="{v}" style="width:{160 * int(row[v]) / n:.1f}px" title="{int(row[v])} {v}"></span>'
-                      for v in (*SCORE_VERDICTS, "other") if int(row[v]))
+                      for v in TESTABLE_VERDICTS if int(row[v]))
         if spec is not None:
             name = f'<a href="#{slug}">{_esc(PAPERS.get(slug, {}).get("title", slug))}</a> <code>{_esc(slug)}</code>'
-            errata = _read_csv(spec.get("errata", "")) if spec.get("errata") else None
             recon = _read_csv(spec.get("reconstructions", "")) if spec.get("reconstructions") else None
             figs = spec.get("figures", [])
-            extra = (f'<td class="num n-errata">{"" if errata is None else len(errata)}</td>'
-                     f'<td class="num">{"" if recon is None else len(recon)}</td>'
+            extra = (f'<td class="num">{"" if recon is None else len(recon)}</td>'
                      f'<td class="num">{sum(not Path(f).stem.startswith("figS") for f in figs)}'
                      f' + {sum(Path(f).stem.startswith("figS") for f in figs)} ours</td>'
                      f'<td><a class="claims-link" href="#{slug}-claims">claims of {_esc(slug)}</a></td>')
         else:
-            name, extra = "<b>total</b>", "<td></td>" * 4
+            name, extra = "<b>total</b>", "<td></td>" * 3
+        share = "" if pd.isna(row["scored_reproduced_pct"]) else f'{row["scored_reproduced_pct"]:.1f} %'
         rows.append(f'<tr data-paper="{_esc(slug)}"><td>{name}</td><td class="num n-claims">{int(row["claims"])}</td>'
-                    + "".join(f'<td class="num n-{v}">{int(row[v])}</td>' for v in SCORE_VERDICTS)
+                    f'<td class="num n-testable">{int(row["testable"])}</td>'
+                    + "".join(f'<td class="num n-{v}">{int(row[v])}</td>' for v in shown)
                     + (f'<td class="num n-other">{int(row["other"])}</td>' if show_other else "")
-                    + f'<td class="bar">{bar}</td>{extra}</tr>')
+                    + f'<td class="num">{share}</td><td class="bar">{bar}</td>'
+                    f'<td class="num n-errata" title="{int(row["minor_errata"])} notation or typesetting slips not counted">'
+                    f'{int(row["errata"])}</td><td class="num n-findings">{int(row["findings"])}</td>{extra}</tr>')
     return (f'<div class="cards">{cards}</div><div class="scroll"><table class="score" id="scorecard-table"><thead>{head}</thead>'
             f"<tbody>{''.join(rows)}</tbody></table></div>"
-            '<p class="sub"><b>reproduced</b>: our value is within the stated tolerance of the paper\'s; '
-            "<b>differs</b>: it is not, and the note says why; <b>erratum</b>: the paper's number follows from an equation "
-            "printed wrong (see the errata).</p>")
+            '<p class="sub">Testable verdicts (scored): <b>reproduced</b> our value is within the tolerance fixed in '
+            "advance, at every setting in the range of the reconstructions it depends on; <b>conditional</b> it holds "
+            "only under a condition the paper does not state (named in the claims table); <b>differs</b> a genuine "
+            "disagreement, explained in the note; <b>erratum</b> the paper's statement is wrong because of an error of "
+            "its text. Kept for transparency, not scored: <b>not checkable</b> (rests on a source the paper does not "
+            "contain), <b>not identifiable</b> (one of many valid answers, e.g. LMI gains; the defining property is "
+            "checked in its own row), <b>context</b> (not a testable result). Errata count equation and prose errors "
+            f"only; {int(total['minor_errata'])} notation or typesetting slips are listed per paper. Overall "
+            f"{'' if pd.isna(pct) else f'{pct:.1f} %'} of the testable claims are reproduced.</p>")
 
 
 def _identity_html(identity: dict, versions: dict) -> str:
@@ -727,11 +791,13 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     files_dir = Path(outputs["files"]) if outputs.get("files") else None
     site = _Site(root, files_dir)
     claims = {slug: _read_csv(spec["claims"]) for slug, spec in papers.items()}
-    score = scorecard({s: (f if f is not None else pd.DataFrame({"verdict": []})) for s, f in claims.items()})
+    score = scorecard({s: (f if f is not None else pd.DataFrame({"verdict": []})) for s, f in claims.items()},
+                      errata={s: _read_csv(spec["errata"]) for s, spec in papers.items() if spec.get("errata")},
+                      findings={s: _read_csv(spec["findings"]) for s, spec in papers.items() if spec.get("findings")})
     git = git_state()
     versions = package_versions()
     ctx = {"root": root, "site": site, "producers": params.get("producers"), "config": params.get("config", {}),
-           "configfiles": params.get("configfiles", []), "commit": git["commit"]}
+           "configfiles": params.get("configfiles", []), "commit": git["commit"], "layouts": _layouts(papers)}
     commit = git["commit"]
     identity = {
         "commit": f"<code>{_esc(commit)}</code>" if commit else "not a git checkout",
@@ -795,6 +861,17 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
                     config_files=[f"{prefix}/workflow/{rel}" for rel in configs if f"workflow/{rel}" in site.raw],
                     pages=pages, versions=versions, out=outputs["crate"])
     return {"provenance": {"scorecard": score.to_dict(orient="records")}}
+
+
+def _layouts(papers: dict) -> dict:
+    """``{slug: {figure id: layout}}`` from the figure lists (which layout choices are the paper's)."""
+    out = {}
+    for slug in papers:
+        try:
+            out[slug] = {spec.figure_id: spec.layout for spec in load_figure_specs(slug)}
+        except ConfigError:  # a paper without a figure list shows no layout notes
+            out[slug] = {}
+    return out
 
 
 def _run_sidecars(papers: dict) -> dict[str, dict]:
