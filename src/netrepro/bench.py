@@ -42,6 +42,10 @@ Benchmarks
     every k of the horizon) against the conditional Monte Carlo estimator it replaces, at the
     pipeline's sample size; the ratio is the time ratio, with the estimator's largest relative 95%
     half-width (what the exact method removes) and the exact method's error bound.
+``gainsched_moments``
+    The exact error second moments of the ``gainsched`` filter (printed gains, linear f = F1 z;
+    :func:`netrepro.papers.gainsched.moments.second_moments`) against the Monte Carlo mean of the
+    pipeline's run count: time ratio, and the Monte Carlo's largest relative error over k.
 ``onebit_grid_smoother``
     The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
     transition against the dense one (same estimates to rounding).
@@ -222,6 +226,51 @@ def bench_exact_mean(n_paths: int, horizon: int, repeats: int) -> list[dict]:
     return [
         BenchRow("exact_mean", f"time_s_{len(lams)}x{horizon + 1}_values", t_ours, t_ref, t_ref / t_ours, "s"),
         BenchRow("exact_mean", "max_rel_error", bound, half, half / bound, "1 (exact bound vs MC 95% half-width)"),
+    ]
+
+
+def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:
+    """Exact E||e(k)||^2 of the ``gainsched`` filter (printed gains, f = F1 z) against the Monte Carlo it replaces.
+
+    The exact second-moment recursion (:func:`netrepro.papers.gainsched.moments.second_moments`)
+    against ``n_runs`` simulated paths (:func:`netrepro.papers.gainsched.model.simulate`, the
+    pipeline's run count) on the configured system, schedule and x(0); the second row is the
+    Monte Carlo's largest relative error against the exact values over k (what the exact method
+    removes: with the multiplicative noise the squared error is heavy-tailed).
+    """
+    import yaml
+
+    from .papers.gainsched.model import gains_from_dict, simulate, system_from_config
+    from .papers.gainsched.moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
+    from .papers.gainsched.steps import p_sequence
+
+    cfg = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())["gainsched"]
+    sys_ = system_from_config(cfg["system"])
+    gains = gains_from_dict(cfg["paper_gains"], sys_)
+    p_seq = p_sequence(cfg, sys_)
+    x0 = np.asarray(cfg["simulation"]["x0"], dtype=float)
+    results = {}
+
+    def ours():
+        M1, M0, W = mode_matrices(sys_, gains, p_seq, linear_gains(sys_)["F1"])
+        X = second_moments(M1, M0, W, p_seq, sys_.sigma2, initial_moment(x0, np.zeros((sys_.n, sys_.n)),
+                                                                          np.zeros(sys_.n)))
+        results["exact"] = error_mse(X)
+
+    def estimator():
+        e = simulate(sys_, gains, p_seq, np.tile(x0, (n_runs, 1)), np.random.default_rng(7), "lower")
+        results["mc"] = np.mean(np.sum(e ** 2, axis=-1), axis=0)
+
+    t_ours = median_time(ours, repeats)
+    t_ref = median_time(estimator, max(1, repeats // 2))
+    exact, mc = results["exact"], results["mc"]
+    rel = float(np.max(np.abs(mc - exact) / exact))
+    return [
+        BenchRow("gainsched_moments", f"time_s_{exact.size}_steps", t_ours, t_ref, t_ref / t_ours,
+                 f"s (exact recursion vs {n_runs} Monte Carlo runs)"),
+        # the recursion is exact up to rounding: no ratio, the reference column is what Monte Carlo gets wrong
+        BenchRow("gainsched_moments", "max_rel_error_mc", 0.0, rel, np.nan,
+                 "1 (Monte Carlo mean's largest relative error over k against the exact recursion)"),
     ]
 
 
@@ -700,9 +749,9 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 # ============================================================================ driver
 SIZES = {
     "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
-                 repeats=5, peak_size=2048, exact_mean=(400000, 60), grid=(500, 400)),
+                 repeats=5, peak_size=2048, exact_mean=(400000, 60), grid=(500, 400), gainsched=(4000,)),
     "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
-                  repeats=2, peak_size=256, exact_mean=(20000, 60), grid=(20, 60)),
+                  repeats=2, peak_size=256, exact_mean=(20000, 60), grid=(20, 60), gainsched=(4000,)),
 }
 
 
@@ -747,6 +796,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
     if want("exact_mean"):
         _progress("exact_mean: exact E(p_k) vs the conditional Monte Carlo estimator")
         rows += bench_exact_mean(*sizes["exact_mean"], reps)
+    if want("gainsched"):
+        _progress("gainsched: exact second-moment recursion vs Monte Carlo")
+        rows += bench_gainsched_moments(*sizes["gainsched"], reps)
     if want("grid"):
         _progress("grid: onebit grid filter/smoother, banded vs dense transition")
         rows += bench_grid_transition(*sizes["grid"], reps)
