@@ -46,6 +46,10 @@ Benchmarks
     The exact error second moments of the ``gainsched`` filter (printed gains, linear f = F1 z;
     :func:`netrepro.papers.gainsched.moments.second_moments`) against the Monte Carlo mean of the
     pipeline's run count: time ratio, and the Monte Carlo's largest relative error over k.
+``markov_exact``
+    The exact E||P_k|| of the ``markov`` paper's Example II: the block-split path tree
+    (:func:`netrepro.papers.markov.exact.exact_moments_split`, what the pipeline runs) against the
+    full-matrix tree, at the same depth, with their agreement.
 ``onebit_grid_smoother``
     The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
     transition against the dense one (same estimates to rounding).
@@ -271,6 +275,46 @@ def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:
         # the recursion is exact up to rounding: no ratio, the reference column is what Monte Carlo gets wrong
         BenchRow("gainsched_moments", "max_rel_error_mc", 0.0, rel, np.nan,
                  "1 (Monte Carlo mean's largest relative error over k against the exact recursion)"),
+    ]
+
+
+def bench_markov_exact(depth: int, repeats: int) -> list[dict]:
+    """Exact E||P_k|| of ``markov`` Example II: the block-split tree against the full-matrix tree it replaces.
+
+    Both enumerate every channel path to ``depth`` (exact, no sampling); the split one
+    (:func:`netrepro.papers.markov.exact.exact_moments_split`) propagates each decoupled block by
+    its own small Riccati map. Rows: the time ratio at the same depth, and the agreement of the
+    two expectation polynomials on a (p, q) grid.
+    """
+    import yaml
+
+    from .papers.markov.exact import exact_moments, exact_moments_split, find_split
+    from .papers.markov.model import LinearSystem
+
+    cfg = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())["markov"]
+    ex = cfg["examples"]["II"]
+    system, sigma0 = LinearSystem.from_config(ex), np.asarray(ex["Sigma0"], float)
+    split = find_split(system, sigma0)
+    if split is None:
+        raise RuntimeError("markov Example II has no block split: the benchmark needs one")
+    results = {}
+
+    def ours():
+        results["split"] = exact_moments_split(system, sigma0, depth, split)
+
+    def reference():
+        results["full"] = exact_moments(system, sigma0, depth)
+
+    t_ours = median_time(ours, repeats)
+    t_ref = median_time(reference, max(1, repeats // 2))
+    p, q = np.meshgrid(np.linspace(0.05, 0.95, 7), np.linspace(0.05, 0.95, 7))
+    a, b = results["split"].mean(p, q), results["full"].mean(p, q)
+    diff = float(np.max(np.abs(a - b) / np.abs(b)))
+    return [
+        BenchRow("markov_exact", f"time_s_depth_{depth}", t_ours, t_ref, t_ref / t_ours,
+                 "s (block-split tree vs full-matrix tree, Example II)"),
+        BenchRow("markov_exact", "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf,
+                 "1 (split vs full E||P_k|| on a 7x7 (p, q) grid; reference = tolerance)"),
     ]
 
 
@@ -749,9 +793,11 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 # ============================================================================ driver
 SIZES = {
     "full": dict(riccati=(131072, 200, 40), channels=(131072, 200, 200), lmi=(20, 51, 1e-5), fisher=(-40.0, 40.0, 0.25),
-                 repeats=5, peak_size=2048, exact_mean=(400000, 60), grid=(500, 400), gainsched=(4000,)),
+                 repeats=5, peak_size=2048, exact_mean=(400000, 60), grid=(500, 400), gainsched=(4000,),
+                 markov=(21,)),
     "quick": dict(riccati=(4096, 20, 4), channels=(4096, 20, 20), lmi=(3, 5, 1e-3), fisher=(-40.0, 40.0, 10.0),
-                  repeats=2, peak_size=256, exact_mean=(20000, 60), grid=(20, 60), gainsched=(4000,)),
+                  repeats=2, peak_size=256, exact_mean=(20000, 60), grid=(20, 60), gainsched=(4000,),
+                  markov=(10,)),
 }
 
 
@@ -799,6 +845,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
     if want("gainsched"):
         _progress("gainsched: exact second-moment recursion vs Monte Carlo")
         rows += bench_gainsched_moments(*sizes["gainsched"], reps)
+    if want("markov"):
+        _progress("markov: exact E||P_k|| by the block-split tree vs the full-matrix tree")
+        rows += bench_markov_exact(*sizes["markov"], reps)
     if want("grid"):
         _progress("grid: onebit grid filter/smoother, banded vs dense transition")
         rows += bench_grid_transition(*sizes["grid"], reps)
