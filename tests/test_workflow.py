@@ -15,6 +15,8 @@ import pandas as pd
 import pytest
 import yaml
 
+from netrepro.verdicts import VERDICTS
+
 from .conftest import run_snakemake
 
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("workflow")]
@@ -51,7 +53,11 @@ def test_report_and_interface_tables(built):
         frame = pd.read_csv(claims)
         assert list(frame.columns[:8]) == ["paper", "claim_id", "statement", "paper_value", "reproduced_value",
                                            "tolerance", "verdict", "note"]
-        assert set(frame["verdict"]) <= {"reproduced", "differs", "erratum"}
+        assert set(frame["verdict"]) <= set(VERDICTS)
+        assert {"location", "condition", "depends_on", "robust"} <= set(frame.columns), claims.name
+    for slug in ("intermittent", "markov", "onebit", "gainsched", "hinf"):
+        if (built / "results/claims" / f"{slug}.csv").is_file():
+            assert (built / "results/findings" / f"{slug}.csv").is_file(), slug
     for table in (built / "results").rglob("*.csv"):
         assert table.with_name(table.name + ".meta.json").is_file(), f"no provenance sidecar for {table}"
 
