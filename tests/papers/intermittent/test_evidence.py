@@ -88,3 +88,13 @@ def test_tail_grows():
     k = np.arange(81)
     assert evidence.tail_grows(1.1**k)
     assert not evidence.tail_grows(2.0 - 0.5**k)
+
+
+def test_mean_is_concave_in_p0_so_the_two_point_laws_bracket_the_p0_range():
+    # the range of reconstruction scalar.Ep0 rests on E(p_k | p0 = q) being concave in q (enumeration, k <= 8)
+    from netrepro.papers.intermittent.model import exact_mean_enumeration
+
+    m = {q: exact_mean_enumeration(q, A, R1, R2, LAM, 8) for q in (0.0, 5.0, 10.0, 15.0, 20.0)}
+    assert np.all(m[10.0] >= 0.5 * (m[5.0] + m[15.0]) - 1e-12)
+    assert np.all(0.5 * (m[5.0] + m[15.0]) >= 0.5 * (m[0.0] + m[20.0]) - 1e-12)
+    assert np.any(m[10.0][1:] > 0.5 * (m[0.0] + m[20.0])[1:] + 1e-6)
