@@ -1,5 +1,6 @@
 # Paper `intermittent` (000): Teerikoski, Kalman filtering with measurement losses.
-# Compute steps -> tables under results/intermittent/, claims, errata, reconstructions.
+# Compute steps -> tables under results/intermittent/, and the evidence table the shared
+# intermittent_claims rule (workflow/rules/verdicts.smk) judges the claims against.
 # Figures and the notebook are generated (src/netrepro/papers/intermittent/figures.yaml).
 
 ICFG = config.get("intermittent", {})
@@ -204,69 +205,35 @@ rule intermittent_two_sensor_simulation:
         step("netrepro.papers.intermittent.steps:two_sensor_simulation_step")
 
 
-rule intermittent_errata:
+rule intermittent_evidence:
     input:
-        code=code("netrepro.papers.intermittent.claims:errata_step"),
-    output:
-        table="results/errata/intermittent.csv",
-    log:
-        "logs/intermittent/errata.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(
-            {
-                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
-                "two_sensor": pick(ICFG.get("two_sensor", {}), "sigma2"),
-            }
-        ),
-        io=io_json,
-    shell:
-        step("netrepro.papers.intermittent.claims:errata_step")
-
-
-rule intermittent_reconstructions:
-    input:
-        code=code("netrepro.papers.intermittent.claims:reconstructions_step"),
-    output:
-        table="results/reconstructions/intermittent.csv",
-    log:
-        "logs/intermittent/reconstructions.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(ICFG),
-        io=io_json,
-    shell:
-        step("netrepro.papers.intermittent.claims:reconstructions_step")
-
-
-rule intermittent_claims:
-    input:
-        code=code("netrepro.papers.intermittent.claims:claims_step"),
+        code=code("netrepro.papers.intermittent.evidence:evidence_step"),
         bounds=rules.intermittent_scalar_bounds.output.table,
         region=rules.intermittent_two_sensor_region.output.table,
         simulation=rules.intermittent_two_sensor_simulation.output.table,
         stationary=rules.intermittent_stationary_mean.output.table,
     output:
-        table="results/claims/intermittent.csv",
+        table="results/evidence/intermittent.csv",
     log:
-        "logs/intermittent/claims.log",
+        "logs/intermittent/evidence.log",
     localrule: True
     conda:
         CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
     params:
         cfg=as_json(
             {
                 "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
-                "two_sensor": pick(ICFG.get("two_sensor", {}), "bisection_tol"),
+                "two_sensor": pick(ICFG.get("two_sensor", {}), "a", "sigma2", "bisection_tol"),
+                "evidence": ICFG.get("evidence", {}),
             }
         ),
         io=io_json,
     shell:
-        step("netrepro.papers.intermittent.claims:claims_step")
+        step("netrepro.papers.intermittent.evidence:evidence_step")
 
 
 if enabled("intermittent"):
@@ -277,4 +244,5 @@ if enabled("intermittent"):
         rules.intermittent_monte_carlo.output.table,
         rules.intermittent_two_sensor_region.output.table,
         rules.intermittent_two_sensor_simulation.output.table,
+        rules.intermittent_evidence.output.table,
     ]
