@@ -356,7 +356,8 @@ def _reconstruction_rows(params) -> list:
     est = params["estimator"]
     fine = np.arange(-60.0, 0.25, 0.5)
     lim0 = 10.0 * math.log10(math.sqrt(2.0 / math.pi))
-    flat_ok = np.abs(ratios_at(fine, 0.0, se)["rho_sl_db"] - lim0) <= 0.005
+    tol = params["evidence"]["flat_tol_db"]
+    flat_ok = np.abs(ratios_at(fine, 0.0, se)["rho_sl_db"] - lim0) <= tol
     flat = float(fine[flat_ok].max()) if flat_ok.any() else float("nan")
     return [
         dict(quantity="reconstruction.snr_definition", value=params["snr_definition"],
@@ -369,7 +370,7 @@ def _reconstruction_rows(params) -> list:
         dict(quantity="reconstruction.mu_theta0", value=params["mu_theta0"]),
         dict(quantity="reconstruction.lag_tol_db", value=params["lag_tol_db"]),
         dict(quantity="reconstruction.snr_grid_db", value=str(params["snr_grid_db"]),
-             note=f"the alpha -> 1 rho_SL is within 0.005 dB of its SNR -> 0 value {lim0:.4f} dB for SNR <= {flat:g} dB"),
+             note=f"the alpha -> 1 rho_SL is within {tol:g} dB of its SNR -> 0 value {lim0:.4f} dB for SNR <= {flat:g} dB"),
         dict(quantity="reconstruction.estimator",
              value=f"1 - alpha in {est['one_minus_alpha']}, SNR {est['snr_db']} dB, {est['n_runs']} runs, seed "
                    f"{est['seed']}, {est['n_boot']} bootstrap resamples"),
