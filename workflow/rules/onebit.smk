@@ -1,5 +1,6 @@
 # Paper `onebit` (002): Zhang, Stein, Nossek, asymptotic performance analysis for 1-bit Bayesian smoothing.
-# Compute steps -> tables under results/onebit/, claims, errata, reconstructions (figures and notebook: figures.smk).
+# Compute steps -> tables under results/onebit/ and the evidence table results/evidence/onebit.csv; the claims,
+# errata, reconstructions and findings tables come from the shared rule onebit_claims (verdicts.smk).
 
 OCFG = config.get("onebit", {})
 # config keys each step reads (only these trigger its rerun)
@@ -25,18 +26,21 @@ ONEBIT_KEYS = {
     "estimator": ("estimator", "sigma_eta", "snr_definition"),
     "alpha_scan": ("alpha_scan", "sigma_eta", "snr_definition"),
     "vector_check": ("vector_check",),
-    "errata": ("vector_check", "sigma_theta0"),
-    "reconstructions": (
+    "evidence": (
+        "sigma_eta",
+        "sigma_theta0",
+        "mu_theta0",
         "snr_definition",
+        "one_minus_alpha",
         "fig1_one_minus_alpha",
         "reference_snr_db",
-        "sigma_eta",
-        "estimator",
         "snr_grid_db",
+        "quadrature",
         "lag_tol_db",
-        "mu_theta0",
+        "estimator",
+        "evidence",
+        "vector_check",
     ),
-    "claims": ("fig1_one_minus_alpha",),
 }
 ONEBIT_SHARDS = OCFG.get("estimator", {}).get("n_shards", 2)
 
@@ -215,61 +219,21 @@ rule onebit_vector_check:
         step("netrepro.papers.onebit.steps:vector_check_step")
 
 
-rule onebit_errata:
+rule onebit_evidence:
     input:
-        code=code("netrepro.papers.onebit.claims:errata_step"),
-    output:
-        table="results/errata/onebit.csv",
-    log:
-        "logs/onebit/errata.log",
-    conda:
-        CONDA_ENV
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=5,
-    params:
-        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["errata"])),
-        io=io_json,
-    shell:
-        step("netrepro.papers.onebit.claims:errata_step")
-
-
-rule onebit_reconstructions:
-    input:
-        code=code("netrepro.papers.onebit.claims:reconstructions_step"),
-    output:
-        table="results/reconstructions/onebit.csv",
-    log:
-        "logs/onebit/reconstructions.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=5,
-    params:
-        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["reconstructions"])),
-        io=io_json,
-    shell:
-        step("netrepro.papers.onebit.claims:reconstructions_step")
-
-
-rule onebit_claims:
-    input:
-        code=code("netrepro.papers.onebit.claims:claims_step"),
+        code=code("netrepro.papers.onebit.evidence:evidence_step"),
         ratios=rules.onebit_ratios.output.table,
-        lag=rules.onebit_lag.output.table,
         efq=rules.onebit_efq.output.table,
+        lag=rules.onebit_lag.output.table,
         estimator=rules.onebit_estimator.output.table,
         estimator_ratios=rules.onebit_estimator.output.ratios,
         crossing=rules.onebit_estimator.output.crossing,
         alpha_threshold=rules.onebit_alpha_scan.output.threshold,
+        shards=rules.onebit_estimator.input.shards,
     output:
-        table="results/claims/onebit.csv",
+        table="results/evidence/onebit.csv",
     log:
-        "logs/onebit/claims.log",
+        "logs/onebit/evidence.log",
     localrule: True
     conda:
         CONDA_ENV
@@ -278,10 +242,10 @@ rule onebit_claims:
         mem_mb=500,
         runtime=5,
     params:
-        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["claims"])),
+        cfg=as_json(pick(OCFG, *ONEBIT_KEYS["evidence"])),
         io=io_json,
     shell:
-        step("netrepro.papers.onebit.claims:claims_step")
+        step("netrepro.papers.onebit.evidence:evidence_step")
 
 
 if enabled("onebit"):
@@ -297,4 +261,5 @@ if enabled("onebit"):
         rules.onebit_estimator.output.crossing,
         rules.onebit_alpha_scan.output.table,
         rules.onebit_alpha_scan.output.threshold,
+        rules.onebit_evidence.output.table,
     ]
