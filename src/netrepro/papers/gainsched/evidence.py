@@ -162,20 +162,22 @@ def _eq15_residuals(sys, design, Q0, Qp, rng) -> tuple:
     return worst_p, worst_c
 
 
-def _verdict_rows(vt, problem, slack, top, nominal_s2, quantity, extra_label=""):
-    """Evidence rows (nominal + sigma^2 variants) of one problem of vertex_lmis.csv."""
+def _verdict_rows(vt, problem, slack, top, nominal_s2, quantity, variant=""):
+    """Evidence rows of one problem of vertex_lmis.csv: without ``variant``, the nominal sigma^2 and one
+    ``sigma2=...`` variant per other sigma^2; with it, only the nominal sigma^2 as that variant."""
     sub = vt[(vt["problem"] == problem) & (vt["slack"] == slack) & (vt["gamma3_top"] == top)]
     rows = []
     for r in sub.itertuples():
         flag = feasible_flag(r.verdict)
-        if flag is None:
-            continue  # undecided: never counted either way
-        nominal = np.isclose(r.sigma2, nominal_s2) and not extra_label
-        label = "nominal" if nominal else ", ".join(x for x in (extra_label, f"sigma2={r.sigma2:g}") if x)
-        if extra_label and not np.isclose(r.sigma2, nominal_s2):
-            continue
-        rows.append({"quantity": quantity, "variant": label, "value": flag,
-                     "note": f"{r.verdict}: {r.evidence}" if nominal else ""})
+        at_nominal = bool(np.isclose(r.sigma2, nominal_s2))
+        if flag is None or (variant and not at_nominal):
+            continue  # undecided verdicts are never counted either way
+        if variant:
+            rows.append({"quantity": quantity, "variant": f"{variant}, sigma2={r.sigma2:g}", "value": flag})
+        elif at_nominal:
+            rows.append({"quantity": quantity, "value": flag, "note": f"{r.verdict}: {r.evidence}"})
+        else:
+            rows.append({"quantity": quantity, "variant": f"sigma2={r.sigma2:g}", "value": flag})
     return rows
 
 
@@ -261,12 +263,12 @@ def evidence_step(params, inputs, outputs):
     for s2 in grid:
         add({"quantity": "figs_errors_converge", "variant": f"sigma2={s2:g}",
              "value": bool(convergence_rate(with_sigma2(sys, s2), paper, p_seq) < 1.0)})
-    for h, r_h in horizon_rates.items():
-        if h != K:
-            add({"quantity": "figs_errors_converge", "variant": f"horizon={h}", "value": bool(r_h < 1.0)})
     horizon_rates = {}
     for h in params["evidence"]["horizons"]:
         horizon_rates[int(h)] = convergence_rate(sys, paper, p_schedule(np.arange(int(h)), sys.p1, sys.p2, omega))
+    for h, r_h in horizon_rates.items():
+        if h != K:
+            add({"quantity": "figs_errors_converge", "variant": f"horizon={h}", "value": bool(r_h < 1.0)})
     omega_rates = {}
     for w in params["evidence"]["omegas"]:
         omega_rates[float(w)] = convergence_rate(sys, paper, p_schedule(np.arange(K), sys.p1, sys.p2, float(w)))
