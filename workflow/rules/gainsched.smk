@@ -175,7 +175,6 @@ rule gainsched_evidence:
         sensitivity=rules.gainsched_sensitivity.output.table,
         limits=rules.gainsched_sensitivity.output.limits,
         vertex=rules.gainsched_vertex_lmis.output.table,
-        timing=rules.gainsched_timing.output.table,
     output:
         table="results/evidence/gainsched.csv",
     log:
