@@ -34,7 +34,7 @@ of the garbled print: they are what the congruence T = diag(I, S22^{-1} S21)
 of S = [S_ij] produces, since T^T S^T C̄ N T = [[S21^T H C, 0], [S21^T H C, 0]]
 (checked in the tests by rebuilding (12) from a recovered S). Reading Γ3 like
 C̄ of (11), [0; H̄C]N, breaks that identity (``gamma3_top="zero"`` keeps this
-reading for the errata demonstration).
+reading: the other end of the range of reconstruction ``gamma3_rows``).
 """
 
 from __future__ import annotations
