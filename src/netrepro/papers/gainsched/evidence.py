@@ -292,15 +292,17 @@ def evidence_step(params, inputs, outputs):
     add({"quantity": "feasibility_decided_by_plant", "value": bool(vacuous),
          "note": f"{bracket_text} (feasibility_limit.csv)"})
 
-    # ---- Remark 2: the example's largest missing probability under (7) (xi = 1: arrival)
-    add({"quantity": "remark2_missing_bound", "value": bool(1.0 - sys.p1 <= 0.5),
+    # ---- Remark 2: the example's largest missing probability under (7) (xi = 1: arrival) against the
+    # remark's bound (config evidence.remark2_bound, a value of the paper like paper_gains)
+    bound = float(params["evidence"]["remark2_bound"])
+    add({"quantity": "remark2_missing_bound", "value": bool(1.0 - sys.p1 <= bound),
          "note": f"largest missing probability 1 - p1 = {1 - sys.p1:g} under (7); {sys.p2:g} = p2 under the paper's "
                  "naming of p(k) as the missing probability"})
-    add({"quantity": "E6_remark2_example.residual_printed", "value": float(sys.p2 - 0.5),
-         "note": f"excess over 0.5 of the largest missing probability of the example: p2 - 0.5 = {sys.p2 - 0.5:g} with "
-                 f"p(k) read as the missing probability (printed), 1 - p1 - 0.5 = {0.5 - sys.p1:g} with p(k) the arrival "
-                 "probability of (7) (corrected column)"})
-    add({"quantity": "E6_remark2_example.residual_corrected", "value": float(0.5 - sys.p1)})
+    add({"quantity": "E6_remark2_example.residual_printed", "value": float(sys.p2 - bound),
+         "note": f"excess over {bound:g} of the largest missing probability of the example: p2 - {bound:g} = "
+                 f"{sys.p2 - bound:g} with p(k) read as the missing probability (printed), 1 - p1 - {bound:g} = "
+                 f"{1 - sys.p1 - bound:g} with p(k) the arrival probability of (7) (corrected column)"})
+    add({"quantity": "E6_remark2_example.residual_corrected", "value": float(1.0 - sys.p1 - bound)})
 
     # ---- Remark 5 (context): size of the example's Theorem 3 (solve times are machine-dependent: timing.csv only)
     n_vars = int(designs.loc["theorem3", "n_scalar_variables"])
