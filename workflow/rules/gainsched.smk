@@ -1,7 +1,9 @@
 # Paper `gainsched` (001): Wei, Wang, Shen, Li, probability-dependent gain-scheduled filtering.
 # Designs (Theorem 3 and beyond) -> independent stability checks, Monte Carlo of Algorithm 1,
-# sigma^2 sensitivity, Remark 5 timing -> claims, errata, reconstructions. Figures and the notebook
-# are generated (workflow/rules/figures.smk) from src/netrepro/papers/gainsched/figures.yaml.
+# sigma^2 sensitivity, Remark 5 timing, certified vertex LMIs -> evidence; the shared rule
+# gainsched_claims judges it against claims.yaml, errata.yaml, reconstructions.yaml and
+# findings.yaml. Figures and the notebook are generated (workflow/rules/figures.smk)
+# from src/netrepro/papers/gainsched/figures.yaml.
 
 GCFG = config.get("gainsched", {})
 
@@ -141,79 +143,65 @@ rule gainsched_timing:
         step("netrepro.papers.gainsched.steps:timing_step")
 
 
-rule gainsched_errata:
+rule gainsched_vertex_lmis:
     input:
-        code=code("netrepro.papers.gainsched.claims:errata_step"),
-        gains=rules.gainsched_design.output.gains,
-        exact=rules.gainsched_exact_moments.output.table,
-        theorem1=rules.gainsched_stability.output.theorem1,
-        solutions=rules.gainsched_design.output.solutions,
+        code=code("netrepro.papers.gainsched.steps:vertex_lmi_step"),
     output:
-        table="results/errata/gainsched.csv",
+        table="results/gainsched/vertex_lmis.csv",
     log:
-        "logs/gainsched/errata.log",
+        "logs/gainsched/vertex_lmis.log",
     conda:
         CONDA_ENV
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=2,
+        runtime=5,
     params:
-        cfg=as_json(pick(GCFG, "system", "lmi", "simulation")),
+        cfg=as_json(pick(GCFG, "system", "paper_gains", "lmi", "sensitivity")),
         io=io_json,
     shell:
-        step("netrepro.papers.gainsched.claims:errata_step")
+        step("netrepro.papers.gainsched.steps:vertex_lmi_step")
 
 
-rule gainsched_reconstructions:
+rule gainsched_evidence:
     input:
-        code=code("netrepro.papers.gainsched.claims:reconstructions_step"),
-        limits=rules.gainsched_sensitivity.output.limits,
-        exact=rules.gainsched_exact_moments.output.table,
-    output:
-        table="results/reconstructions/gainsched.csv",
-    log:
-        "logs/gainsched/reconstructions.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    threads: 1
-    resources:
-        mem_mb=500,
-        runtime=1,
-    params:
-        cfg=as_json(pick(GCFG, "system", "lmi", "simulation")),
-        io=io_json,
-    shell:
-        step("netrepro.papers.gainsched.claims:reconstructions_step")
-
-
-rule gainsched_claims:
-    input:
-        code=code("netrepro.papers.gainsched.claims:claims_step"),
+        code=code("netrepro.papers.gainsched.evidence:evidence_step"),
         gains=rules.gainsched_design.output.gains,
         designs=rules.gainsched_design.output.designs,
+        solutions=rules.gainsched_design.output.solutions,
         theorem1=rules.gainsched_stability.output.theorem1,
+        exact=rules.gainsched_exact_moments.output.table,
         exact_mse=rules.gainsched_exact_moments.output.per_k,
-        stability=rules.gainsched_stability.output.stability,
+        sensitivity=rules.gainsched_sensitivity.output.table,
         limits=rules.gainsched_sensitivity.output.limits,
-        timing=rules.gainsched_timing.output.table,
+        vertex=rules.gainsched_vertex_lmis.output.table,
     output:
-        table="results/claims/gainsched.csv",
+        table="results/evidence/gainsched.csv",
     log:
-        "logs/gainsched/claims.log",
+        "logs/gainsched/evidence.log",
     localrule: True
     conda:
         CONDA_ENV
     threads: 1
     resources:
-        mem_mb=500,
-        runtime=1,
+        mem_mb=1000,
+        runtime=2,
     params:
-        cfg=as_json(pick(GCFG, "system", "sensitivity")),
+        cfg=as_json(
+            pick(
+                GCFG,
+                "system",
+                "paper_gains",
+                "lmi",
+                "simulation",
+                "stability",
+                "sensitivity",
+                "evidence",
+            )
+        ),
         io=io_json,
     shell:
-        step("netrepro.papers.gainsched.claims:claims_step")
+        step("netrepro.papers.gainsched.evidence:evidence_step")
 
 
 if enabled("gainsched"):
@@ -232,4 +220,6 @@ if enabled("gainsched"):
         rules.gainsched_sensitivity.output.table,
         rules.gainsched_sensitivity.output.limits,
         rules.gainsched_timing.output.table,
+        rules.gainsched_vertex_lmis.output.table,
+        rules.gainsched_evidence.output.table,
     ]

@@ -11,10 +11,11 @@ Modules:
 * :mod:`.moments`: exact second moments for linear f (issue 16);
 * :mod:`.feasibility`: certified feasible / infeasible / undecided decisions, plant LMI, brackets;
 * :mod:`.tuning`: gains of form (9) tuned by Monte Carlo or on the exact cost (yardsticks, not the paper's);
-* :mod:`.steps`: pipeline steps (designs, stability, simulation, sensitivity, timing);
-* :mod:`.claims`: claims, errata and reconstructions steps;
+* :mod:`.steps`: pipeline steps (designs, stability, simulation, sensitivity, timing, vertex LMIs);
+* :mod:`.evidence`: the evidence step (our side of ``claims.yaml``, ``errata.yaml``,
+  ``reconstructions.yaml``, ``findings.yaml``; issue 15);
 * :mod:`.figures`: Figs 1-2, S1, S2 from the tables;
 * :mod:`.checks`: configuration checks; ``figures.yaml``: the figure list.
 """
 
-__all__ = ["model", "moments", "design", "feasibility", "tuning", "steps", "claims", "figures", "checks"]
+__all__ = ["model", "moments", "design", "feasibility", "tuning", "steps", "evidence", "figures", "checks"]

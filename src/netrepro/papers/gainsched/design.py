@@ -34,7 +34,7 @@ of the garbled print: they are what the congruence T = diag(I, S22^{-1} S21)
 of S = [S_ij] produces, since T^T S^T C̄ N T = [[S21^T H C, 0], [S21^T H C, 0]]
 (checked in the tests by rebuilding (12) from a recovered S). Reading Γ3 like
 C̄ of (11), [0; H̄C]N, breaks that identity (``gamma3_top="zero"`` keeps this
-reading for the errata demonstration).
+reading: the other end of the range of reconstruction ``gamma3_rows``).
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ import numpy as np
 from ...engines.lmi import SOLVER
 from .model import Gains, GainschedError, System
 
-__all__ = ["Theorem3", "Theorem3Solution", "recover_gains", "recover_output_gains", "certified_cost",
+__all__ = ["Theorem3", "Theorem3Solution", "FixedGainsVertexLMI", "zero_diagonal_blocks", "recover_gains", "recover_output_gains", "certified_cost",
            "output_certificate",
            "certificate_from_solution", "congruence_residual", "REALISATIONS"]
 
@@ -125,6 +125,11 @@ class Theorem3:
         as the Schur complement [[M, E^T], [E, -I]] < 0, E = [I, -L̄, 0]. Unlike
         adding [I, -I]^T [I, -I] (which ties the estimate to S21 = S22), nothing is
         forced: recover with :func:`recover_output_gains`.
+    fixed_gains : Gains or None
+        Given gains instead of variables, in the realisation T = I (S21 = S22 = R2), where
+        (26) inverts to Ḡ = R2^T G(p), H̄ = R2^T H(p): linear in R2. A restriction of the
+        slack (S21 = S22), so a feasible point proves (24) for these gains, an infeasible
+        verdict only for this family (:class:`FixedGainsVertexLMI` has the general slack).
     noise_row : bool
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
@@ -144,8 +149,11 @@ class Theorem3:
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
                  gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False,
-                 output_slack: bool = False):
+                 output_slack: bool = False, fixed_gains: Gains | None = None):
         self.noise_row = noise_row
+        self.fixed_gains = fixed_gains
+        if fixed_gains is not None:
+            zero_filter, scheduled = False, True
         self.output_slack = bool(output_slack and performance)
         self.zero_filter = zero_filter
         if zero_filter:
@@ -166,10 +174,10 @@ class Theorem3:
             "R1": cp.Variable((n, n), name="R1"),
             "R2": cp.Variable((n, n), name="R2"),
         }
-        if not zero_filter:
+        if not zero_filter and fixed_gains is None:
             v["G0"] = cp.Variable((n, n), name="Gbar0")
             v["H0"] = cp.Variable((n, m), name="Hbar0")
-        if scheduled:
+        if scheduled and fixed_gains is None:
             v["Gf"] = cp.Variable((n, n), name="Gbarf")
             v["Hf"] = cp.Variable((n, m), name="Hbarf")
         if self.output_slack:
@@ -280,6 +288,8 @@ class Theorem3:
         """
         if self.zero_filter:
             return np.zeros((self.sys.n, self.sys.n))
+        if self.fixed_gains is not None:  # T = I (S21 = S22 = R2): Ḡ = R2^T G(p), inverse of (26)
+            return self.vars["R2"].T @ self.fixed_gains.G(p)
         return self.vars["G0"] + p * self.vars["Gf"] if self.scheduled else self.vars["G0"]
 
     def Hbar(self, p):
@@ -295,6 +305,8 @@ class Theorem3:
         """
         if self.zero_filter:
             return np.zeros((self.sys.n, self.sys.m))
+        if self.fixed_gains is not None:  # T = I: H̄ = R2^T H(p), inverse of (26)
+            return self.vars["R2"].T @ self.fixed_gains.H(p)
         return self.vars["H0"] + p * self.vars["Hf"] if self.scheduled else self.vars["H0"]
 
     def Lambda(self, pl):
@@ -431,6 +443,9 @@ class Theorem3:
                                     n_scalar_variables=self.n_scalar_variables())
         elapsed = time.perf_counter() - start
         values = {k: (None if x.value is None else np.array(x.value)) for k, x in self.vars.items()}
+        if self.fixed_gains is not None and values["R2"] is not None:
+            for name, mat in self.fixed_gains.as_dict().items():
+                values[name] = values["R2"].T @ mat
         if self.zero_filter and values["R2"] is not None:
             values["G0"] = np.zeros((self.sys.n, self.sys.n))
             values["H0"] = np.zeros((self.sys.n, self.sys.m))
@@ -702,3 +717,165 @@ def congruence_residual(sys: System, values: dict, pairs, realisation: str = "id
         M = theorem1_matrix(sys, gains, cert["Q0"] + p * cert["Qp"], cert["Q0"] + pn * cert["Qp"], cert["S"], p)
         worst = max(worst, float(np.max(np.abs(big.T @ M @ big - combo))))
     return worst
+
+
+class FixedGainsVertexLMI:
+    r"""Theorem 3's vertex LMIs (24) for *given* gains, in the original coordinates.
+
+    By the congruence diag(T, I, T, T, T) of the proof of Theorem 2, (24) with recovered gains
+    (G, H) is feasible iff there are Q0, Qp > 0 (27) and a slack S = [S_ij] such that the 16
+    vertex matrices of (12),
+
+    .. math::
+
+        \begin{bmatrix}
+        -Q^i & * & * & * & * \\
+        FZN & -2I & * & * & * \\
+        S^T(\mathcal A^{ij} + \bar B F_1 Z N) & S^T\bar B & -\Lambda^l & * & * \\
+        \Theta^{jr} S^T \bar C^i N & 0 & 0 & -\Theta^{jr}\Lambda^l & * \\
+        \sigma^2 S^T \bar D N & 0 & 0 & 0 & -\sigma^2\Lambda^l
+        \end{bmatrix} < 0,
+
+    are negative definite, with :math:`Q^i = Q_0 + p_i Q_p`, :math:`\Lambda^l = S + S^T - Q^l`,
+    :math:`\Theta^{jr} = p_j(1-p_r)`, :math:`\mathcal A^{ij} = [[A, 0], [p_j H(p_i) C, G(p_i)]]`,
+    :math:`\bar C^i = [0; H(p_i) C]` (the multi-affine lifting (28)-(33) of p H(p), Θ H(p)).
+    For fixed gains this is an LMI in (Q0, Qp, S); S21, S22 nonsingular is generic (a strict
+    solution can be perturbed), so no realisation of (26) is imposed.
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    eps : float
+        Q0, Qp >= eps I in the proposing problem (the question itself is strict).
+    bound : float
+        Entry-wise bound on Q0, Qp, S (scale fixing).
+    margin_cap : float
+        The proposing problem maximises t <= margin_cap with vertices <= -t I.
+
+    Returns
+    -------
+    FixedGainsVertexLMI
+        :meth:`certify` gives the shared engine's verdict at a noise variance.
+    """
+
+    def __init__(self, sys: System, gains: Gains, eps: float = 1e-6, bound: float = 1e3, margin_cap: float = 0.1):
+        self.sys, self.gains = sys, gains
+        nn = 2 * sys.n
+        self.sigma2 = cp.Parameter(nonneg=True, name="sigma2", value=sys.sigma2)
+        self.Q0 = cp.Variable((nn, nn), symmetric=True, name="Q0")
+        self.Qp = cp.Variable((nn, nn), symmetric=True, name="Qp")
+        self.S = cp.Variable((nn, nn), name="S")
+        self.t = cp.Variable(name="t")
+        ps = (sys.p1, sys.p2)
+        cons = [cp.abs(self.Q0) <= bound, cp.abs(self.Qp) <= bound, cp.abs(self.S) <= bound, self.t <= margin_cap,
+                self.Q0 >> eps * np.eye(nn), self.Qp >> eps * np.eye(nn)]
+        blocks = []
+        for i in range(2):
+            for j in range(2):
+                for r in range(2):
+                    for l in range(2):
+                        M = self.vertex(ps[i], ps[j], ps[r], ps[l])
+                        Msym = 0.5 * (M + M.T)
+                        cons.append(Msym << -self.t * np.eye(M.shape[0]))
+                        blocks.append((f"vertex{i}{j}{r}{l}", -Msym))
+        blocks += [("Q0", self.Q0), ("Qp", self.Qp)]
+        self.problem = cp.Problem(cp.Maximize(self.t), cons)
+        from ...engines.certify import CertifiedLMI
+
+        self.certifier = CertifiedLMI(blocks, problem=self.problem, drop=(self.t,))
+
+    def vertex(self, pi: float, pj: float, pr: float, pl: float):
+        """The vertex (i, j, r, l) of (24) in the original coordinates (see the class docstring).
+
+        Parameters
+        ----------
+        pi, pj, pr, pl : float
+
+        Returns
+        -------
+        cvxpy expression (8n + nz, 8n + nz)
+        """
+        s, g = self.sys, self.gains
+        n, nn, nz = s.n, 2 * s.n, s.nz
+        Gi, Hi = g.G(pi), g.H(pi)
+        N = s.N
+        Acal = np.block([[s.A, np.zeros((n, n))], [pj * Hi @ s.C, Gi]])
+        Bbar = np.vstack([s.B, np.zeros((n, nz))])
+        Cbar = np.vstack([np.zeros((n, n)), Hi @ s.C])
+        Dbar = np.vstack([s.D, np.zeros((n, n))])
+        theta = pj * (1.0 - pr)
+        S = self.S
+        Lam = S + S.T - (self.Q0 + pl * self.Qp)
+        Om1 = S.T @ (Acal + Bbar @ s.F1 @ s.Z @ N)
+        Om2 = theta * (S.T @ (Cbar @ N))
+        SB = S.T @ Bbar
+        SD = self.sigma2 * (S.T @ (Dbar @ N))
+        FZN = s.F @ s.Z @ N
+        O = np.zeros
+        return cp.bmat([
+            [-(self.Q0 + pi * self.Qp), FZN.T, Om1.T, Om2.T, SD.T],
+            [FZN, -2 * np.eye(nz), SB.T, O((nz, nn)), O((nz, nn))],
+            [Om1, SB, -Lam, O((nn, nn)), O((nn, nn))],
+            [Om2, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
+            [SD, O((nn, nz)), O((nn, nn)), O((nn, nn)), -self.sigma2 * Lam],
+        ])
+
+    def certify(self, sigma2: float):
+        """Solve at ``sigma2`` and decide with the shared engine (status is information only).
+
+        Infeasibility is certified by a checked dual certificate or by the necessary condition that
+        (24) implies mean-square stability of (10): the frozen second-moment radius of (10) at the
+        sector vertices and p in {p1, p2}, and the plant's (:mod:`.feasibility`), must be < 1.
+
+        Parameters
+        ----------
+        sigma2 : float
+
+        Returns
+        -------
+        tuple
+            ``(Verdict, status, margin)``.
+        """
+        from .feasibility import RADIUS_MARGIN, plant_vertex_radius, with_sigma2
+        from .model import frozen_radius, sector_cases
+
+        self.sigma2.value = float(sigma2)
+        try:
+            self.problem.solve(solver=SOLVER)
+            status = str(self.problem.status)
+        except cp.error.SolverError as exc:  # pragma: no cover - solver failure path
+            status = f"solver_error: {exc}"
+        sys2 = with_sigma2(self.sys, sigma2)
+
+        def necessary():
+            rho = max([frozen_radius(sys2, self.gains, p, F) for p in (sys2.p1, sys2.p2)
+                       for F in sector_cases(sys2).values()] + [plant_vertex_radius(sys2, sigma2)])
+            return rho >= 1.0 + RADIUS_MARGIN, f"second-moment radius of (10) {rho:.12g} at sigma2 = {sigma2:.12g}"
+
+        verdict = self.certifier.certify(status, necessary=necessary)
+        margin = float(self.t.value) if self.t.value is not None else np.nan
+        return verdict, status, margin
+
+
+def zero_diagonal_blocks(coefficients) -> list:
+    """Blocks of a strict system ``F_j(u) > 0`` with a diagonal entry identically zero in every coordinate.
+
+    A positive definite matrix has a positive diagonal, so any such block makes the strict
+    system infeasible for every value of the variables (the noise row of (24) at sigma^2 = 0).
+
+    Parameters
+    ----------
+    coefficients : netrepro.engines.certify.LMICoefficients
+
+    Returns
+    -------
+    list of (str, int)
+        ``(block name, diagonal index)`` of each identically zero diagonal entry.
+    """
+    hits = []
+    for name, F0, F in zip(coefficients.names, coefficients.F0, coefficients.F):
+        const = np.abs(np.diagonal(F0))
+        coef = np.abs(np.diagonal(F, axis1=-2, axis2=-1)).max(axis=0) if np.size(F) else np.zeros_like(const)
+        hits += [(name, int(d)) for d in np.flatnonzero((const == 0) & (coef == 0))]
+    return hits

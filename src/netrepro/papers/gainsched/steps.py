@@ -64,6 +64,7 @@ __all__ = [
     "exact_moments_step",
     "sensitivity_step",
     "timing_step",
+    "vertex_lmi_step",
 ]
 
 MATRICES = ("G0", "Gf", "H0", "Hf")
@@ -510,3 +511,67 @@ def timing_step(params, inputs, outputs):
         frame["fit_exponent"] = np.nan
         frame["extrapolated_1000_s"] = np.nan
     return {"table": frame}
+
+
+def vertex_lmi_step(params, inputs, outputs):
+    """Certified decisions on the vertex LMIs (24) beyond the designs (issue 15).
+
+    ``table`` (vertex_lmis.csv), one row per problem, slack family, Γ3 reading and sigma^2:
+
+    * ``printed_gains``: do the gains printed in Section IV satisfy (24)? With the general slack S
+      in the original coordinates (:class:`.design.FixedGainsVertexLMI`, both readings of Γ3
+      coincide there), and in the paper's T-coordinates with S21 = S22 (T = I) under both
+      readings of Γ3 (a restricted family: only its feasible verdicts speak for (24));
+    * ``scheduled``: Theorem 3 with free gains under the other reading of Γ3, Θ[0; H̄C]N;
+    * ``noise_free``: Theorem 3 at sigma^2 = 0 with and without the last block row of (24);
+      with it, a diagonal block that is identically zero certifies infeasibility.
+
+    Every verdict is the shared engine's (point check, dual certificate or necessary condition);
+    the solver status and margin are information.
+    """
+    from .design import FixedGainsVertexLMI, Theorem3, zero_diagonal_blocks
+    from .feasibility import necessary_condition, with_sigma2
+
+    sys = _sys(params)
+    lmi = params["lmi"]
+    gains = gains_from_dict(params["paper_gains"], sys)
+    grid = sorted({float(s) for s in params["sensitivity"]["sigma2_grid"]} | {float(sys.sigma2)})
+    eps, bound, cap = float(lmi["eps"]), float(lmi["bound"]), float(lmi["margin_cap"])
+    common = dict(eps=eps, bound=bound, margin_cap=cap, qp_positive=bool(lmi["qp_positive"]))
+    rows = []
+
+    def record(problem, family, top, s2, verdict, status, margin):
+        rows.append({"problem": problem, "slack": family, "gamma3_top": top, "sigma2": float(s2),
+                     "verdict": verdict.verdict, "evidence": verdict.evidence, "status": status, "margin": margin,
+                     "certified_slack": verdict.point.slack if verdict.point is not None else np.nan})
+
+    general = FixedGainsVertexLMI(sys, gains, eps=eps, bound=bound, margin_cap=cap)
+    for s2 in grid:
+        v, status, margin = general.certify(s2)
+        record("printed_gains", "general", "HC", s2, v, status, margin)
+    for top in ("HC", "zero"):
+        prob = Theorem3(sys, fixed_gains=gains, gamma3_top=top, **common)
+        for s2 in grid:
+            v, sol = prob.certify(s2)
+            record("printed_gains", "S21=S22", top, s2, v, sol.status, sol.margin)
+    prob = Theorem3(sys, gamma3_top="zero", **common)
+    for s2 in grid:
+        v, sol = prob.certify(s2)
+        record("scheduled", "free", "zero", s2, v, sol.status, sol.margin)
+    sys0 = with_sigma2(sys, 0.0)
+    for keep in (True, False):
+        prob = Theorem3(sys0, noise_row=keep, gamma3_top=lmi.get("gamma3_top", "HC"), **common)
+        sol = prob.solve(0.0)
+        plant = necessary_condition(sys0, 0.0)
+        zeros = zero_diagonal_blocks(prob.certifier.coefficients())
+
+        def necessary(zeros=zeros, plant=plant):
+            if zeros:
+                return True, (f"{len(zeros)} diagonal entries identically zero (e.g. {zeros[0][0]}, index "
+                              f"{zeros[0][1]}): no strict solution")
+            return plant()
+
+        v = prob.certifier.certify(sol.status, necessary=necessary)
+        record("noise_free", "with noise row" if keep else "without noise row", lmi.get("gamma3_top", "HC"), 0.0,
+               v, sol.status, sol.margin)
+    return {"table": pd.DataFrame(rows)}
