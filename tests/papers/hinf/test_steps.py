@@ -80,7 +80,7 @@ def test_issue17_steps_columns(hinf_run):
     fh = steps.fig2_horizon_step(cfg, {}, {})
     pa = fh["table"]
     assert list(pa.columns[:7]) == ["scenario", "agent", "horizon", "local", "decentralized", "ratio", "z"]
-    assert set(pa["scenario"]) == {"fig2", "fig2_ki0"}
+    assert set(pa["scenario"]) == {t for s in cfg["fig2_horizon"]["scenarios"] for t in (s, f"{s}_ki0")}
     np.testing.assert_allclose(pa["ratio"], pa["decentralized"] / pa["local"])
     # the local filter does not use the consensus: identical with and without the integral gain
     a = pa[pa["scenario"] == "fig2"].reset_index()
