@@ -208,6 +208,26 @@ rule hinf_evader_check:
         step("netrepro.papers.hinf.steps:evader_check_step")
 
 
+rule hinf_fig5_control:
+    input:
+        code=code("netrepro.papers.hinf.steps:fig5_control_step"),
+    output:
+        table="results/hinf/fig5_control.csv",
+    log:
+        "logs/hinf/fig5_control.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:fig5_control_step")
+
+
 rule hinf_network:
     input:
         code=code("netrepro.papers.hinf.steps:network_step"),
@@ -249,6 +269,7 @@ rule hinf_evidence:
         modes=rules.hinf_fig2_horizon.output.modes,
         evader=rules.hinf_evader_check.output.table,
         evader_paired=rules.hinf_evader_check.output.paired,
+        fig5_control=rules.hinf_fig5_control.output.table,
     output:
         table="results/evidence/hinf.csv",
     log:
@@ -289,5 +310,6 @@ if enabled("hinf"):
         rules.hinf_evader_check.output.paired,
         rules.hinf_network.output.table,
         rules.hinf_network.output.connectivity,
+        rules.hinf_fig5_control.output.table,
         rules.hinf_evidence.output.table,
     ]

@@ -75,6 +75,8 @@ def hinf_run(tmp_path_factory):
     run(steps.evader_check_step, cfg, {}, ["table", "paired"])
     files["evader"], files["evader_paired"] = files.pop("table"), files.pop("paired")
     files["paired"] = paired
+    run(steps.fig5_control_step, cfg, {}, ["table"])
+    files["fig5_control"] = files.pop("table")
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

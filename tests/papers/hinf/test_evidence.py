@@ -16,7 +16,7 @@ from netrepro.verdicts import load_paper_data, read_evidence, verdicts_step
 
 INPUTS = ("consensus", "attenuation", "checks", "summary", "paired", "errors", "trajectories", "per_run_static_fixed",
           "per_run_static_mobile", "connectivity", "sensitivity", "sensitivity_evasive", "paired_evasive", "per_agent",
-          "modes", "evader", "evader_paired")
+          "modes", "evader", "evader_paired", "fig5_control")
 
 
 @pytest.fixture(scope="module")
@@ -61,12 +61,6 @@ def test_gain_norms_closed_form():
     ([1.0, 0.5, 0.2, 0.1], 0.3, 2), ([0.1, 0.2], 0.3, 0), ([0.5, 0.1, 0.4, 0.1], 0.3, 3), ([0.5, 0.1, 0.4], 0.3, -1)])
 def test_settle_step_by_hand(series, thr, expected):
     assert evidence.settle_step(series, thr) == expected
-
-
-def test_paired_z_is_the_paired_t_statistic():
-    rng = np.random.default_rng(3)
-    a, b = rng.normal(size=50), rng.normal(0.3, size=50)
-    assert evidence.paired_z(a, b)[2] == pytest.approx(stats.ttest_rel(a, b).statistic)
 
 
 def test_evidence_matches_independent_reads_of_the_tables(evidence_table):

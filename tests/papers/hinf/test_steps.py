@@ -109,3 +109,15 @@ def test_evader_and_network_steps(hinf_run):
     links = net["table"]
     k0 = links[(links["scenario"] == "fig2") & (links["run"] == 0) & (links["k"] == 0)]
     assert len(k0) == 9
+
+
+def test_fig5_control_table(hinf_run):
+    cfg, files = hinf_run
+    t = pd.read_csv(files["fig5_control"])
+    assert list(t.columns) == ["parameter", "value", "runs", "horizon", "start", "stationary", "mobile", "mean_diff",
+                               "se", "z"]
+    sv = cfg["sensitivity"]
+    assert len(t) == len(sv["Gamma"]) + len(sv["v_max"])
+    assert t["stationary"].nunique() == 1  # one stationary reference, paired with every mobile run
+    np.testing.assert_allclose(t["mobile"] - t["stationary"], t["mean_diff"], atol=1e-12)
+    np.testing.assert_allclose(t["z"], t["mean_diff"] / t["se"])

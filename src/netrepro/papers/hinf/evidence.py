@@ -21,11 +21,12 @@ import pandas as pd
 
 from ...verdicts import evidence_frame
 from .algebra import rotation
+from .model import paired_z
 from .motion import control_law, printed_control_law, printed_sigma_gradient, sigma_gradient
 from .noise import (NoiseModel, geometry, noise_covariance, noise_information, noise_variances, printed_dinfo_dtheta,
                     sample_noise)
 
-__all__ = ["evidence_step", "central_difference", "steady_state_prior", "gain_norms", "settle_step", "paired_z",
+__all__ = ["evidence_step", "central_difference", "steady_state_prior", "gain_norms", "settle_step",
            "advantage", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS"]
 
 # reconstruction key -> the parameter of the one-at-a-time sweeps (results/hinf/sensitivity*.csv) that varies it
@@ -112,13 +113,6 @@ def settle_step(error_mean, threshold: float) -> int:
         return 0
     k = int(above[-1]) + 1
     return k if k < len(e) else -1
-
-
-def paired_z(a, b):
-    """Paired z-score of ``a - b`` over runs: (mean, standard error, z)."""
-    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
-    se = d.std(ddof=1) / math.sqrt(len(d))
-    return float(d.mean()), float(se), float(d.mean() / se)
 
 
 def advantage(local, decentralized):
@@ -593,9 +587,15 @@ def evidence_step(params, inputs, outputs):
                  "note": _fig4_attribution(summ, per_run, z_sig, settle_txt)})
     z5 = float(paired.loc["fig5_mobile_vs_stationary", "z"])
     sd = summ.loc[("static_fixed", "decentralized")]
+    f5 = pd.read_csv(inputs["fig5_control"])
     rows.append({"quantity": "fig5.mobile_beats_stationary", "value": _z_rule(z5, z_sig),
                  "note": f"late mean error stationary {sd['late_mean']:.4f}, mobile {md['late_mean']:.4f} (paired z = {z5:.1f}, "
-                         f"{int(md['n_runs'])} runs)"})
+                         f"{int(md['n_runs'])} runs); control sweep (fig5_control.csv, {int(f5['runs'].iloc[0])} runs, "
+                         f"horizon {int(f5['horizon'].iloc[0])}): stationary {f5['stationary'].iloc[0]:.4f}, mobile "
+                         + ", ".join(f"{r.parameter}={r.value:g} {r.mobile:.4f} (z = {r.z:.1f})" for r in f5.itertuples())})
+    for r in f5.itertuples():
+        rows.append({"quantity": "fig5.mobile_beats_stationary", "variant": f"{r.parameter}={r.value:g} (H={r.horizon})",
+                     "value": _z_rule(r.z, z_sig)})
     ev = summ.loc[("evasive_hinf", "decentralized")]
     rows.append({"quantity": "fig6.agents_align", "value": bool(ev["range_error_end"] < ev["range_error_start"]),
                  "note": f"mean |r_i - a1|: start {ev['range_error_start']:.2f}, end {ev['range_error_end']:.2f}"})
