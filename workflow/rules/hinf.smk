@@ -228,6 +228,26 @@ rule hinf_fig5_control:
         step("netrepro.papers.hinf.steps:fig5_control_step")
 
 
+rule hinf_evasive_network:
+    input:
+        code=code("netrepro.papers.hinf.steps:evasive_network_step"),
+    output:
+        table="results/hinf/evasive_network.csv",
+    log:
+        "logs/hinf/evasive_network.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:evasive_network_step")
+
+
 rule hinf_network:
     input:
         code=code("netrepro.papers.hinf.steps:network_step"),
@@ -270,6 +290,7 @@ rule hinf_evidence:
         evader=rules.hinf_evader_check.output.table,
         evader_paired=rules.hinf_evader_check.output.paired,
         fig5_control=rules.hinf_fig5_control.output.table,
+        evasive_network=rules.hinf_evasive_network.output.table,
     output:
         table="results/evidence/hinf.csv",
     log:
@@ -311,5 +332,6 @@ if enabled("hinf"):
         rules.hinf_network.output.table,
         rules.hinf_network.output.connectivity,
         rules.hinf_fig5_control.output.table,
+        rules.hinf_evasive_network.output.table,
         rules.hinf_evidence.output.table,
     ]

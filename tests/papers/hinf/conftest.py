@@ -77,6 +77,8 @@ def hinf_run(tmp_path_factory):
     files["paired"] = paired
     run(steps.fig5_control_step, cfg, {}, ["table"])
     files["fig5_control"] = files.pop("table")
+    run(steps.evasive_network_step, cfg, {}, ["table"])
+    files["evasive_network"] = files.pop("table")
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

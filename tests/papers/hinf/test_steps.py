@@ -121,3 +121,12 @@ def test_fig5_control_table(hinf_run):
     assert t["stationary"].nunique() == 1  # one stationary reference, paired with every mobile run
     np.testing.assert_allclose(t["mobile"] - t["stationary"], t["mean_diff"], atol=1e-12)
     np.testing.assert_allclose(t["z"], t["mean_diff"] / t["se"])
+
+
+def test_evasive_network_table(hinf_run):
+    cfg, files = hinf_run
+    t = pd.read_csv(files["evasive_network"])
+    assert list(t.columns) == ["target", "run", "connected_fraction", "local", "decentralized"]
+    assert set(t["target"]) == set(cfg["paired"]["targets"])
+    assert (t.groupby("target").size() == cfg["paired"]["network_runs"]).all()
+    assert t["connected_fraction"].between(0, 1).all()

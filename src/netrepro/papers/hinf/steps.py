@@ -67,6 +67,10 @@ Tables (all under ``results/hinf/``)
     ``parameter, value, runs, horizon, start, stationary, mobile, mean_diff, se, z`` — Fig 5 (mobile minus stationary
     decentralized late error, paired over runs: same seed, target and noise stream) across the sweeps of the control
     gain ``Gamma`` and the speed limit ``v_max`` (``sensitivity`` runs, horizon and seed; window ``start..horizon``).
+``evasive_network.csv`` (issue 15)
+    ``target, run, connected_fraction, local, decentralized`` — the Fig-6 setting (``paired.scenario``) against each
+    target model, ``paired.network_runs`` runs, seed ``paired.seed``: per run, the fraction of steps of the late window
+    with a connected graph (25) and the late-window mean errors of the local and decentralized H-infinity filters.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
     connected_fraction, min_lambda2`` per trajectory run.
@@ -91,7 +95,7 @@ from .noise import NoiseModel, geometry, noise_covariance, noise_information, no
 __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
-    "evader_check_step", "network_step", "fig5_control_step",
+    "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
@@ -559,3 +563,24 @@ def fig5_control_step(params, inputs, outputs):
             rows.append({"parameter": key, "value": float(val), "runs": runs, "horizon": horizon, "start": start,
                          "stationary": float(b.mean()), "mobile": float(a.mean()), "mean_diff": m, "se": se, "z": z})
     return {"table": pd.DataFrame(rows)}
+
+
+def evasive_network_step(params, inputs, outputs):
+    """Is the Fig-6 network's disconnection what costs the decentralized filter? Per-run connectivity and errors.
+
+    The scenario ``paired.scenario`` is run against each target of ``paired.targets`` (agents moved by its
+    driver), with ``paired.network_runs`` runs and seed ``paired.seed``.
+    """
+    cfg, pc = params, params["paired"]
+    start = int(cfg["claims"]["late_start"])
+    rows = []
+    for target in pc["targets"]:
+        sc = resolve_scenario(cfg, pc["scenario"], runs=int(pc["network_runs"]), seed=int(pc["seed"]))
+        sc["target"] = target
+        sc["filters"] = ["local", "decentralized"]
+        out = simulate(sc)
+        conn = np.asarray(out["connected_runs"], dtype=float)[:, start:].mean(1)
+        loc, dec = (window_means(out["errors"][f], start) for f in ("local", "decentralized"))
+        rows.append(pd.DataFrame({"target": target, "run": np.arange(len(conn)), "connected_fraction": conn,
+                                  "local": loc, "decentralized": dec}))
+    return {"table": pd.concat(rows, ignore_index=True)}
