@@ -1,4 +1,4 @@
-"""A tiny run of every `hinf` step, shared by the step, claims and figure tests."""
+"""A tiny run of every `hinf` step, shared by the step, evidence and figure tests."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from netrepro.papers.hinf import claims, steps
+from netrepro.papers.hinf import steps
 from netrepro.papers.hinf.model import SCENARIOS
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -27,7 +27,7 @@ def tiny_section() -> dict:
     sv.update(runs=4, horizon=30, gamma=[1.5, 3.0], gamma_c=[0.5], K_p=[0.4], K_i=[0.2], h=[0.5], iters=[1])
     sec["claims"]["late_start"] = 20
     sec["paired"].update(runs=6)
-    sec["fig2_horizon"].update(runs=4, horizons=[30, 40])
+    sec["fig2_horizon"].update(runs=4, horizons=[30, 40], scenarios=["fig2", "fig3"])
     return sec
 
 
@@ -61,6 +61,7 @@ def hinf_run(tmp_path_factory):
             p = d / f"sim_{scen}_{kind}.csv"
             tabs[kind].to_csv(p, index=False)
             pieces[f"{kind}_{scen}"] = p
+        files[f"per_run_{scen}"] = pieces[f"per_run_{scen}"]
     run(steps.tables_step, {}, pieces, ["errors", "single", "trajectories", "summary", "paired"])
     run(steps.sensitivity_step, cfg, {}, ["table"])
     files["sensitivity"] = files.pop("table")
@@ -74,6 +75,10 @@ def hinf_run(tmp_path_factory):
     run(steps.evader_check_step, cfg, {}, ["table", "paired"])
     files["evader"], files["evader_paired"] = files.pop("table"), files.pop("paired")
     files["paired"] = paired
+    run(steps.fig5_control_step, cfg, {}, ["table"])
+    files["fig5_control"] = files.pop("table")
+    run(steps.evasive_network_step, cfg, {}, ["table"])
+    files["evasive_network"] = files.pop("table")
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

@@ -80,7 +80,7 @@ def test_issue17_steps_columns(hinf_run):
     fh = steps.fig2_horizon_step(cfg, {}, {})
     pa = fh["table"]
     assert list(pa.columns[:7]) == ["scenario", "agent", "horizon", "local", "decentralized", "ratio", "z"]
-    assert set(pa["scenario"]) == {"fig2", "fig2_ki0"}
+    assert set(pa["scenario"]) == {t for s in cfg["fig2_horizon"]["scenarios"] for t in (s, f"{s}_ki0")}
     np.testing.assert_allclose(pa["ratio"], pa["decentralized"] / pa["local"])
     # the local filter does not use the consensus: identical with and without the integral gain
     a = pa[pa["scenario"] == "fig2"].reset_index()
@@ -109,3 +109,24 @@ def test_evader_and_network_steps(hinf_run):
     links = net["table"]
     k0 = links[(links["scenario"] == "fig2") & (links["run"] == 0) & (links["k"] == 0)]
     assert len(k0) == 9
+
+
+def test_fig5_control_table(hinf_run):
+    cfg, files = hinf_run
+    t = pd.read_csv(files["fig5_control"])
+    assert list(t.columns) == ["parameter", "value", "runs", "horizon", "start", "stationary", "mobile", "mean_diff",
+                               "se", "z"]
+    sv = cfg["sensitivity"]
+    assert len(t) == len(sv["Gamma"]) + len(sv["v_max"])
+    assert t["stationary"].nunique() == 1  # one stationary reference, paired with every mobile run
+    np.testing.assert_allclose(t["mobile"] - t["stationary"], t["mean_diff"], atol=1e-12)
+    np.testing.assert_allclose(t["z"], t["mean_diff"] / t["se"])
+
+
+def test_evasive_network_table(hinf_run):
+    cfg, files = hinf_run
+    t = pd.read_csv(files["evasive_network"])
+    assert list(t.columns) == ["target", "run", "connected_fraction", "local", "decentralized"]
+    assert set(t["target"]) == set(cfg["paired"]["targets"])
+    assert (t.groupby("target").size() == cfg["paired"]["network_runs"]).all()
+    assert t["connected_fraction"].between(0, 1).all()

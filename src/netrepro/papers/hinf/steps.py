@@ -63,6 +63,14 @@ Tables (all under ``results/hinf/``)
 ``evader_paired.csv``
     ``solver, n_iter, runs, filter_a, filter_b, gamma, mean_diff, se, z, error_a, error_b`` — the H-infinity
     vs Kalman comparison repeated with the configured and the better-converged evader.
+``fig5_control.csv`` (issue 15)
+    ``parameter, value, runs, horizon, start, stationary, mobile, mean_diff, se, z`` — Fig 5 (mobile minus stationary
+    decentralized late error, paired over runs: same seed, target and noise stream) across the sweeps of the control
+    gain ``Gamma`` and the speed limit ``v_max`` (``sensitivity`` runs, horizon and seed; window ``start..horizon``).
+``evasive_network.csv`` (issue 15)
+    ``target, run, connected_fraction, local, decentralized`` — the Fig-6 setting (``paired.scenario``) against each
+    target model, ``paired.network_runs`` runs, seed ``paired.seed``: per run, the fraction of steps of the late window
+    with a connected graph (25) and the late-window mean errors of the local and decentralized H-infinity filters.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
     connected_fraction, min_lambda2`` per trajectory run.
@@ -87,7 +95,7 @@ from .noise import NoiseModel, geometry, noise_covariance, noise_information, no
 __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
-    "evader_check_step", "network_step",
+    "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
@@ -529,3 +537,50 @@ def network_step(params, inputs, outputs):
             for i, j in zip(*np.nonzero(np.triu(adj[k]))):
                 links.append({"scenario": scen, "run": int(run), "k": k, "i": ids[i], "j": ids[j]})
     return {"table": pd.DataFrame(links, columns=["scenario", "run", "k", "i", "j"]), "connectivity": pd.DataFrame(conn)}
+
+
+def fig5_control_step(params, inputs, outputs):
+    """Fig 5 re-judged across the control reconstructions: mobile vs stationary decentralized agents, paired.
+
+    For each value of ``sensitivity.Gamma`` and ``sensitivity.v_max`` (the other at its configured value) the
+    mobile scenario is simulated with the sensitivity runs, horizon and seed, and compared run by run with the
+    stationary scenario simulated once with the same settings (same seed: same target and noise stream).
+    """
+    cfg, sv = params, params["sensitivity"]
+    horizon, runs, seed = int(sv["horizon"]), int(sv["runs"]), int(sv["seed"])
+    start = min(int(cfg["claims"]["late_start"]), horizon // 2)
+    mobile = sv["mobile_scenario"]
+    fixed = resolve_scenario(cfg, "static_fixed", runs=runs, horizon=horizon, seed=seed)
+    fixed["filters"] = ["decentralized"]
+    b = window_means(simulate(fixed)["errors"]["decentralized"], start)
+    rows = []
+    for key in ("Gamma", "v_max"):
+        for val in sv[key]:
+            sc = resolve_scenario(cfg, mobile, runs=runs, horizon=horizon, seed=seed, control={key: val})
+            sc["filters"] = [sc["driver"]]
+            a = window_means(simulate(sc)["errors"][sc["driver"]], start)
+            m, se, z = paired_z(a, b)
+            rows.append({"parameter": key, "value": float(val), "runs": runs, "horizon": horizon, "start": start,
+                         "stationary": float(b.mean()), "mobile": float(a.mean()), "mean_diff": m, "se": se, "z": z})
+    return {"table": pd.DataFrame(rows)}
+
+
+def evasive_network_step(params, inputs, outputs):
+    """Is the Fig-6 network's disconnection what costs the decentralized filter? Per-run connectivity and errors.
+
+    The scenario ``paired.scenario`` is run against each target of ``paired.targets`` (agents moved by its
+    driver), with ``paired.network_runs`` runs and seed ``paired.seed``.
+    """
+    cfg, pc = params, params["paired"]
+    start = int(cfg["claims"]["late_start"])
+    rows = []
+    for target in pc["targets"]:
+        sc = resolve_scenario(cfg, pc["scenario"], runs=int(pc["network_runs"]), seed=int(pc["seed"]))
+        sc["target"] = target
+        sc["filters"] = ["local", "decentralized"]
+        out = simulate(sc)
+        conn = np.asarray(out["connected_runs"], dtype=float)[:, start:].mean(1)
+        loc, dec = (window_means(out["errors"][f], start) for f in ("local", "decentralized"))
+        rows.append(pd.DataFrame({"target": target, "run": np.arange(len(conn)), "connected_fraction": conn,
+                                  "local": loc, "decentralized": dec}))
+    return {"table": pd.concat(rows, ignore_index=True)}
