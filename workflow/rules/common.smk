@@ -150,5 +150,7 @@ def report_inputs(wildcards):
         named[f"{slug}_errata"] = spec["errata"]
         named[f"{slug}_reconstructions"] = spec["reconstructions"]
         named[f"{slug}_findings"] = spec["findings"]
+        named[f"{slug}_captions"] = spec["captions"]
+        named[f"{slug}_figure_list"] = spec["figure_list"]
         named[f"{slug}_notebook"] = spec["notebook"]
     return named

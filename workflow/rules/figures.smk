@@ -32,6 +32,9 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
                 step()
 
     _figures = [_spec.path for _spec in _specs]
+    # the notebook and the report show the captions and the figure list's layout notes
+    _captions = [f"workflow/report/{_slug}/{_spec.figure_id}.rst" for _spec in _specs]
+    _figure_list = f"src/netrepro/papers/{_slug}/figures.yaml"
     _verdicts = getattr(rules, f"{_slug}_claims").output
     _claims = _verdicts.table
     # papers not yet on the shared verdict step (issue 15) still have their own rules
@@ -56,6 +59,8 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             errata=_errata,
             reconstructions=_reconstructions,
             findings=_findings,
+            captions=_captions,
+            figure_list=_figure_list,
         output:
             html=f"report/{_slug}.html",
         log:
@@ -75,5 +80,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
         errata=_errata,
         reconstructions=_reconstructions,
         findings=_findings,
+        captions=_captions,
+        figure_list=_figure_list,
         notebook=f"report/{_slug}.html",
     )
