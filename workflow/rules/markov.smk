@@ -39,6 +39,22 @@ rule markov_lmi_checks:
         step("netrepro.papers.markov.steps:lmi_checks_step")
 
 
+rule markov_tight_variants:
+    input:
+        code=code("netrepro.papers.markov.steps:tight_variants_step"),
+    output:
+        table="results/markov/tight_variants.csv",
+    log:
+        "logs/markov/tight_variants.log",
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(pick(MCFG, "examples", "checks")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.markov.steps:tight_variants_step")
+
+
 rule markov_iid_line:
     input:
         code=code("netrepro.papers.markov.steps:iid_line_step"),
@@ -133,6 +149,7 @@ rule markov_evidence:
     input:
         code=code("netrepro.papers.markov.evidence:evidence_step"),
         checks=rules.markov_lmi_checks.output.table,
+        tight=rules.markov_tight_variants.output.table,
         curves=rules.markov_critical_curves.output.table,
         iid=rules.markov_iid_line.output.table,
         map=rules.markov_stability_map.output.table,
@@ -175,6 +192,7 @@ if enabled("markov"):
         rules.markov_critical_curves.output.table,
         rules.markov_critical_curves.output.benchmark,
         rules.markov_lmi_checks.output.table,
+        rules.markov_tight_variants.output.table,
         rules.markov_iid_line.output.table,
         rules.markov_exact_moments.output.table,
         rules.markov_stability_map.output.table,

@@ -11,7 +11,7 @@ from netrepro.papers.markov import checks, evidence, steps
 __all__ = ["tiny_config", "run_all", "NAMES"]
 
 ROOT = Path(__file__).resolve().parents[3]
-NAMES = ("curves", "bench", "checks", "iid", "moments", "map", "sensitivity", "paths", "check", "evidence",
+NAMES = ("curves", "bench", "checks", "tight", "iid", "moments", "map", "sensitivity", "paths", "check", "evidence",
          "expectations")
 
 
@@ -40,11 +40,12 @@ def run_all(cfg: dict, tmp: Path) -> dict:
     t = {name: tmp / f"{name}.csv" for name in NAMES}
     _run(steps.critical_curves_step, cfg, {}, {"table": t["curves"], "benchmark": t["bench"]})
     _run(steps.lmi_checks_step, cfg, {}, {"table": t["checks"]})
+    _run(steps.tight_variants_step, cfg, {}, {"table": t["tight"]})
     _run(steps.iid_line_step, cfg, {}, {"table": t["iid"]})
     _run(steps.exact_moments_step, cfg, {}, {"table": t["moments"]})
     _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"], "sensitivity": t["sensitivity"]})
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
     _run(steps.expectations_step, cfg, {"moments": t["moments"]}, {"table": t["expectations"]})
-    _run(evidence.evidence_step, cfg, {"checks": t["checks"], "curves": t["curves"], "iid": t["iid"], "map": t["map"],
-                                       "sensitivity": t["sensitivity"], "moments": t["moments"]}, {"table": t["evidence"]})
+    _run(evidence.evidence_step, cfg, {"checks": t["checks"], "tight": t["tight"], "curves": t["curves"], "iid": t["iid"],
+                                       "map": t["map"], "sensitivity": t["sensitivity"], "moments": t["moments"]}, {"table": t["evidence"]})
     return t

@@ -128,3 +128,16 @@ def test_evidence_step_feeds_every_claim(markov_tables):
     assert float(errata.loc["E10_prop2_signed_measure", "residual_printed"]) > 0
     assert float(errata.loc["E10_prop2_signed_measure", "residual_corrected"]) == 0
     assert len(findings_table(data, ev)) == len(data.findings)
+
+
+def test_tight_variants_bracket_the_closed_form(markov_tables):
+    """Every tolerance's certified bracket at q = 0.5 contains the Example II critical value derived by hand:
+    |lambda|^4 (pq + (1-q)^2) = 1 with |lambda| = 1.2, i.e. p = (1 - 2.0736 / 4) / (2.0736 / 2)."""
+    t = pd.read_csv(markov_tables["tight"])
+    t = t[t.check == "exII_q05"]
+    assert len(t) >= 2
+    p_c = (1 - 2.0736 / 4) / (2.0736 / 2)
+    assert p_c == pytest.approx(0.4645061728, abs=1e-10)
+    assert ((t.p_lower <= p_c) & (t.p_upper >= p_c)).all()
+    # below ~1e-7 the certified bracket stops shrinking with the tolerance (solver accuracy near the edge)
+    assert ((t.p_upper - t.p_lower)[t.tol <= 1e-6] < 1e-6).all()

@@ -187,10 +187,6 @@ def _system(ex):
     return LinearSystem.from_config(ex)
 
 
-def _fmt_cfg(value) -> str:
-    return str(value)
-
-
 # ----------------------------------------------------------------------------- evidence blocks
 def _section51_rows(ex1, checks, curves):
     A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
@@ -222,10 +218,10 @@ def _section51_rows(ex1, checks, curves):
         if check == "exI_fig3_p05":
             note += f"; Proposition 1 bound at q = 0.65 is {p_prop1:.4f} < 0.5 (it does not cover Fig 3)"
         rows.append(dict(quantity=name, value=bool(r.certified and r.verdict == "feasible"), note=note))
-    return rows, p_prop1, closed
+    return rows
 
 
-def _section52_rows(ex2, checks, moments, growth_margins, growth_margin):
+def _section52_rows(ex2, checks, tight, moments, growth_margins, growth_margin):
     lam2 = spectral_abs(ex2["A"])
     A2, C2 = np.asarray(ex2["A"], float), np.asarray(ex2["C"], float)
     lo2 = observability_index(A2, C2)
@@ -241,6 +237,8 @@ def _section52_rows(ex2, checks, moments, growth_margins, growth_margin):
                   f"closed form of the true critical value (1 - (|l|^2 (1-q))^2) / (|l|^4 q) = {analytic:.9f} lies "
                   f"{'inside' if lower <= analytic <= upper else 'OUTSIDE'} the bracket"),
     ]
+    for t in tight[tight.check == "exII_q05"].itertuples():
+        rows.append(dict(quantity="exII.p_thm5_q05", variant=f"tight_tol={t.tol:g}", value=float(t.p_lower)))
     r = ck.loc["exII_thm5_p0465"]
     rows.append(dict(quantity="exII.p0465_certified", value=bool(r.certified and r.verdict == "feasible"),
                      note=f"at p = 0.465 the LMI is certified {r.verdict} ({r.evidence}); p_underline = {lower:.6f}"))
@@ -367,7 +365,7 @@ def _prop2_rows(params, moments):
     return rows
 
 
-def _errata_rows(ex1, ex2, lower, analytic, seed):
+def _errata_rows(ex1, lower, analytic, seed):
     A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
     rng = np.random.default_rng(seed)
     schur = schur_residual(A1, C1, 0.5, 0.65, rng)
@@ -392,7 +390,7 @@ def _errata_rows(ex1, ex2, lower, analytic, seed):
     ]
 
 
-def _reconstruction_rows(params, sens):
+def _reconstruction_rows(params, sens, tight):
     ex, sp, xc, mp = params["examples"], params["paths"], params["expectations"], params["map"]
     mc, mr, es = mp["certify"], mp["refine"], params["estimator"]
 
@@ -403,7 +401,8 @@ def _reconstruction_rows(params, sens):
     vals = {
         "examples.Sigma0": (f"{ex['I']['Sigma0']} / {ex['II']['Sigma0']}", ""),
         "checks.eps": (params["checks"]["eps"], ""),
-        "checks.tight_tol": (params["checks"]["tight_tol"], ""),
+        "checks.tight_tol": (params["checks"]["tight_tol"], "tight_variants.csv: certified bracket per tolerance: " + "; ".join(
+            f"{t.check} tol {t.tol:g}: [{t.p_lower:.9f}, {t.p_upper:.9f}]" for t in tight.itertuples())),
         "paths.horizon": (sp["horizon"], ""),
         "paths.seed": (sp["seed"], ""),
         "paths.n_paths": (f"{sp['n_paths']} / {sp['rb_paths']} (rb_paths, horizon {sp['rb_horizon']})", ""),
@@ -426,14 +425,14 @@ def _reconstruction_rows(params, sens):
         "prop2.grid": (f"p {params['prop2']['p_min']}..{params['prop2']['p_max']} ({params['prop2']['p_points']}), "
                        f"q {params['prop2']['q']}, k_max {params['prop2']['k_max']}", ""),
     }
-    return [dict(quantity=f"reconstruction.{k}", value=_fmt_cfg(v), note=n) for k, (v, n) in vals.items()]
+    return [dict(quantity=f"reconstruction.{k}", value=str(v), note=n) for k, (v, n) in vals.items()]
 
 
 def evidence_step(params, inputs, outputs):
     """Step of rule ``markov_evidence``: ``results/evidence/markov.csv``.
 
-    ``params``: the ``markov`` configuration (examples, checks, curves, paths, exact, expectations,
-    map, estimator, prop2, errata_seed); ``inputs``: ``checks, curves, iid, map, sensitivity, moments``.
+    ``params``: the ``markov`` configuration (examples, checks, curves, iid, paths, exact, expectations,
+    map, estimator, prop2, errata_seed); ``inputs``: ``checks, tight, curves, iid, map, sensitivity, moments``.
     """
     ex1, ex2 = params["examples"]["I"], params["examples"]["II"]
     checks = pd.read_csv(inputs["checks"]).set_index("check")
@@ -442,14 +441,15 @@ def evidence_step(params, inputs, outputs):
     smap = pd.read_csv(inputs["map"], keep_default_na=False)
     sens = pd.read_csv(inputs["sensitivity"])
     moments = pd.read_csv(inputs["moments"])
-    rows, _, _ = _section51_rows(ex1, checks, curves)
-    r52, lower, analytic = _section52_rows(ex2, checks, moments, params["map"]["sensitivity"]["growth_margin"],
+    rows = _section51_rows(ex1, checks, curves)
+    tight = pd.read_csv(inputs["tight"])
+    r52, lower, analytic = _section52_rows(ex2, checks, tight, moments, params["map"]["sensitivity"]["growth_margin"],
                                            params["map"]["certify"]["growth_margin"])
     rows += r52
     rows += _curve_rows(curves, params)
     rows += _iid_rows(iid, params["iid"]["tol"])
     rows += _map_rows(smap, curves, params)
     rows += _prop2_rows(params, moments)
-    rows += _errata_rows(ex1, ex2, lower, analytic, params["errata_seed"])
-    rows += _reconstruction_rows(params, sens)
+    rows += _errata_rows(ex1, lower, analytic, params["errata_seed"])
+    rows += _reconstruction_rows(params, sens, tight)
     return {"table": evidence_frame(rows)}

@@ -20,6 +20,9 @@ Tables (``results/markov/``)
 ``lmi_checks.csv``
     point checks of Theorem 2 / 5: ``check, example, p, q, status, margin, solver_feasible,
     certified, rho_H, lyap_margin``.
+``tight_variants.csv``
+    the tight Theorem 5 bisections repeated at each ``checks.tight_tol_variants``: ``check, example,
+    q, tol, p_lower, p_upper, certified, n_solves``.
 ``lmi_benchmark.csv``
     ``mode`` (parametrised / rebuilt), ``n_solves, seconds, solves_per_second``.
 ``iid_line.csv``
@@ -180,6 +183,25 @@ def lmi_checks_step(params, inputs, outputs):
                          "status": r.status, "verdict": _verdict(r), "evidence": r.evidence,
                          "margin": r.margin, "solver_feasible": r.solver_feasible,
                          "certified": r.certified, "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
+    return {"table": pd.DataFrame(rows)}
+
+
+def tight_variants_step(params, inputs, outputs):
+    """The tight Theorem 5 bisections (eq. 12) repeated at every tolerance of ``checks.tight_tol_variants``.
+
+    Table ``tight_variants.csv``: ``check, example, q, tol, p_lower, p_upper, certified, n_solves``; the
+    claims on ``p_underline`` are re-judged across these tolerances.
+    """
+    ck = params["checks"]
+    rows = []
+    for item in ck["tight"]:
+        ex = params["examples"][item["example"]]
+        lmi = GilbertElliottLMI(np.asarray(ex["A"], float), np.asarray(ex["C"], float))
+        for tol in ck["tight_tol_variants"]:
+            res = thm5_lower_bound(lmi, float(item["q"]), 1.0, float(tol))
+            rows.append({"check": item["name"], "example": item["example"], "q": item["q"], "tol": float(tol),
+                         "p_lower": res["p_lower"], "p_upper": res["p_upper"], "certified": res["certified"],
+                         "n_solves": res["n_solves"]})
     return {"table": pd.DataFrame(rows)}
 
 
