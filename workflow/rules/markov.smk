@@ -1,5 +1,6 @@
 # Paper `markov` (004): Wu, Shi, Anderson, Johansson, Kalman filtering over Gilbert-Elliott channels.
-# Compute steps -> tables under results/markov/, claims, errata, reconstructions.
+# Compute steps -> tables under results/markov/ and the evidence table; the shared rule markov_claims
+# (workflow/rules/verdicts.smk) judges the claims in src/netrepro/papers/markov/*.yaml against it.
 # Figure and notebook rules are generated (src/netrepro/papers/markov/figures.yaml, figures.smk).
 
 MCFG = config.get("markov", {})
@@ -36,6 +37,22 @@ rule markov_lmi_checks:
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:lmi_checks_step")
+
+
+rule markov_tight_variants:
+    input:
+        code=code("netrepro.papers.markov.steps:tight_variants_step"),
+    output:
+        table="results/markov/tight_variants.csv",
+    log:
+        "logs/markov/tight_variants.log",
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(pick(MCFG, "examples", "checks")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.markov.steps:tight_variants_step")
 
 
 rule markov_iid_line:
@@ -84,7 +101,7 @@ rule markov_stability_map:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(pick(MCFG, "examples", "map")),
+        cfg=as_json(pick(MCFG, "examples", "map", "estimator")),
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:stability_map_step")
@@ -102,7 +119,7 @@ rule markov_sample_paths:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(pick(MCFG, "examples", "paths")),
+        cfg=as_json(pick(MCFG, "examples", "paths", "estimator")),
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:sample_paths_step")
@@ -122,68 +139,52 @@ rule markov_expectations:
     resources:
         mem_mb=1000,
     params:
-        cfg=as_json(pick(MCFG, "examples", "paths", "expectations")),
+        cfg=as_json(pick(MCFG, "examples", "paths", "expectations", "estimator")),
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:expectations_step")
 
 
-rule markov_errata:
+rule markov_evidence:
     input:
-        code=code("netrepro.papers.markov.claims:errata_step"),
+        code=code("netrepro.papers.markov.evidence:evidence_step"),
         checks=rules.markov_lmi_checks.output.table,
-    output:
-        table="results/errata/markov.csv",
-    log:
-        "logs/markov/errata.log",
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(pick(MCFG, "examples")),
-        io=io_json,
-    shell:
-        step("netrepro.papers.markov.claims:errata_step")
-
-
-rule markov_reconstructions:
-    input:
-        code=code("netrepro.papers.markov.claims:reconstructions_step"),
-    output:
-        table="results/reconstructions/markov.csv",
-    log:
-        "logs/markov/reconstructions.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(
-            pick(MCFG, "examples", "paths", "checks", "exact", "map", "curves", "expectations")
-        ),
-        io=io_json,
-    shell:
-        step("netrepro.papers.markov.claims:reconstructions_step")
-
-
-rule markov_claims:
-    input:
-        code=code("netrepro.papers.markov.claims:claims_step"),
-        checks=rules.markov_lmi_checks.output.table,
+        tight=rules.markov_tight_variants.output.table,
         curves=rules.markov_critical_curves.output.table,
         iid=rules.markov_iid_line.output.table,
         map=rules.markov_stability_map.output.table,
+        sensitivity=rules.markov_stability_map.output.sensitivity,
         moments=rules.markov_exact_moments.output.table,
     output:
-        table="results/claims/markov.csv",
+        table="results/evidence/markov.csv",
     log:
-        "logs/markov/claims.log",
+        "logs/markov/evidence.log",
     localrule: True
     conda:
         CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=500,
     params:
-        cfg=as_json(pick(MCFG, "examples", "map")),
+        cfg=as_json(
+            pick(
+                MCFG,
+                "examples",
+                "paths",
+                "checks",
+                "exact",
+                "map",
+                "curves",
+                "iid",
+                "expectations",
+                "estimator",
+                "prop2",
+                "errata_seed",
+            )
+        ),
         io=io_json,
     shell:
-        step("netrepro.papers.markov.claims:claims_step")
+        step("netrepro.papers.markov.evidence:evidence_step")
 
 
 if enabled("markov"):
@@ -191,6 +192,7 @@ if enabled("markov"):
         rules.markov_critical_curves.output.table,
         rules.markov_critical_curves.output.benchmark,
         rules.markov_lmi_checks.output.table,
+        rules.markov_tight_variants.output.table,
         rules.markov_iid_line.output.table,
         rules.markov_exact_moments.output.table,
         rules.markov_stability_map.output.table,
@@ -198,4 +200,5 @@ if enabled("markov"):
         rules.markov_sample_paths.output.table,
         rules.markov_sample_paths.output.check,
         rules.markov_expectations.output.table,
+        rules.markov_evidence.output.table,
     ]

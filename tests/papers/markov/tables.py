@@ -1,4 +1,4 @@
-"""All `markov` steps run once on a tiny configuration; the tables are shared by the step, claims and figure tests."""
+"""All `markov` steps run once on a tiny configuration; the tables are shared by the step, evidence and figure tests."""
 
 from __future__ import annotations
 
@@ -6,13 +6,13 @@ from pathlib import Path
 
 import yaml
 
-from netrepro.papers.markov import checks, claims, steps
+from netrepro.papers.markov import checks, evidence, steps
 
 __all__ = ["tiny_config", "run_all", "NAMES"]
 
 ROOT = Path(__file__).resolve().parents[3]
-NAMES = ("curves", "bench", "checks", "iid", "moments", "map", "sensitivity", "paths", "check", "claims", "errata",
-         "recon", "expectations")
+NAMES = ("curves", "bench", "checks", "tight", "iid", "moments", "map", "sensitivity", "paths", "check", "evidence",
+         "expectations")
 
 
 def tiny_config() -> dict:
@@ -36,17 +36,16 @@ def _run(fn, params, inputs, outputs):
 
 
 def run_all(cfg: dict, tmp: Path) -> dict:
-    """Run every compute step, claims, errata and reconstructions; return ``{name: path}``."""
+    """Run every compute step and the evidence step; return ``{name: path}``."""
     t = {name: tmp / f"{name}.csv" for name in NAMES}
     _run(steps.critical_curves_step, cfg, {}, {"table": t["curves"], "benchmark": t["bench"]})
     _run(steps.lmi_checks_step, cfg, {}, {"table": t["checks"]})
+    _run(steps.tight_variants_step, cfg, {}, {"table": t["tight"]})
     _run(steps.iid_line_step, cfg, {}, {"table": t["iid"]})
     _run(steps.exact_moments_step, cfg, {}, {"table": t["moments"]})
     _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"], "sensitivity": t["sensitivity"]})
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
     _run(steps.expectations_step, cfg, {"moments": t["moments"]}, {"table": t["expectations"]})
-    _run(claims.claims_step, cfg, {"checks": t["checks"], "curves": t["curves"], "iid": t["iid"], "map": t["map"],
-                                   "moments": t["moments"]}, {"table": t["claims"]})
-    _run(claims.errata_step, cfg, {"checks": t["checks"]}, {"table": t["errata"]})
-    _run(claims.reconstructions_step, cfg, {}, {"table": t["recon"]})
+    _run(evidence.evidence_step, cfg, {"checks": t["checks"], "tight": t["tight"], "curves": t["curves"], "iid": t["iid"],
+                                       "map": t["map"], "sensitivity": t["sensitivity"], "moments": t["moments"]}, {"table": t["evidence"]})
     return t

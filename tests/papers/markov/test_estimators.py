@@ -52,9 +52,9 @@ def test_plain_mean_understates_beyond_boundary():
 
 def test_rb_trace_grid_matches_single_point_estimator():
     rng = np.random.default_rng(8)
-    m, h = estimators.rb_trace_grid(EX1, np.eye(2), [0.5], [0.5], 400, 40, rng, n_batches=10)
+    m, h = estimators.rb_trace_grid(EX1, np.eye(2), [0.5], [0.5], 400, 40, rng, n_batches=10, z=1.96)
     arr = estimators.gilbert_elliott_arrivals(np.random.default_rng(9), 4000, 40, 0.5, 0.5, initial=1)
-    m2, lo, hi = estimators.rb_mean_trace(EX1, np.eye(2), 0.5, 0.5, arr)
+    m2, lo, hi = estimators.rb_mean_trace(EX1, np.eye(2), 0.5, 0.5, arr, n_batches=20, z=1.96)
     assert abs(m[0, -1] - m2[-1]) < 3 * (h[0, -1] + (hi[-1] - lo[-1]) / 2)
 
 
@@ -68,6 +68,6 @@ def test_linear_trace_estimator_is_unbiased(system):
     per_path = estimators.rb_mean_norm(system, np.eye(system.n), p, q, arr, which="trace")
     exact = exact_moments(system, np.eye(system.n), T).mean(p, q, "trace")
     assert np.allclose(w @ per_path, exact, rtol=1e-10)
-    mean, _, _ = estimators.rb_mean_trace(system, np.eye(system.n), p, q, arr, n_batches=len(arr))
+    mean, _, _ = estimators.rb_mean_trace(system, np.eye(system.n), p, q, arr, n_batches=len(arr), z=1.96)
     assert np.allclose(mean, per_path.mean(axis=0), rtol=1e-10)
 

@@ -64,23 +64,23 @@ def test_asymptote_backtest_on_example2(p):
 def test_conditional_estimate_against_enumeration():
     """Example I, k <= 8: the conditional estimate agrees with brute-force enumeration within its interval."""
     S0 = np.eye(2)
-    mean, half = xp.conditional_estimate(EX1, S0, 0.5, 0.65, 3000, 7, np.random.default_rng(7))
+    mean, half = xp.conditional_estimate(EX1, S0, 0.5, 0.65, 3000, 7, np.random.default_rng(7), 1.96)
     exact_vals = np.array([_brute_force_mean(EX1, S0, 0.5, 0.65, k) for k in range(2, 9)])
     exact_vals = np.concatenate([[np.linalg.norm(S0, 2)], exact_vals])
-    zmax, ok = xp.conditional_validation(mean, half, exact_vals, 4.0)
+    zmax, ok = xp.conditional_validation(mean, half, exact_vals, 4.0, 1.96, 1e-9)
     assert ok, zmax
     assert np.all(half[1:] / mean[1:] < 0.1)
 
 
 def test_conditional_validation_rejects():
     exact_vals = np.array([1.0, 2.0, 3.0])
-    zmax, ok = xp.conditional_validation(np.array([1.0, 2.0, 3.5]), np.array([0.0, 0.0, 0.196]), exact_vals, 4.0)
+    zmax, ok = xp.conditional_validation(np.array([1.0, 2.0, 3.5]), np.array([0.0, 0.0, 0.196]), exact_vals, 4.0, 1.96, 1e-9)
     assert not ok and zmax == pytest.approx(5.0)
     # deterministic value (zero half-width) that disagrees: rejected
-    zmax, ok = xp.conditional_validation(np.array([1.0, 2.1, 3.0]), np.array([0.0, 0.0, 0.196]), exact_vals, 4.0)
+    zmax, ok = xp.conditional_validation(np.array([1.0, 2.1, 3.0]), np.array([0.0, 0.0, 0.196]), exact_vals, 4.0, 1.96, 1e-9)
     assert not ok and np.isinf(zmax)
     with pytest.raises(InputError):
-        xp.conditional_validation(np.array([1.0]), np.array([0.0]), exact_vals, 4.0)
+        xp.conditional_validation(np.array([1.0]), np.array([0.0]), exact_vals, 4.0, 1.96, 1e-9)
 
 
 def test_expectations_table(markov_tables, markov_cfg):

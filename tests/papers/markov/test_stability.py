@@ -21,11 +21,11 @@ def test_classify_growth():
 def test_long_horizon_refinement_trusts_only_narrow_intervals():
     """Example I near its boundary is resolved; Example II's parity tail is flagged as untrusted."""
     opts = {"enabled": True, "n_paths": 200, "horizon": 160, "n_batches": 10, "rel_tol": 0.1, "bounded_tol": 0.003,
-            "unbounded_tol": 0.01, "chunk": 64, "seed": 4242, "pilot_paths": 100, "pilot_horizon": 60}
+            "unbounded_tol": 0.01, "chunk": 64, "seed": 4242, "pilot_paths": 100, "pilot_horizon": 60, "pilot_factor": 2.0}
     rng = np.random.default_rng(6)
-    rate, rel, verdict = stability.refine_long_horizon(EX1, np.eye(2), np.array([0.5, 0.5]), np.array([0.36, 0.5]), opts, rng)
+    rate, rel, verdict = stability.refine_long_horizon(EX1, np.eye(2), np.array([0.5, 0.5]), np.array([0.36, 0.5]), opts, rng, 1.96)
     assert list(verdict) == ["unbounded", "bounded"]
     assert rate[0] == pytest.approx(np.log(1.69 * 0.64), abs=0.01)  # trailing loss-run growth |lambda|^2 (1-q)
-    _, _, verdict2 = stability.refine_long_horizon(EX2, np.eye(3), np.array([0.99]), np.array([0.5]), opts, rng)
+    _, _, verdict2 = stability.refine_long_horizon(EX2, np.eye(3), np.array([0.99]), np.array([0.5]), opts, rng, 1.96)
     assert verdict2[0] == "undecided"
 

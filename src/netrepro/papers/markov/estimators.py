@@ -107,7 +107,7 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
     return out
 
 
-def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int = 20):
+def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int, z: float):
     """Conditional estimator of ``E tr P_k`` for long horizons, with batch means.
 
     Same decomposition as :func:`rb_mean_norm`, but for the trace, which is *linear* in the
@@ -127,10 +127,12 @@ def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int = 20):
         With ``arrivals[:, 0]`` all True.
     n_batches : int
         Number of batches of the confidence interval.
+    z : float
+        Normal quantile of the interval (``config.yaml``: ``markov.estimator.interval_z``; 1.96: 95%).
 
     Returns
     -------
-    (mean, low, high): arrays of length ``T + 1`` (``k = 1..T+1``), 95% batch-means interval.
+    (mean, low, high): arrays of length ``T + 1`` (``k = 1..T+1``), batch-means interval ``mean +- z s / sqrt(B)``.
     """
     arrivals = np.asarray(arrivals, dtype=bool)
     if not arrivals[:, 0].all():
@@ -160,11 +162,11 @@ def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int = 20):
             w = np.where(i < k - 1, p * (1.0 - q) ** np.maximum(k - 2 - i, 0), 1.0)
             vals[:, k - 1] = np.sum(w * (inner[:, i - 1, j] + c[j] * f[:, i - 1]), axis=1)
     mean = vals.mean(axis=0)
-    half = 1.96 * vals.std(axis=0, ddof=1) / np.sqrt(len(batches))
+    half = z * vals.std(axis=0, ddof=1) / np.sqrt(len(batches))
     return mean, mean - half, mean + half
 
 
-def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_batches: int = 10):
+def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_batches: int, z: float):
     """:func:`rb_mean_trace` for many ``(p, q)`` points at once (all paths of all points in one batch).
 
     Memory is ``O(points x paths)``: the batch sums of ``1{gamma_i = 1} P_{i+1}`` are accumulated
@@ -184,11 +186,13 @@ def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_bat
         Random source.
     n_batches : int
         Number of batches of the confidence interval.
+    z : float
+        Normal quantile of the interval (``markov.estimator.interval_z``; 1.96: 95%).
 
     Returns
     -------
-    (mean, half): arrays ``(n_points, horizon + 1)``, the estimate of ``E tr P_k`` and the 95%
-    batch-means half-width.
+    (mean, half): arrays ``(n_points, horizon + 1)``, the estimate of ``E tr P_k`` and the
+    batch-means half-width ``z s / sqrt(B)``.
     """
     ps, qs = np.atleast_1d(np.asarray(ps, float)), np.atleast_1d(np.asarray(qs, float))
     npts, B, T = len(ps), n_batches, horizon
@@ -225,7 +229,7 @@ def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_bat
             vals[:, k - 1] = np.sum(w * (inner[:, i - 1, j] + c[j] * f[:, i - 1]), axis=1)
     vals = vals.reshape(npts, B, T + 1)
     mean = vals.mean(axis=1)
-    half = 1.96 * vals.std(axis=1, ddof=1) / np.sqrt(B)
+    half = z * vals.std(axis=1, ddof=1) / np.sqrt(B)
     return mean, half
 
 

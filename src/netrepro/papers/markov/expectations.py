@@ -65,11 +65,11 @@ def two_step_rate(A, C, Q, p, q) -> float:
     return float(rate)
 
 
-def conditional_estimate(system, Sigma0, p, q, n_paths: int, horizon: int, rng):
+def conditional_estimate(system, Sigma0, p, q, n_paths: int, horizon: int, rng, z: float):
     """Conditional (Rao-Blackwellised) estimate of ``E||P_k||``, ``k = 1..horizon+1``, with a 95% interval.
 
     The per-path values of :func:`.estimators.rb_mean_norm` (trailing loss run integrated exactly)
-    are independent across paths, so the interval is ``mean +- 1.96 s / sqrt(N)``.
+    are independent across paths, so the interval is ``mean +- z s / sqrt(N)``.
 
     Parameters
     ----------
@@ -83,6 +83,8 @@ def conditional_estimate(system, Sigma0, p, q, n_paths: int, horizon: int, rng):
         Number of channel paths and of steps.
     rng : numpy.random.Generator
         Random source.
+    z : float
+        Normal quantile of the interval (``markov.estimator.interval_z``; 1.96: 95%).
 
     Returns
     -------
@@ -92,16 +94,16 @@ def conditional_estimate(system, Sigma0, p, q, n_paths: int, horizon: int, rng):
     arrivals = est.gilbert_elliott_arrivals(rng, n_paths, horizon, p, q, initial=1)
     vals = est.rb_mean_norm(system, Sigma0, p, q, arrivals)
     mean = vals.mean(axis=0)
-    half = 1.96 * vals.std(axis=0, ddof=1) / np.sqrt(n_paths)
+    half = z * vals.std(axis=0, ddof=1) / np.sqrt(n_paths)
     return mean, half
 
 
-def conditional_validation(mean, half, exact, z_max: float):
+def conditional_validation(mean, half, exact, z_max: float, z: float, rtol: float):
     """Largest ``|z|`` of the conditional estimate against the exact values on the exact range.
 
-    ``z_k = (mean_k - exact_k) / (half_k / 1.96)`` for ``k = 2..K`` (``k = 1`` is deterministic);
-    where the estimate is deterministic (``half_k <= 1e-9 exact_k``, e.g. ``k = 2``: ``gamma_1 = 1``)
-    the values must agree to ``1e-9`` relative instead (``z = 0`` if they do, ``inf`` if not).
+    ``z_k = (mean_k - exact_k) / (half_k / z)`` for ``k = 2..K`` (``k = 1`` is deterministic);
+    where the estimate is deterministic (``half_k <= rtol exact_k``, e.g. ``k = 2``: ``gamma_1 = 1``)
+    the values must agree to ``rtol`` relative instead (``z = 0`` if they do, ``inf`` if not).
 
     Parameters
     ----------
@@ -111,6 +113,10 @@ def conditional_validation(mean, half, exact, z_max: float):
         Exact ``E||P_k||``, ``k = 1..K`` (:meth:`.exact.ExactMoments.mean`).
     z_max : float
         Largest admissible ``|z|``.
+    z : float
+        The quantile that made ``half`` (``markov.estimator.interval_z``).
+    rtol : float
+        Relative tolerance of the deterministic case (``markov.estimator.deterministic_rtol``).
 
     Returns
     -------
@@ -119,11 +125,11 @@ def conditional_validation(mean, half, exact, z_max: float):
     K = len(exact)
     if len(mean) < K:
         raise InputError(f"the estimate has {len(mean)} values; need at least the {K} exact ones")
-    se = half[1:K] / 1.96
+    se = half[1:K] / z
     diff = mean[1:K] - exact[1:]
-    det = se <= 1e-9 * np.abs(exact[1:])
+    det = se <= rtol * np.abs(exact[1:])
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = np.where(det, np.where(np.abs(diff) <= 1e-9 * np.abs(exact[1:]), 0.0, np.inf), diff / se)
+        z = np.where(det, np.where(np.abs(diff) <= rtol * np.abs(exact[1:]), 0.0, np.inf), diff / se)
     zmax = float(np.max(np.abs(z))) if len(z) else 0.0
     return zmax, bool(zmax <= z_max)
 

@@ -50,7 +50,7 @@ def classify_growth(means: np.ndarray, bounded_tol: float, unbounded_tol: float)
     return rate, x2, verdict
 
 
-def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
+def refine_long_horizon(system, Sigma0, ps, qs, opts, rng, z: float):
     """Long-horizon verdicts from the conditional trace estimator (:func:`~.estimators.rb_trace_grid`).
 
     The growth rate is ``log(m_T / m_{T/2}) / (T/2)``. The estimator integrates the trailing loss
@@ -58,7 +58,7 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
     95% half-width stays below ``rel_tol`` of the mean over ``k >= T/2`` (a heavy tail that is not
     a trailing loss run, e.g. Example II's parity-locked receptions, shows up as a wide interval);
     elsewhere the verdict stays ``undecided``. A short pilot run screens out points whose interval
-    is already wider than twice ``rel_tol``.
+    is already wider than ``pilot_factor`` times ``rel_tol``.
 
     Parameters
     ----------
@@ -72,6 +72,8 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
         Estimator settings (``config.yaml``: ``markov.map.refine``).
     rng : numpy.random.Generator
         Random source.
+    z : float
+        Normal quantile of the batch-means interval (``markov.estimator.interval_z``).
 
     Returns
     -------
@@ -81,7 +83,7 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
         rates, rels = [], []
         for start in range(0, len(idx), opts["chunk"]):
             sel = idx[start:start + opts["chunk"]]
-            m, h = rb_trace_grid(system, Sigma0, ps[sel], qs[sel], n_paths, T, rng, opts["n_batches"])
+            m, h = rb_trace_grid(system, Sigma0, ps[sel], qs[sel], n_paths, T, rng, opts["n_batches"], z)
             with np.errstate(divide="ignore", invalid="ignore"):
                 rates.append(np.log(m[:, -1] / m[:, T // 2]) / (T - T // 2))
                 rels.append(np.max(h[:, T // 2:] / m[:, T // 2:], axis=1))
@@ -91,7 +93,7 @@ def refine_long_horizon(system, Sigma0, ps, qs, opts, rng):
     rate, rel = np.full(len(ps), np.nan), np.full(len(ps), np.inf)
     # pilot: a short, cheap run; points whose interval is already wide are not worth the long run
     _, rel_pilot = run(np.arange(len(ps)), opts["pilot_paths"], opts["pilot_horizon"])
-    keep = np.flatnonzero(np.isfinite(rel_pilot) & (rel_pilot < 2 * opts["rel_tol"]))
+    keep = np.flatnonzero(np.isfinite(rel_pilot) & (rel_pilot < opts["pilot_factor"] * opts["rel_tol"]))
     rate[keep], rel[keep] = run(keep, opts["n_paths"], opts["horizon"])
     reliable = np.isfinite(rate) & np.isfinite(rel) & (rel < opts["rel_tol"])
     verdict = np.where(~reliable, "undecided", np.where(rate < opts["bounded_tol"], "bounded",

@@ -20,6 +20,9 @@ Tables (``results/markov/``)
 ``lmi_checks.csv``
     point checks of Theorem 2 / 5: ``check, example, p, q, status, margin, solver_feasible,
     certified, rho_H, lyap_margin``.
+``tight_variants.csv``
+    the tight Theorem 5 bisections repeated at each ``checks.tight_tol_variants``: ``check, example,
+    q, tol, p_lower, p_upper, certified, n_solves``.
 ``lmi_benchmark.csv``
     ``mode`` (parametrised / rebuilt), ``n_solves, seconds, solves_per_second``.
 ``iid_line.csv``
@@ -183,6 +186,25 @@ def lmi_checks_step(params, inputs, outputs):
     return {"table": pd.DataFrame(rows)}
 
 
+def tight_variants_step(params, inputs, outputs):
+    """The tight Theorem 5 bisections (eq. 12) repeated at every tolerance of ``checks.tight_tol_variants``.
+
+    Table ``tight_variants.csv``: ``check, example, q, tol, p_lower, p_upper, certified, n_solves``; the
+    claims on ``p_underline`` are re-judged across these tolerances.
+    """
+    ck = params["checks"]
+    rows = []
+    for item in ck["tight"]:
+        ex = params["examples"][item["example"]]
+        lmi = GilbertElliottLMI(np.asarray(ex["A"], float), np.asarray(ex["C"], float))
+        for tol in ck["tight_tol_variants"]:
+            res = thm5_lower_bound(lmi, float(item["q"]), 1.0, float(tol))
+            rows.append({"check": item["name"], "example": item["example"], "q": item["q"], "tol": float(tol),
+                         "p_lower": res["p_lower"], "p_upper": res["p_upper"], "certified": res["certified"],
+                         "n_solves": res["n_solves"]})
+    return {"table": pd.DataFrame(rows)}
+
+
 def iid_line_step(params, inputs, outputs):
     """The i.i.d. line p + q = 1 (Remark 4): Sinopoli's bounds on lambda_c and Theorem 5's crossing."""
     tol = params["iid"]["tol"]
@@ -239,7 +261,7 @@ def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
     return ExactMoments(coef, float(head["sum_norm"]), float(head["sum_trace"]))
 
 
-def _estimator_map(em, ex, e_idx, P, Qg, mp):
+def _estimator_map(em, ex, e_idx, P, Qg, mp, z):
     """The estimator cross-check of the map (exact extrapolation, then the long-horizon estimator)."""
     opts = mp["refine"]
     means = em.mean(P, Qg, "norm")
@@ -252,7 +274,7 @@ def _estimator_map(em, ex, e_idx, P, Qg, mp):
     if opts["enabled"] and len(todo):
         rng = np.random.default_rng([opts["seed"], e_idx])
         r_long, rel, v_long = refine_long_horizon(_system(ex), np.asarray(ex["Sigma0"], float),
-                                                  P.ravel()[todo], Qg.ravel()[todo], opts, rng)
+                                                  P.ravel()[todo], Qg.ravel()[todo], opts, rng, z)
         f.loc[todo, "growth_rate_long"] = r_long
         f.loc[todo, "rel_halfwidth_long"] = rel
         decided = todo[v_long != "undecided"]
@@ -329,7 +351,7 @@ def stability_map_step(params, inputs, outputs):
         verdict, method = decide_certified(facts, P, cc["rho_margin"], cc["growth_margin"])
         curve_q, curve_p = true_critical_curve(ex.get("reference", "none"), spectral_abs(ex["A"]))
         dist = critical_distance(Qg, P, curve_q, curve_p)
-        est, means = _estimator_map(load_moments(table, name), ex, e_idx, P, Qg, mp)
+        est, means = _estimator_map(load_moments(table, name), ex, e_idx, P, Qg, mp, params["estimator"]["interval_z"])
         growth = np.fmax(facts["loss_growth"], facts["parity_growth"])
         with np.errstate(divide="ignore"):
             p_thm1 = 1.0 / facts["rho1"]
@@ -343,7 +365,7 @@ def stability_map_step(params, inputs, outputs):
     return {"table": pd.concat(frames, ignore_index=True), "sensitivity": pd.DataFrame(sens)}
 
 
-def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
+def _estimator_check(system, S0, example, p, q, em, n, horizon, rng, z):
     """Plain sample mean and conditional estimator of E||P_k||: against the exact value at k = depth + 1,
     and against each other at the long horizon ``k = horizon + 1`` (where only the conditional one is trusted)."""
     exact = em.mean(p, q, "norm")
@@ -354,8 +376,8 @@ def _estimator_check(system, S0, example, p, q, em, n, horizon, rng):
     se_p, se_r = plain.std(ddof=1) / np.sqrt(n), rbk.std(ddof=1) / np.sqrt(n)
     kl = rb.shape[1]
     return {"example": example, "p": p, "q": q, "k": k, "exact_mean": exact[k - 1],
-            "plain_mean": plain.mean(), "plain_ci_high": plain.mean() + 1.96 * se_p,
-            "rb_mean": rbk.mean(), "rb_ci_low": rbk.mean() - 1.96 * se_r, "rb_ci_high": rbk.mean() + 1.96 * se_r,
+            "plain_mean": plain.mean(), "plain_ci_high": plain.mean() + z * se_p,
+            "rb_mean": rbk.mean(), "rb_ci_low": rbk.mean() - z * se_r, "rb_ci_high": rbk.mean() + z * se_r,
             "plain_over_exact": plain.mean() / exact[k - 1], "rb_over_exact": rbk.mean() / exact[k - 1],
             "k_long": kl, "plain_mean_long": norms[:, kl - 1].mean(), "rb_mean_long": rb[:, kl - 1].mean(),
             "plain_over_rb_long": norms[:, kl - 1].mean() / rb[:, kl - 1].mean(), "n_paths": n}
@@ -392,7 +414,8 @@ def sample_paths_step(params, inputs, outputs):
         em = load_moments(table, point["example"])
         rng = np.random.default_rng([sp["seed"], 100 + j])
         checks.append(_estimator_check(_system(ex), np.asarray(ex["Sigma0"], float), point["example"],
-                                       float(point["p"]), float(point["q"]), em, sp["rb_paths"], sp["rb_horizon"], rng))
+                                       float(point["p"]), float(point["q"]), em, sp["rb_paths"], sp["rb_horizon"], rng,
+                                       params["estimator"]["interval_z"]))
     return {"table": pd.DataFrame(rows), "check": pd.DataFrame(checks)}
 
 
@@ -430,7 +453,7 @@ def expectations_step(params, inputs, outputs):
     ``backtest_k0`` brackets the exact values with monotone ratios (:func:`.expectations.asymptote_backtest`);
     otherwise ``not_trustworthy``. The decisions and their numbers go to the provenance.
     """
-    sp, xc = params["paths"], params["expectations"]
+    sp, xc, es = params["paths"], params["expectations"], params["estimator"]
     table = pd.read_csv(inputs["moments"])
     k_max = sp["horizon"] + 1
     rows, prov, split_moments = [], {}, {}
@@ -451,8 +474,9 @@ def expectations_step(params, inputs, outputs):
             info["parity_lock"] = parity
             if not parity:
                 rng = np.random.default_rng([xc["seed"], j])
-                mean, half = xp.conditional_estimate(system, S0, p, q, xc["n_paths"], k_max - 1, rng)
-                zmax, z_ok = xp.conditional_validation(mean, half, exact, xc["z_max"])
+                mean, half = xp.conditional_estimate(system, S0, p, q, xc["n_paths"], k_max - 1, rng, es["interval_z"])
+                zmax, z_ok = xp.conditional_validation(mean, half, exact, xc["z_max"], es["interval_z"],
+                                                       es["deterministic_rtol"])
                 rel = float(np.max(half / mean))
                 info.update(cond_max_abs_z=zmax, cond_max_rel_halfwidth=rel)
                 if z_ok and rel < xc["rel_tol"]:

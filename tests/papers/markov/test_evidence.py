@@ -1,0 +1,143 @@
+"""Evidence of `markov` (evidence.py) against independent computations, and its data files."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from netrepro.papers.markov import evidence, exact, model
+from netrepro.verdicts import claims_table, errata_table, findings_table, load_paper_data, read_evidence
+
+from .systems import EX1, EX2
+
+
+def _psi(P, g, system):
+    return model.riccati_g(P, system.A, system.C, system.Q, system.R) if g else model.riccati_h(P, system.A, system.Q)
+
+
+@pytest.mark.parametrize("system", [EX1, EX2])
+def test_enumeration_matches_exact_tree(system):
+    """Brute force over all 2^(k-1) paths (gamma_1 = 1) equals the transition-count tree of exact.py."""
+    paths = evidence.enumerate_norms(system, np.eye(system.n), 8)
+    em = exact.exact_moments(system, np.eye(system.n), 7)
+    for p, q in ((0.3, 0.6), (0.9, 0.95)):
+        assert np.allclose(evidence.mean_norm_enumerated(paths, p, q, "gamma1"), em.mean(p, q), rtol=1e-10)
+
+
+def test_stationary_start_by_hand():
+    """E||P_3|| with gamma_1 drawn from the stationary law, by the two-step formula written out."""
+    p, q = 0.7, 0.8
+    S0 = np.eye(2)
+    pi1 = q / (p + q)
+    law = {1: pi1, 0: 1 - pi1}
+    trans = {(1, 1): 1 - p, (1, 0): p, (0, 1): q, (0, 0): 1 - q}
+    want = sum(law[a] * trans[(a, b)] * np.linalg.norm(_psi(_psi(S0, a, EX1), b, EX1), 2)
+               for a, b in itertools.product([0, 1], repeat=2))
+    got = evidence.mean_norm_enumerated(evidence.enumerate_norms(EX1, S0, 3), p, q, "stationary")
+    assert got[2] == pytest.approx(want, rel=1e-12)
+    assert got[0] == pytest.approx(1.0)
+
+
+def test_monotonicity_violation_on_a_hand_table():
+    means = np.array([[1.0, 2.0], [1.5, 1.8], [2.0, 2.1]])
+    v = evidence.monotonicity_violation(means, [0.1, 0.2, 0.3])
+    assert v["violation"] == pytest.approx(0.2 / 1.8)
+    assert (v["p1"], v["p2"], v["k"]) == (0.2, 0.1, 2)
+    assert evidence.monotonicity_violation(means, [0.1, 0.2, 0.3], rtol=0.2)["violation"] == 0.0
+    assert evidence.monotonicity_violation(np.sort(means, axis=0), [0.1, 0.2, 0.3])["violation"] == 0.0
+
+
+def test_prop1_closed_form_value():
+    """Section 5.1: |lambda| = 1.3, q = 0.65 gives 0.22 (by hand: 0.4085 / 1.856465)."""
+    assert float(evidence.prop1_closed_form(1.3, 0.65)) == pytest.approx(0.4085 / 1.856465, rel=1e-12)
+
+
+def test_single_transition():
+    rows = [("I", p, 0.5, "bounded" if p < 0.4 else "unbounded") for p in (0.1, 0.3, 0.5, 0.7)]
+    ok, _ = evidence.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    assert ok
+    rows[3] = ("I", 0.7, 0.5, "bounded")
+    bad, note = evidence.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    assert not bad and "1 of 1" in note
+
+
+def _signed_coupling(p1, p2, q, k):
+    """Paths of the Fig. 1 chain on {(0,0), (0,1), (1,1)} from (1,1), with (signed) weights."""
+    step = {(1, 1): {(1, 1): 1 - p1, (0, 1): p1 - p2, (0, 0): p2},
+            (0, 1): {(1, 1): q, (0, 0): p2, (0, 1): 1 - q - p2},
+            (0, 0): {(1, 1): q, (0, 0): 1 - q}}
+    paths = [((1, 1),)]
+    weights = [1.0]
+    for _ in range(k - 2):
+        paths, weights = zip(*[(s + (t,), w * pr) for s, w in zip(paths, weights) for t, pr in step[s[-1]].items()])
+    return paths, np.array(weights)
+
+
+def test_signed_coupling_argument_fails_from_gamma1():
+    """Erratum E10: the signed chain has the right marginals and phi_1 >= phi_2 in norm on every path, yet
+    E_p1||P_k|| < E_p2||P_k|| with gamma_1 = 1: ordering integrals under a signed measure is invalid."""
+    q, k = 0.95, 8
+    em = exact.exact_moments(EX1, np.eye(2), k - 1)
+    ps = np.linspace(0.5, 0.99, 50)
+    means = em.mean(ps, q)[:, k - 1]
+    i1 = int(np.argmin(means[ps > 0.9]) + np.flatnonzero(ps > 0.9)[0])
+    i2 = int(np.argmax(means[:i1]))
+    p1, p2 = ps[i1], ps[i2]
+    assert means[i2] > means[i1] and p2 < p1 and p2 + q > 1
+    paths, w = _signed_coupling(p1, p2, q, k)
+    assert w.min() < 0
+    norm1, norm2 = [], []
+    for path in paths:
+        P1 = P2 = np.eye(2)
+        for z, zt in path:  # (gamma_1, ..., gamma_{k-1}) of both chains: P_k
+            P1, P2 = _psi(P1, z, EX1), _psi(P2, zt, EX1)
+        norm1.append(np.linalg.norm(P1, 2))
+        norm2.append(np.linalg.norm(P2, 2))
+    norm1, norm2 = np.array(norm1), np.array(norm2)
+    assert np.all(norm1 >= norm2 - 1e-9)
+    # marginals: the signed integrals are the two channels' expectations at k (paths give P_{k})
+    e1, e2 = em.mean(p1, q)[k - 1], em.mean(p2, q)[k - 1]
+    assert w @ norm1 == pytest.approx(e1, rel=1e-9)
+    assert w @ norm2 == pytest.approx(e2, rel=1e-9)
+    assert w @ (norm1 - norm2) < 0
+
+
+def test_data_files_load():
+    data = load_paper_data("markov")
+    ids = {c.claim_id for c in data.claims}
+    assert {"ref16_p004", "ref16_p0045", "exI_fig3_stable", "thm5_lower_bound", "prop2_threshold"} <= ids
+    assert "exI_iid_consistent" not in ids
+    kinds = {c.claim_id: c.kind for c in data.claims}
+    assert kinds["ref16_p004"] == kinds["ref16_p0045"] == "not_checkable"
+    assert {e["id"] for e in data.errata} >= {"E10_prop2_signed_measure"}
+    assert not {"E4_ref16_value", "E8_prop1_form"} & {e["id"] for e in data.errata}
+
+
+def test_evidence_step_feeds_every_claim(markov_tables):
+    """On the tiny configuration every claim, erratum and finding finds its evidence."""
+    ev = read_evidence(markov_tables["evidence"])
+    data = load_paper_data("markov")
+    claims = claims_table(data, {}, ev).set_index("claim_id")
+    assert claims.loc["exII_p0465_certified", "verdict"] == "erratum"
+    assert claims.loc["exII_fig6_diverges", "robust"] == "yes"
+    assert claims.loc["ref16_p004", "verdict"] == "not_checkable"
+    errata = errata_table(data, ev).set_index("erratum_id")
+    assert float(errata.loc["E10_prop2_signed_measure", "residual_printed"]) > 0
+    assert float(errata.loc["E10_prop2_signed_measure", "residual_corrected"]) == 0
+    assert len(findings_table(data, ev)) == len(data.findings)
+
+
+def test_tight_variants_bracket_the_closed_form(markov_tables):
+    """Every tolerance's certified bracket at q = 0.5 contains the Example II critical value derived by hand:
+    |lambda|^4 (pq + (1-q)^2) = 1 with |lambda| = 1.2, i.e. p = (1 - 2.0736 / 4) / (2.0736 / 2)."""
+    t = pd.read_csv(markov_tables["tight"])
+    t = t[t.check == "exII_q05"]
+    assert len(t) >= 2
+    p_c = (1 - 2.0736 / 4) / (2.0736 / 2)
+    assert p_c == pytest.approx(0.4645061728, abs=1e-10)
+    assert ((t.p_lower <= p_c) & (t.p_upper >= p_c)).all()
+    # below ~1e-7 the certified bracket stops shrinking with the tolerance (solver accuracy near the edge)
+    assert ((t.p_upper - t.p_lower)[t.tol <= 1e-6] < 1e-6).all()
