@@ -37,15 +37,9 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
     _figure_list = f"src/netrepro/papers/{_slug}/figures.yaml"
     _verdicts = getattr(rules, f"{_slug}_claims").output
     _claims = _verdicts.table
-    # papers not yet on the shared verdict step (issue 15) still have their own rules
-    _errata = (
-        getattr(_verdicts, "errata", None) or getattr(rules, f"{_slug}_errata").output.table
-    )
-    _reconstructions = (
-        getattr(_verdicts, "reconstructions", None)
-        or getattr(rules, f"{_slug}_reconstructions").output.table
-    )
-    _findings = getattr(_verdicts, "findings", None) or []
+    _errata = _verdicts.errata
+    _reconstructions = _verdicts.reconstructions
+    _findings = _verdicts.findings
 
     rule:
         name:

@@ -4,7 +4,7 @@
 # Included after the papers' own rules, whose `<slug>_evidence` outputs it reads.
 
 
-for _slug in [s for s in config["papers"] if f"{s}_evidence" in {r.name for r in workflow.rules}]:
+for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
 
     rule:
         name:
