@@ -289,3 +289,12 @@ def test_every_claim_of_a_paper_points_to_a_quantity_a_step_produces(slug):
     assert table["verdict"].tolist() == reference["verdict"].tolist()
     for f in data.findings:
         assert (REFERENCE / Path(f["table"]).relative_to("results")).is_file(), f["id"]
+
+
+def test_a_long_condition_is_counted_not_spelled_out():
+    variants = {f"agent {i}": (0.41 if i % 3 else 0.9) for i in range(30)}
+    result = judge(numeric(), 0.42, variants)
+    assert result.verdict == "conditional"
+    assert result.condition.startswith("holds at 21 of 31 settings: nominal settings; agent 1; agent 2;")
+    assert "and 15 more (the note lists them)" in result.condition
+    assert "not for agent 0; agent 3;" in result.condition and "and 4 more" in result.condition

@@ -492,10 +492,25 @@ def judge(entry: ClaimEntry, value=None, variants: dict | None = None) -> Judgem
     holds = ([nominal_label] if nominal else []) + [label for label, ok in outcomes.items() if ok]
     fails = ([] if nominal else [nominal_label]) + [label for label, ok in outcomes.items() if not ok]
     if holds:
-        return Judgement("conditional", robust, f"holds for {'; '.join(holds)}; not for {'; '.join(fails)}")
+        return Judgement("conditional", robust, _condition_text(holds, fails))
     if entry.erratum_id:
         return Judgement("erratum", robust, "")
     return Judgement("differs", robust, "")
+
+
+_LISTED = 6  # settings named in a condition on each side; the note lists every setting with its value
+
+
+def _condition_text(holds: list, fails: list) -> str:
+    """Where a conditional claim holds and where not; long lists are counted, not spelled out."""
+    def side(labels):
+        if len(labels) <= _LISTED:
+            return "; ".join(labels)
+        return "; ".join(labels[:_LISTED]) + f"; and {len(labels) - _LISTED} more (the note lists them)"
+
+    total = len(holds) + len(fails)
+    head = f"holds at {len(holds)} of {total} settings: " if total > 2 * _LISTED else "holds for "
+    return f"{head}{side(holds)}; not for {side(fails)}"
 
 
 def _fmt_tolerance(entry: ClaimEntry) -> str:
