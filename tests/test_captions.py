@@ -26,3 +26,20 @@ def test_caption_parses_without_warnings(path):
 def test_every_listed_figure_has_a_caption(slug):
     for spec in load_figure_specs(slug):
         assert (ROOT / "workflow" / "report" / slug / f"{spec.figure_id}.rst").is_file(), spec.rule
+
+
+@pytest.mark.parametrize("slug", sorted(PAPERS))
+def test_every_figure_says_which_layout_choices_are_the_papers(slug):
+    """Issue 15: each figure states which layout choices come from the paper and which are ours."""
+    for spec in load_figure_specs(slug):
+        assert spec.layout.get("from_paper", "").strip() and spec.layout.get("ours", "").strip(), spec.rule
+
+
+def test_a_malformed_layout_is_rejected(tmp_path):
+    from netrepro.errors import ConfigError
+
+    folder = tmp_path / "papers" / "x"
+    folder.mkdir(parents=True)
+    (folder / "figures.yaml").write_text("fig1:\n  plot: f\n  layout: {paper: axes}\n")
+    with pytest.raises(ConfigError, match="figure 'fig1': field 'layout'"):
+        load_figure_specs("x", src=tmp_path)
