@@ -881,7 +881,7 @@ def _run_sidecars(papers: dict) -> dict[str, dict]:
     found: dict[str, dict] = {}
     for spec in papers.values():
         paths = [*spec.get("figures", []), *spec.get("tables", []),
-                 *(spec.get(k) for k in ("claims", "errata", "reconstructions"))]
+                 *(spec.get(k) for k in ("claims", "errata", "reconstructions", "findings"))]
         for path in paths:
             if not path:
                 continue
