@@ -298,3 +298,14 @@ def test_a_long_condition_is_counted_not_spelled_out():
     assert result.condition.startswith("holds at 21 of 31 settings: nominal settings; agent 1; agent 2;")
     assert "and 15 more (the note lists them)" in result.condition
     assert "not for agent 0; agent 3;" in result.condition and "and 4 more" in result.condition
+
+
+@pytest.mark.parametrize("slug", SLUGS)
+def test_no_statement_or_printed_form_is_typed_in_python(slug):
+    """The paper's side lives only in the data files: no statement or printed form is repeated in the code."""
+    data = load_paper_data(slug)
+    texts = [e.statement for e in data.claims] + [e["printed"] for e in data.errata] + \
+            [e.tolerance_reason for e in data.claims]
+    sources = "\n".join(p.read_text() for p in Path(__file__).resolve().parents[1].glob("src/netrepro/**/*.py"))
+    typed = [t for t in texts if len(t) >= 25 and t in sources]
+    assert not typed, typed
