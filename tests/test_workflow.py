@@ -124,3 +124,24 @@ def test_bad_config_stops_before_any_job(built):
     assert "intermittent.scalar.R2" in proc.stdout + proc.stderr
     after = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
     assert before == after
+
+
+def test_malformed_claims_file_stops_before_any_job(built):
+    """Issue 15: a claims file that breaks its schema stops the run at start-up, naming file, entry and field."""
+    claims = built / "src/netrepro/papers/onebit/claims.yaml"
+    original = claims.read_text()
+    entries = yaml.safe_load(original)
+    del entries[1]["tolerance"]
+    before = {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
+    try:
+        claims.write_text(yaml.safe_dump(entries, sort_keys=False))
+        proc = subprocess.run([sys.executable, "-m", "snakemake", "--configfile", "config/test.yaml", "-j2",
+                               "--forceall", "report"], cwd=built, capture_output=True, text=True, timeout=300,
+                              env=dict(os.environ, PYTHONPATH=str(built / "src")))
+    finally:
+        claims.write_text(original)
+    message = proc.stdout + proc.stderr
+    assert proc.returncode != 0
+    assert "onebit/claims.yaml" in message and f"entry 1 (id '{entries[1]['id']}')" in message
+    assert "'tolerance.reason'" in message or "'tolerance'" in message
+    assert before == {p: p.stat().st_mtime_ns for p in (built / "results").rglob("*")}
