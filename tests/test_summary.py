@@ -50,7 +50,7 @@ def test_summary_sentences_carry_the_counted_numbers():
     errata = pd.DataFrame({"kind": ["equation", "notation"]})
     text = " ".join(summary_sentences(A, errata, pd.DataFrame({"finding_id": ["F1"]}),
                                       replication_summary(A, ["fig1", "fig2"])))
-    assert "Of 5 testable claims, 2 are reproduced, 1 hold only under a condition" in text
-    assert "1 differ and 1 are wrong" in text and "2 further rows" in text
+    assert "Of 5 testable claims, 2 are reproduced, 1 holds only under a condition" in text
+    assert "1 differs and 1 is wrong" in text and "2 further rows are kept" in text
     assert "Of its 2 figures, 1 partially, 1 no claim" in text
     assert "1 errata of substance" in text and "1 notation or typesetting" in text and "1 findings" in text

@@ -158,6 +158,10 @@ def replication_summary(claims: pd.DataFrame, figure_ids=()) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["item", "kind", "status", "testable", *VERDICTS, "why"])
 
 
+def _verb(count: int, one: str, many: str) -> str:
+    return one if count == 1 else many
+
+
 def summary_sentences(claims: pd.DataFrame, errata: pd.DataFrame | None, findings: pd.DataFrame | None,
                       summary: pd.DataFrame) -> list[str]:
     """The replication summary of a paper in three sentences, every number counted from the tables."""
@@ -170,13 +174,14 @@ def summary_sentences(claims: pd.DataFrame, errata: pd.DataFrame | None, finding
     groups = summary[summary["kind"] == "group"]
     fig_counts = figs["status"].value_counts()
     group_counts = groups["status"].value_counts()
+    n = {v: int(counts.get(v, 0)) for v in VERDICTS}
     sentences = [
-        f"Of {testable} testable claims, {int(counts.get('reproduced', 0))} are reproduced, "
-        f"{int(counts.get('conditional', 0))} hold only under a condition the paper does not state, "
-        f"{int(counts.get('differs', 0))} differ and {int(counts.get('erratum', 0))} are wrong because of an error "
-        f"of the text; {untestable} further rows are kept for transparency "
-        f"({int(counts.get('not_checkable', 0))} not checkable, {int(counts.get('not_identifiable', 0))} not "
-        f"identifiable, {int(counts.get('context', 0))} context).",
+        f"Of {testable} testable claims, {n['reproduced']} {_verb(n['reproduced'], 'is', 'are')} reproduced, "
+        f"{n['conditional']} {_verb(n['conditional'], 'holds', 'hold')} only under a condition the paper does not "
+        f"state, {n['differs']} {_verb(n['differs'], 'differs', 'differ')} and {n['erratum']} "
+        f"{_verb(n['erratum'], 'is', 'are')} wrong because of an error of the text; {untestable} further "
+        f"{_verb(untestable, 'row is', 'rows are')} kept for transparency ({n['not_checkable']} not checkable, "
+        f"{n['not_identifiable']} not identifiable, {n['context']} context).",
     ]
     parts = []
     for label, rows, tally in (("figures", figs, fig_counts), ("claim groups", groups, group_counts)):
