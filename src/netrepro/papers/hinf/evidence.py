@@ -151,9 +151,14 @@ def sensitivity_text(sens: pd.DataFrame, parameter: str) -> str:
     return "sweep (results/hinf/sensitivity.csv): " + "; ".join(parts)
 
 
+def _solver_label(solver: str, n_iter) -> str:
+    """``mirror x20``, ``pairwise x300``; ``exact`` (no iterations)."""
+    return "exact" if solver == "exact" else f"{solver} x{n_iter}"
+
+
 def evader_text(ev: pd.DataFrame) -> str:
     """A sentence summarising ``evader_convergence.csv``: is the evader's inner minimisation converged?"""
-    parts = [f"{r.solver} x{r.n_iter}{' (configured)' if r.configured else ''}: choice certified in "
+    parts = [f"{_solver_label(r.solver, r.n_iter)}{' (configured)' if r.configured else ''}: choice certified in "
              f"{r.certified_fraction:.1%} of {r.decisions} decisions, same as the certified reference in "
              f"{r.same_as_reference:.1%}, objective lost mean {r.mean_loss:.2g} / max {r.max_loss:.2g} "
              f"(median value {r.median_value:.3g})" for r in ev.itertuples()]
@@ -490,7 +495,7 @@ def _premise_rows(pe, evp, z_sig, gamma):
         rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"gamma={ratio:g} gamma_0",
                      "value": bool((g["z"] < -z_sig).all())})
     for (solver, n_iter, runs), g in evp.groupby(["solver", "n_iter", "runs"], sort=False):
-        rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"evader {solver} x{n_iter} ({runs} runs)",
+        rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"evader {_solver_label(solver, n_iter)} ({runs} runs)",
                      "value": bool((g["z"] < -z_sig).all())})
     rows.append({"quantity": "premise.random_target", "value": float(rnd["z"].max()),
                  "note": "paired z (H-infinity minus Kalman) against the random-walk target, by filter and gamma: "
