@@ -2,7 +2,10 @@
 
 The target knows the agents' positions and the sensor model (not the filters) and moves,
 greedily, to where the smallest ellipse over-bounding the intersection of the agents'
-uncertainty ellipses (22) is largest.
+uncertainty ellipses (22) is largest. The inner minimisation over the weights lambda of (24) is solved
+exactly and certified (:func:`min_fused_trace_exact`, the configured ``evader.solver``); mirror descent
+(:func:`min_fused_trace`) and pairwise Frank-Wolfe (:func:`min_fused_trace_pairwise`) are kept for the
+convergence check (issue 17).
 """
 
 from __future__ import annotations

@@ -40,7 +40,7 @@ RECONSTRUCTION_CONFIG = {
     "consensus.K_p": "consensus.K_p", "consensus.K_i": "consensus.K_i", "consensus.h": "consensus.h",
     "consensus.iters": "consensus.iters", "control.Gamma": "control.Gamma", "control.v_max": "control.v_max",
     "control.recursion": "control.recursion", "evader.n_headings": "evader.n_headings",
-    "evader.step_scale": "evader.step_scale", "evader.n_iter": "evader.n_iter", "layouts.ten": "layouts.ten",
+    "evader.step_scale": "evader.step_scale", "evader.solver": "evader.solver", "layouts.ten": "layouts.ten",
     "layouts.four": "layouts.four", "scenarios.horizon": "scenarios.*.horizon", "scenarios.runs": "scenarios.*.runs",
     "scenarios.static_fixed.W_filter": "scenarios.static_fixed.W_filter", "claims.late_start": "claims.late_start",
     "claims.settle_threshold": "claims.settle_threshold", "claims.z_significant": "claims.z_significant",
@@ -529,7 +529,7 @@ def _reconstruction_rows(cfg, sens, ev_conv) -> list[dict]:
         note = sensitivity_text(sens, sweep) if sweep else ""
         if key == "filter.gamma":
             note += " | evasive target (gamma = inf: Kalman-driven agents): " + sensitivity_text(sens, "gamma_evasive")
-        if key == "evader.n_iter":
+        if key == "evader.solver":
             note = evader_text(ev_conv)
         rows.append({"quantity": f"reconstruction.{key}", "value": _get(cfg, path), "note": note})
     return rows
