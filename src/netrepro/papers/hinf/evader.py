@@ -184,45 +184,61 @@ def _sym_coords(Minv):
     return np.stack([Minv[..., 0, 0], 0.5 * (Minv[..., 0, 1] + Minv[..., 1, 0]), Minv[..., 1, 1]], -1)
 
 
-def _adjugate(H):
-    """Adjugate of symmetric ``k x k`` matrices, ``k`` in 1, 2, 3 (closed form; singular matrices allowed)."""
-    k = H.shape[-1]
-    if k == 1:
-        return np.ones_like(H)
-    if k == 2:
-        out = np.empty_like(H)
-        out[..., 0, 0], out[..., 1, 1] = H[..., 1, 1], H[..., 0, 0]
-        out[..., 0, 1], out[..., 1, 0] = -H[..., 0, 1], -H[..., 1, 0]
-        return out
-    r0, r1, r2 = H[..., 0, :], H[..., 1, :], H[..., 2, :]
-    return np.stack([np.cross(r1, r2), np.cross(r2, r0), np.cross(r0, r1)], -1)  # columns: adj(H) = cof(H)^T
+def _polarised_det(s):
+    """``H_ij = (a_i d_j + a_j d_i) / 2 - b_i b_j`` for ``s = (a, b, d)`` of shape ``(..., N, 3)``: ``det(sum lam_j S_j)
+    = lam^T H lam``."""
+    a, b, d = s[..., 0], s[..., 1], s[..., 2]
+    return 0.5 * (a[..., :, None] * d[..., None, :] + d[..., :, None] * a[..., None, :]) - b[..., :, None] * b[..., None, :]
 
 
-def _face_stationary(s, l, combos):
+def _face_stationary(H, l, combos):
     """Stationary point of ``f = tr A / det A`` on the relative interior of each face ``combos`` of the simplex.
 
     With ``A = sum_j lam_j S_j`` on a face with vertices ``J`` (``|J| = k <= 3``), ``tr A = l . lam`` and
-    ``det A = lam^T H lam``, ``H_ij`` the polarised determinant ``(a_i d_j + a_j d_i) / 2 - b_i b_j``.
-    The Lagrange condition ``grad f = mu 1`` with ``sum lam = 1`` (Euler: ``mu = -f``) reads
-    ``2 (l . lam) H lam = det A (l + (l . lam) 1)``; with ``P = adj(H) l``, ``R = adj(H) 1`` its solution is
-    ``L = tr A = sqrt((l . P) / (1 . R))`` and ``lam = (P + L R) / 1 . (P + L R)``. No iteration: the point
-    is exact up to rounding. Faces whose ``H`` is singular (``S_j`` linearly dependent) have their minimum
-    on a smaller face, which is enumerated too.
+    ``det A = lam^T H lam``, ``H`` of ``_polarised_det``. The Lagrange condition ``grad f = mu 1`` with
+    ``sum lam = 1`` (Euler: ``mu = -f``) reads ``2 (l . lam) H lam = det A (l + (l . lam) 1)``; with
+    ``P = adj(H) l``, ``R = adj(H) 1`` its solution is ``L = tr A = sqrt((l . P) / (1 . R))`` and
+    ``lam = (P + L R) / 1 . (P + L R)``. No iteration: the point is exact up to rounding. Faces whose ``H`` is
+    singular (``S_j`` linearly dependent) have their minimum on a smaller face, which is enumerated too.
 
-    Returns ``lam`` of shape ``(..., C, k)`` (not yet checked for feasibility).
+    Parameters
+    ----------
+    H : ndarray, shape ``(m, N, N)``
+    l : ndarray, shape ``(m, N)``
+        ``tr S_j``.
+    combos : ndarray of int, shape ``(C, k)``
+
+    Returns
+    -------
+    lam : ndarray, shape ``(m, C, k)``
+        Not yet checked for feasibility (may be negative or nan).
+    h : dict
+        ``h[i, j]`` (``i <= j``), shape ``(m, C)``: the entries of ``H`` on each face.
+    lj : list
+        ``lj[i]``, shape ``(m, C)``: ``tr S_j`` of the face's ``i``-th vertex.
     """
-    idx = np.asarray(combos)                       # (C, k)
-    sj = s[..., idx, :]                            # (..., C, k, 3)
-    lj = l[..., idx]                               # (..., C, k)
-    a, b, d = sj[..., 0], sj[..., 1], sj[..., 2]
-    H = 0.5 * (a[..., :, None] * d[..., None, :] + d[..., :, None] * a[..., None, :]) - b[..., :, None] * b[..., None, :]
-    adj = _adjugate(H)
-    P = np.einsum("...ij,...j->...i", adj, lj)
-    R = adj.sum(-1)
+    k = combos.shape[1]
+    h = {(i, j): H[:, combos[:, i], combos[:, j]] for i in range(k) for j in range(i, k)}  # (m, C) each
+    lj = [l[:, combos[:, i]] for i in range(k)]
+    if k == 1:
+        adj = {(0, 0): np.ones_like(h[0, 0])}
+    elif k == 2:
+        adj = {(0, 0): h[1, 1], (1, 1): h[0, 0], (0, 1): -h[0, 1]}
+    else:
+        adj = {(0, 0): h[1, 1] * h[2, 2] - h[1, 2] ** 2, (1, 1): h[0, 0] * h[2, 2] - h[0, 2] ** 2,
+               (2, 2): h[0, 0] * h[1, 1] - h[0, 1] ** 2, (0, 1): h[0, 2] * h[1, 2] - h[0, 1] * h[2, 2],
+               (0, 2): h[0, 1] * h[1, 2] - h[0, 2] * h[1, 1], (1, 2): h[0, 1] * h[0, 2] - h[0, 0] * h[1, 2]}
+
+    def e(i, j, m=adj):
+        return m[(i, j) if i <= j else (j, i)]
+
+    P = [sum(e(i, j) * lj[j] for j in range(k)) for i in range(k)]
+    R = [sum(e(i, j) for j in range(k)) for i in range(k)]
     with np.errstate(divide="ignore", invalid="ignore"):
-        L = np.sqrt(np.einsum("...i,...i->...", lj, P) / R.sum(-1))
-        num = P + L[..., None] * R
-        return num / num.sum(-1, keepdims=True)
+        L = np.sqrt(sum(lj[i] * P[i] for i in range(k)) / sum(R))
+        num = np.stack([P[i] + L * R[i] for i in range(k)], -1)
+        lam = num / num.sum(-1, keepdims=True)
+    return lam, h, lj
 
 
 def _newton_polish(s, l, lam, steps: int = 3):
@@ -281,8 +297,9 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
     hull). Every support of size 1, 2 and 3 is enumerated (``N + N(N-1)/2 + N(N-1)(N-2)/6``; 175 for
     ``N = 10``); on each, the stationary point of ``f`` on the face is found in closed form (see
     ``_face_stationary``: a square root, no polynomial root finding), kept if its weights are
-    non-negative, and the smallest ``f`` over the kept points is the minimum. Vectorised over the leading
-    axes and the supports (no loop over decisions).
+    non-negative, and the smallest ``f`` over the kept points is the minimum. Triangles are solved only for
+    the instances whose best vertex or edge is not already certified optimal by its Frank-Wolfe gap (the
+    optimum is then on a triangle). Vectorised over the leading axes and the supports (no loop over decisions).
 
     The result is certified by :func:`fused_trace_bounds`: its Frank-Wolfe gap is checked to be at most
     ``tol`` times the value for every instance (``ArithmeticError`` otherwise).
@@ -306,41 +323,46 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
     s = _sym_coords(Minv)                              # (..., N, 3)
     l = s[..., 0] + s[..., 2]                          # tr S_j
     lead = Minv.shape[:-3]
-    best_f = np.full(lead, np.inf)
-    best_lam = np.zeros(lead + (n,))
+    Mf, sf, lf = Minv.reshape(-1, n, 2, 2), s.reshape(-1, n, 3), l.reshape(-1, n)
+    Hf = _polarised_det(sf)                            # (M, N, N)
+    best_f = np.full(len(sf), np.inf)
+    best_lam = np.zeros((len(sf), n))
+    rows = np.arange(len(sf))  # instances still to be solved
     for k in (1, 2, 3):
-        if k > n:
+        if k > n or len(rows) == 0:
             break
-        combos = list(combinations(range(n), k))
-        lam = _face_stationary(s, l, combos)            # (..., C, k)
+        if k == 3:  # triangles only where no vertex or edge is already certified (the Frank-Wolfe gap decides)
+            value, lower = fused_trace_bounds(Mf, best_lam)
+            rows = np.nonzero(value - lower > 0.01 * tol * np.abs(value))[0]
+            if len(rows) == 0:
+                break
+        combos = np.asarray(list(combinations(range(n), k)))
+        lam, h, lj = _face_stationary(Hf[rows], lf[rows], combos)  # lam (m, C, k)
         ok = np.all(np.isfinite(lam), -1) & np.all(lam >= -1e-12, -1)
         lam = np.where(ok[..., None], np.clip(lam, 0.0, None), 1.0 / k)
         lam = lam / lam.sum(-1, keepdims=True)
-        A = np.einsum("...ck,...ckm->...cm", lam, s[..., np.asarray(combos), :])
-        det = A[..., 0] * A[..., 2] - A[..., 1] ** 2
+        tr = sum(lam[..., i] * lj[i] for i in range(k))
+        det = sum((1 if i == j else 2) * lam[..., i] * lam[..., j] * h[i, j] for i in range(k) for j in range(i, k))
         with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(ok & (det > 0), (A[..., 0] + A[..., 2]) / det, np.inf)
+            f = np.where(ok & (det > 0), tr / det, np.inf)
         c = f.argmin(-1)
-        fc = np.take_along_axis(f, c[..., None], -1)[..., 0]
-        better = fc < best_f
-        full = np.zeros(lead + (n,))
-        lc = np.take_along_axis(lam, c[..., None, None], -2)[..., 0, :]  # (..., k)
-        ic = np.asarray(combos)[c]                                       # (..., k)
-        np.put_along_axis(full, ic, lc, -1)
-        best_f = np.where(better, fc, best_f)
-        best_lam = np.where(better[..., None], full, best_lam)
-    value, lower = fused_trace_bounds(Minv, best_lam)
+        fc = f[np.arange(len(rows)), c]
+        better = fc < best_f[rows]
+        full = np.zeros((len(rows), n))
+        np.put_along_axis(full, combos[c], lam[np.arange(len(rows)), c], -1)
+        upd = rows[better]
+        best_f[upd] = fc[better]
+        best_lam[upd] = full[better]
+    value, lower = fused_trace_bounds(Mf, best_lam)
     rough = value - lower > 0.01 * tol * np.abs(value)  # nearly degenerate faces: polish by Newton, keep if better
     if rough.any():
-        flat = best_lam.reshape(-1, n)
-        bad = np.nonzero(rough.reshape(-1))[0]
-        pol = _newton_polish(s.reshape(-1, n, 3)[bad], l.reshape(-1, n)[bad], flat[bad])
-        v2, lo2 = fused_trace_bounds(Minv.reshape(-1, n, 2, 2)[bad], pol)
-        keep = v2 - lo2 < (value - lower).reshape(-1)[bad]
-        flat = flat.copy()
-        flat[bad[keep]] = pol[keep]
-        best_lam = flat.reshape(best_lam.shape)
-        value, lower = fused_trace_bounds(Minv, best_lam)
+        bad = np.nonzero(rough)[0]
+        pol = _newton_polish(sf[bad], lf[bad], best_lam[bad])
+        v2, lo2 = fused_trace_bounds(Mf[bad], pol)
+        keep = v2 - lo2 < (value - lower)[bad]
+        best_lam[bad[keep]] = pol[keep]
+        value, lower = fused_trace_bounds(Mf, best_lam)
+    value, lower, best_lam = value.reshape(lead), lower.reshape(lead), best_lam.reshape(lead + (n,))
     if not np.all(value - lower <= tol * np.abs(value)):
         worst = float(np.max((value - lower) / np.abs(value)))
         raise ArithmeticError(f"min_fused_trace_exact: relative Frank-Wolfe gap {worst:.3g} above tolerance {tol:g}")
