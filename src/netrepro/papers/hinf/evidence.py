@@ -40,7 +40,7 @@ RECONSTRUCTION_CONFIG = {
     "consensus.K_p": "consensus.K_p", "consensus.K_i": "consensus.K_i", "consensus.h": "consensus.h",
     "consensus.iters": "consensus.iters", "control.Gamma": "control.Gamma", "control.v_max": "control.v_max",
     "control.recursion": "control.recursion", "evader.n_headings": "evader.n_headings",
-    "evader.step_scale": "evader.step_scale", "evader.n_iter": "evader.n_iter", "layouts.ten": "layouts.ten",
+    "evader.step_scale": "evader.step_scale", "evader.solver": "evader.solver", "layouts.ten": "layouts.ten",
     "layouts.four": "layouts.four", "scenarios.horizon": "scenarios.*.horizon", "scenarios.runs": "scenarios.*.runs",
     "scenarios.static_fixed.W_filter": "scenarios.static_fixed.W_filter", "claims.late_start": "claims.late_start",
     "claims.settle_threshold": "claims.settle_threshold", "claims.z_significant": "claims.z_significant",
@@ -151,9 +151,14 @@ def sensitivity_text(sens: pd.DataFrame, parameter: str) -> str:
     return "sweep (results/hinf/sensitivity.csv): " + "; ".join(parts)
 
 
+def _solver_label(solver: str, n_iter) -> str:
+    """``mirror x20``, ``pairwise x300``; ``exact`` (no iterations)."""
+    return "exact" if solver == "exact" else f"{solver} x{n_iter}"
+
+
 def evader_text(ev: pd.DataFrame) -> str:
     """A sentence summarising ``evader_convergence.csv``: is the evader's inner minimisation converged?"""
-    parts = [f"{r.solver} x{r.n_iter}{' (configured)' if r.configured else ''}: choice certified in "
+    parts = [f"{_solver_label(r.solver, r.n_iter)}{' (configured)' if r.configured else ''}: choice certified in "
              f"{r.certified_fraction:.1%} of {r.decisions} decisions, same as the certified reference in "
              f"{r.same_as_reference:.1%}, objective lost mean {r.mean_loss:.2g} / max {r.max_loss:.2g} "
              f"(median value {r.median_value:.3g})" for r in ev.itertuples()]
@@ -490,7 +495,7 @@ def _premise_rows(pe, evp, z_sig, gamma):
         rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"gamma={ratio:g} gamma_0",
                      "value": bool((g["z"] < -z_sig).all())})
     for (solver, n_iter, runs), g in evp.groupby(["solver", "n_iter", "runs"], sort=False):
-        rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"evader {solver} x{n_iter} ({runs} runs)",
+        rows.append({"quantity": "premise.hinf_beats_kalman_evasive", "variant": f"evader {_solver_label(solver, n_iter)} ({runs} runs)",
                      "value": bool((g["z"] < -z_sig).all())})
     rows.append({"quantity": "premise.random_target", "value": float(rnd["z"].max()),
                  "note": "paired z (H-infinity minus Kalman) against the random-walk target, by filter and gamma: "
@@ -524,7 +529,7 @@ def _reconstruction_rows(cfg, sens, ev_conv) -> list[dict]:
         note = sensitivity_text(sens, sweep) if sweep else ""
         if key == "filter.gamma":
             note += " | evasive target (gamma = inf: Kalman-driven agents): " + sensitivity_text(sens, "gamma_evasive")
-        if key == "evader.n_iter":
+        if key == "evader.solver":
             note = evader_text(ev_conv)
         rows.append({"quantity": f"reconstruction.{key}", "value": _get(cfg, path), "note": note})
     return rows

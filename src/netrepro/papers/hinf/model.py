@@ -20,7 +20,7 @@ import numpy as np
 from ...errors import InputError, ModelError
 from .algebra import I2, min_eig2, sym2
 from .consensus import adjacency, laplacian, pi_consensus_step
-from .evader import evader_move, min_fused_trace
+from .evader import SOLVERS, evader_move
 from .filters import FilterDoesNotExist, decentralized_update, hinf_update, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
@@ -90,6 +90,7 @@ def resolve_scenario(cfg: dict, name: str, **overrides) -> dict:
         "radius": float(cfg["comm_radius"]), "consensus": cons, "control": ctrl, "mobile": bool(sc["mobile"]),
         "driver": sc.get("driver", "decentralized"),
         "evader": {"n_headings": cfg["evader"]["n_headings"], "n_iter": cfg["evader"]["n_iter"],
+                   "solver": cfg["evader"].get("solver", "mirror"),
                    "step": cfg["evader"]["step_scale"] * math.sqrt(2 * W)},
         "filters": list(sc["filters"]), "horizon": int(sc["horizon"]), "runs": int(sc["runs"]), "seed": int(sc["seed"]),
     }
@@ -279,7 +280,8 @@ def simulate(sc: dict) -> dict:
         ags[:, k] = P
     if sc["target"] == "evasive" or sc.get("fused_all", True):
         r, th = geometry(tgt[:, 0], ags[:, 0])
-        fused[:, 0] = min_fused_trace(noise_information(r, th, model), int(ev.get("n_iter", 40)))[0]
+        inner = SOLVERS[ev.get("solver", "mirror")]  # the evader's own inner solver of (24)
+        fused[:, 0] = inner(noise_information(r, th, model), int(ev.get("n_iter", 40)))[0]
     return {"errors": errors, "target": tgt, "agents": ags, "connected": connected, "max_degree": max_degree,
             "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix, "connected_runs": conn_runs,
             "information": info_hist}

@@ -59,10 +59,11 @@ Tables (all under ``results/hinf/``)
 ``evader_convergence.csv`` (issue 17)
     ``solver, n_iter, configured, decisions, certified_fraction, same_as_reference, median_gap, max_gap,
     median_margin, median_value, max_loss, mean_loss, loss_above_tolerance_fraction, ...`` — replayed
-    evader decisions, each candidate's value bracketed by a duality-gap certificate.
+    evader decisions (mirror descent, pairwise Frank-Wolfe, exact), each candidate's value bracketed by a
+    duality-gap certificate; the exact solver is the reference.
 ``evader_paired.csv``
     ``solver, n_iter, runs, filter_a, filter_b, gamma, mean_diff, se, z, error_a, error_b`` — the H-infinity
-    vs Kalman comparison repeated with the configured and the better-converged evader.
+    vs Kalman comparison repeated with the configured, the mirror-descent and the pairwise evader.
 ``fig5_control.csv`` (issue 15)
     ``parameter, value, runs, horizon, start, stationary, mobile, mean_diff, se, z`` — Fig 5 (mobile minus stationary
     decentralized late error, paired over runs: same seed, target and noise stream) across the sweeps of the control
@@ -463,13 +464,18 @@ def evader_check_step(params, inputs, outputs):
     """Has the evader's inner minimisation (eq (24), over lambda) converged? Decisions replayed and certified.
 
     The decisions of the first ``evader_check.runs`` runs of ``evasive_hinf`` are replayed with the
-    evader's mirror descent at several iteration counts (the configured one included) and with a
-    certified reference (pairwise Frank-Wolfe; every candidate's value bracketed by its duality gap).
-    A choice is certified when its lower bound beats every other candidate's upper bound. The loss
-    of a choice is the reference value of the best candidate minus that of the chosen one: a wrong
-    choice matters only if this exceeds the reference's tolerance (the candidates are otherwise tied).
-    Second table: the H-infinity vs Kalman comparison of ``paired_evasive`` (configured gamma) repeated on
-    ``paired_runs`` runs with the configured evader and with the pairwise (better converged) evader.
+    evader's mirror descent at several iteration counts, with pairwise Frank-Wolfe
+    (``evader_check.reference_iterations`` iterations) and with the exact solver
+    (:func:`~netrepro.papers.hinf.evader.min_fused_trace_exact`), which is the certified reference: every
+    candidate's value is bracketed by its duality gap (:func:`~netrepro.papers.hinf.evader.fused_trace_bounds`),
+    at most ``EXACT_TOLERANCE`` relative for the exact solver. A choice is certified when its lower bound
+    beats every other candidate's upper bound. The loss of a choice is the reference value of the best
+    candidate minus that of the chosen one: a wrong choice matters only if this exceeds the reference's
+    tolerance (the candidates are otherwise tied). The configured evader (``evader.solver``, and
+    ``evader.n_iter`` for mirror descent) is flagged. Second table: the H-infinity vs Kalman comparison of
+    ``paired_evasive`` (configured gamma) repeated on ``paired_runs`` runs with the configured evader, the
+    mirror-descent evader (``evader.n_iter`` iterations) and the pairwise evader (``pairwise_iterations``).
+    ``n_iter`` is 0 for the exact solver (no iterations).
     """
     cfg, ec = params, params["evader_check"]
     sc = resolve_scenario(cfg, "evasive_hinf", runs=int(ec["runs"]))
@@ -479,19 +485,18 @@ def evader_check_step(params, inputs, outputs):
     x = out["target"][:, :-1].reshape(-1, 2)
     P = out["agents"][:, :-1].reshape(-1, N, 2)
     ev = sc["evader"]
-    ref = evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"], int(ec["reference_iterations"]),
-                           "pairwise")
+    conf_solver = ev.get("solver", "mirror")
+    ref = evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"], 0, "exact")
     idx = np.arange(len(x))
     best_ref = ref["upper"][idx, ref["choice"]]
     rows = []
     mirror = sorted({int(n) for n in ec["mirror_iterations"]} | {int(ev["n_iter"])})  # the configured one always
-    for solver, n_iter in [("mirror", n) for n in mirror] + [
-            ("pairwise", int(ec["reference_iterations"]))]:
-        d = ref if solver == "pairwise" else evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"],
-                                                              n_iter, solver)
+    for solver, n_iter in [("mirror", n) for n in mirror] + [("pairwise", int(ec["reference_iterations"])), ("exact", 0)]:
+        d = ref if solver == "exact" else evader_decisions(x, P, sc["model"], ev["step"], ev["n_headings"], n_iter, solver)
         loss = best_ref - ref["upper"][idx, d["choice"]]
         tol = ref["gap"]
-        rows.append({"solver": solver, "n_iter": n_iter, "configured": solver == "mirror" and n_iter == int(ev["n_iter"]),
+        configured = solver == conf_solver and (solver == "exact" or n_iter == int(ev["n_iter"]))
+        rows.append({"solver": solver, "n_iter": n_iter, "configured": configured,
                      "decisions": len(x), "certified_fraction": float(d["certified"].mean()),
                      "same_as_reference": float(np.mean(d["choice"] == ref["choice"])),
                      "median_gap": float(np.median(d["gap"])), "max_gap": float(d["gap"].max()),
@@ -501,11 +506,14 @@ def evader_check_step(params, inputs, outputs):
                      "loss_above_tolerance_fraction": float(np.mean(loss > tol)),
                      "reference_certified_fraction": float(ref["certified"].mean()),
                      "reference_max_gap": float(ref["gap"].max())})
-    # does the premise's verdict depend on the evader's unconverged inner solver? same seeds, both evaders
+    # does the premise's verdict depend on the evader's inner solver? same seeds, each evader
     prows = []
-    for solver, n_iter in (("mirror", int(ev["n_iter"])), ("pairwise", int(ec["pairwise_iterations"]))):
+    evaders = [(conf_solver, 0 if conf_solver == "exact" else int(ev["n_iter"]))]
+    evaders += [e for e in (("mirror", int(ev["n_iter"])), ("pairwise", int(ec["pairwise_iterations"])))
+                if e not in evaders]
+    for solver, n_iter in evaders:
         sp = resolve_scenario(cfg, "evasive_hinf", runs=int(ec["paired_runs"]), seed=int(cfg["paired"]["seed"]))
-        sp["evader"] = {**sp["evader"], "solver": solver, "n_iter": n_iter}
+        sp["evader"] = {**sp["evader"], "solver": solver, "n_iter": max(n_iter, 1)}
         res = run_paired(sp, [])
         start = int(cfg["claims"]["late_start"])
         for kind in KINDS:
