@@ -72,6 +72,7 @@ __all__ = [
     "referenced_tables",
     "read_evidence",
     "evidence_frame",
+    "erratum_evidence",
     "lookup",
     "agrees",
     "judge",
@@ -368,6 +369,29 @@ def evidence_frame(rows) -> pd.DataFrame:
     if dup.any():
         raise ValueError(f"repeated evidence rows: {frame.loc[dup, ['quantity', 'variant']].values.tolist()}")
     return frame
+
+
+def erratum_evidence(erratum_id: str, printed, corrected=None, note: str = "") -> list[dict]:
+    """Evidence rows of an erratum's residuals, named as :func:`errata_table` reads them.
+
+    Parameters
+    ----------
+    erratum_id : str
+        The erratum's id in ``errata.yaml``.
+    printed, corrected
+        Residual of the printed form and of the corrected one (``corrected`` omitted: no row).
+    note : str
+        The computed part of the demonstration.
+
+    Returns
+    -------
+    list of dict
+        Rows for :func:`evidence_frame`.
+    """
+    rows = [{"quantity": f"{erratum_id}.residual_printed", "value": printed, "note": note}]
+    if corrected is not None:
+        rows.append({"quantity": f"{erratum_id}.residual_corrected", "value": corrected})
+    return rows
 
 
 def _parse(value):

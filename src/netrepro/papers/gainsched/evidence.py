@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...io import read_table
-from ...verdicts import evidence_frame
+from ...verdicts import erratum_evidence, evidence_frame
 from .feasibility import plant_vertex_radius, with_sigma2
 from .model import (
     frozen_radius,
@@ -298,11 +298,11 @@ def evidence_step(params, inputs, outputs):
     add({"quantity": "remark2_missing_bound", "value": bool(1.0 - sys.p1 <= bound),
          "note": f"largest missing probability 1 - p1 = {1 - sys.p1:g} under (7); {sys.p2:g} = p2 under the paper's "
                  "naming of p(k) as the missing probability"})
-    add({"quantity": "E6_remark2_example.residual_printed", "value": float(sys.p2 - bound),
-         "note": f"excess over {bound:g} of the largest missing probability of the example: p2 - {bound:g} = "
+    rows += erratum_evidence(
+        "E6_remark2_example", float(sys.p2 - bound), float(1.0 - sys.p1 - bound),
+        f"excess over {bound:g} of the largest missing probability of the example: p2 - {bound:g} = "
                  f"{sys.p2 - bound:g} with p(k) read as the missing probability (printed), 1 - p1 - {bound:g} = "
-                 f"{1 - sys.p1 - bound:g} with p(k) the arrival probability of (7) (corrected column)"})
-    add({"quantity": "E6_remark2_example.residual_corrected", "value": float(1.0 - sys.p1 - bound)})
+                 f"{1 - sys.p1 - bound:g} with p(k) the arrival probability of (7) (corrected column)")
 
     # ---- Remark 5 (context): size of the example's Theorem 3 (solve times are machine-dependent: timing.csv only)
     n_vars = int(designs.loc["theorem3", "n_scalar_variables"])
@@ -327,27 +327,27 @@ def evidence_step(params, inputs, outputs):
     design = gains_from_table(gains_tab, "theorem3", sys)
     c = certificate_from_solution(v, "identity_T")
     e1p, e1c = _eq15_residuals(sys, design, c["Q0"], c["Qp"], rng)
-    add({"quantity": "E1_eq15_sign.residual_printed", "value": e1p,
-         "note": f"max over 4000 random z̄, 3 sector nonlinearities and 3 (p, p+) pairs of E ΔV (14) minus the right "
-                 f"side of (15) (must be <= 0): printed {e1p:.4g}, corrected {e1c:.3g}"})
-    add({"quantity": "E1_eq15_sign.residual_corrected", "value": e1c})
+    rows += erratum_evidence(
+        "E1_eq15_sign", e1p, e1c,
+        f"max over 4000 random z̄, 3 sector nonlinearities and 3 (p, p+) pairs of E ΔV (14) minus the right "
+                 f"side of (15) (must be <= 0): printed {e1p:.4g}, corrected {e1c:.3g}")
     n_runs, seed = int(params["evidence"]["missing_runs"]), int(params["evidence"]["missing_seed"])
     frac, se = missing_fraction(p_seq, n_runs, seed)
-    add({"quantity": "E2_missing_probability.residual_printed", "value": abs(frac - p_seq.mean()),
-         "note": f"fraction of missing measurements in {n_runs} runs x {p_seq.size} steps of (6)-(7) (seed {seed}): "
-                 f"{frac:.4f} (s.e. {se:.1g}); mean p(k) {p_seq.mean():.4f}, 1 - mean p(k) {1 - p_seq.mean():.4f}"})
-    add({"quantity": "E2_missing_probability.residual_corrected", "value": abs(frac - (1 - p_seq.mean()))})
+    rows += erratum_evidence(
+        "E2_missing_probability", abs(frac - p_seq.mean()), abs(frac - (1 - p_seq.mean())),
+        f"fraction of missing measurements in {n_runs} runs x {p_seq.size} steps of (6)-(7) (seed {seed}): "
+                 f"{frac:.4f} (s.e. {se:.1g}); mean p(k) {p_seq.mean():.4f}, 1 - mean p(k) {1 - p_seq.mean():.4f}")
     e3 = r2_congruence_residuals(v)
-    add({"quantity": "E3_R2_transpose.residual_printed", "value": e3["printed"],
-         "note": f"||T^T S T - [[S11, R1], [R2, R2]]||_F with S21 = I and the Theorem 3 solution: printed relation "
-                 f"{e3['printed']:.3g}, corrected {e3['corrected']:.2g}"})
-    add({"quantity": "E3_R2_transpose.residual_corrected", "value": e3["corrected"]})
+    rows += erratum_evidence(
+        "E3_R2_transpose", e3["printed"], e3["corrected"],
+        f"||T^T S T - [[S11, R1], [R2, R2]]||_F with S21 = I and the Theorem 3 solution: printed relation "
+                 f"{e3['printed']:.3g}, corrected {e3['corrected']:.2g}")
     s2_hi = float(max(sens["sigma2_grid"]))
     rho_w0, rho_w = plant_vertex_radius(sys, 0.0), plant_vertex_radius(sys, s2_hi)
-    add({"quantity": "E5_definition1_w.residual_printed", "value": rho_w0,
-         "note": f"plant vertex second-moment radius at sigma2 = {s2_hi:g}: {rho_w0:.4f} with w(k) = 0 as Definition 1 "
-                 f"prints (sigma2 drops out: 'stable'), {rho_w:.4f} with the multiplicative noise (not MS stable)"})
-    add({"quantity": "E5_definition1_w.residual_corrected", "value": rho_w})
+    rows += erratum_evidence(
+        "E5_definition1_w", rho_w0, rho_w,
+        f"plant vertex second-moment radius at sigma2 = {s2_hi:g}: {rho_w0:.4f} with w(k) = 0 as Definition 1 "
+                 f"prints (sigma2 drops out: 'stable'), {rho_w:.4f} with the multiplicative noise (not MS stable)")
 
     # ---- findings
     sm = exact[exact["nonlinearity"] == "mid"].set_index(["design", "initial_state"])["sum_mse"]

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...verdicts import evidence_frame
+from ...verdicts import erratum_evidence, evidence_frame
 from .algebra import rotation
 from .model import paired_z
 from .motion import control_law, printed_control_law, printed_sigma_gradient, sigma_gradient
@@ -183,8 +183,7 @@ def _errata_rows(cfg) -> list[dict]:
     rows = []
 
     def add(eid, printed, corrected, note):
-        rows.append({"quantity": f"{eid}.residual_printed", "value": float(printed), "note": note})
-        rows.append({"quantity": f"{eid}.residual_corrected", "value": float(corrected)})
+        rows.extend(erratum_evidence(eid, float(printed), float(corrected), note))
 
     # E1: eq (3) is the square root of the covariance, not the noise vector
     n = int(cfg["errata"]["n_samples"])
@@ -595,11 +594,11 @@ def evidence_step(params, inputs, outputs):
                          f"{_agent_summary(pa, 'fig2', z_sig)}"})
     noise_rows, adv = _noise_gain_rows(summ, sens, pa, cfg)
     rows += noise_rows
-    rows.append({"quantity": "E_speed.residual_printed", "value": max(0.0, adv["fig3"] - adv["fig2"]),
-                 "note": f"advantage (local/decentralized late error) at W={cfg['scenarios']['fig2']['W']:g}: "
-                         f"{adv['fig2']:.3f}, at W={cfg['scenarios']['fig3']['W']:g}: {adv['fig3']:.3f}; residual = how "
-                         f"far the order each form states is violated"})
-    rows.append({"quantity": "E_speed.residual_corrected", "value": max(0.0, adv["fig2"] - adv["fig3"])})
+    rows += erratum_evidence(
+        "E_speed", max(0.0, adv["fig3"] - adv["fig2"]), max(0.0, adv["fig2"] - adv["fig3"]),
+        f"advantage (local/decentralized late error) at W={cfg['scenarios']['fig2']['W']:g}: "
+        f"{adv['fig2']:.3f}, at W={cfg['scenarios']['fig3']['W']:g}: {adv['fig3']:.3f}; residual = how "
+        f"far the order each form states is violated")
     # Fig 4-5
     errors = pd.read_csv(inputs["errors"])
     thresholds = sorted(set(float(t) for t in cfg["claims"]["settle_variants"]) | {float(cfg["claims"]["settle_threshold"])})

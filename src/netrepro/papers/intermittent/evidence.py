@@ -14,7 +14,7 @@ import numpy as np
 
 from ...engines.riccati import Sensor, expected_riccati_map
 from ...io import read_table
-from ...verdicts import evidence_frame
+from ...verdicts import erratum_evidence, evidence_frame
 from .exact import exact_mean
 from .model import (critical_probability, exact_mean_enumeration, lower_bound_sequence, report_estimate_sequence,
                     riccati_step, sinopoli_operator, upper_bound_sequence)
@@ -172,8 +172,7 @@ def _errata_rows(sc, ts):
     rows = []
 
     def add(eid, printed, corrected, note):
-        rows.append({"quantity": f"{eid}.residual_printed", "value": printed, "note": note})
-        rows.append({"quantity": f"{eid}.residual_corrected", "value": corrected})
+        rows.extend(erratum_evidence(eid, printed, corrected, note))
 
     p = 1.0
     k_opt = optimize.minimize_scalar(lambda K: sinopoli_operator(K, p, lam, a, R1, R2)).x
@@ -219,12 +218,12 @@ def _errata_rows(sc, ts):
     lams = lam_c + np.array([0.05, 0.1, 0.2, 0.3])
     means = np.array([exact_mean(p0, a, R1, [R2], [x], 60).mean for x in lams])
     rise = float(np.max(np.maximum(np.diff(means, axis=0), 0.0)))
-    rows.append({"quantity": "E16.residual_printed", "value": float(s_c[-1] - s_c[0]),
-                 "note": f"the premise 'E(p_k) bounded at lambda_c' fails: E(p_k) >= s_k and s_100 - s_0 = "
-                         f"{s_c[-1] - s_c[0]:.4f} at lambda = lambda_c; the monotonicity the corrected argument uses "
-                         f"holds on the exact E(p_k), k <= 60, at lambda_c + (0.05, 0.1, 0.2, 0.3): largest increase "
-                         f"with lambda {rise:.1e}"})
-    rows.append({"quantity": "E16.residual_corrected", "value": rise})
+    rows += erratum_evidence(
+        "E16", float(s_c[-1] - s_c[0]), rise,
+        f"the premise 'E(p_k) bounded at lambda_c' fails: E(p_k) >= s_k and s_100 - s_0 = "
+        f"{s_c[-1] - s_c[0]:.4f} at lambda = lambda_c; the monotonicity the corrected argument uses "
+        f"holds on the exact E(p_k), k <= 60, at lambda_c + (0.05, 0.1, 0.2, 0.3): largest increase "
+        f"with lambda {rise:.1e}")
     sig = np.diag(ts["sigma2"])
     X, l1, l2 = 1.0, 0.5, 0.5
     ones = np.ones((2, 1))
@@ -241,9 +240,8 @@ def _errata_rows(sc, ts):
     add("E12", abs(literal - lmi), abs(float(two_sensor_lower_bound(lam1, a)) - lmi),
         f"at lambda1 = 0.3 the LMI threshold is {lmi:.5f}; literal reading {literal:.5f}")
     r_inf = upper_bound_sequence(p0, a, R1, R2, lam, 400)[-1]
-    rows.append({"quantity": "E13.residual_printed", "value": "",
-                 "note": f"fixed point of the modified Riccati iteration r* = {r_inf:.4f} at lambda_c + 0.1, "
-                         "against the exact lim E(p_k) of claim C10"})
+    rows += erratum_evidence("E13", "", None, f"fixed point of the modified Riccati iteration r* = {r_inf:.4f} at "
+                             "lambda_c + 0.1, against the exact lim E(p_k) of claim C10")
     rows += _eq12_rows(ts)
     return rows
 
@@ -469,7 +467,7 @@ def _sample_path_rows(sc, ev, lam, stationary):
             + ", ".join(f"{p:.3g} (T = 1e{int(np.log10(T))})" for T, p in probs.items())
             + "; the run occurs almost surely on an infinite horizon, for every level, so sup_k p_k = inf with "
               "probability 1 although E(p_k) is bounded")
-    return [{"quantity": "E17.residual_printed", "value": probs[10**15], "note": note},
+    return [*erratum_evidence("E17", probs[10**15], None, note),
             {"quantity": "sample_paths_unbounded", "value": probs[10**15], "note": note}]
 
 

@@ -9,12 +9,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ...verdicts import evidence_frame
+from ...verdicts import erratum_evidence, evidence_frame
 from .certificates import parity_growth, parity_structure
 from .lmis import schur_residual
 from .model import (
     H_matrix, L_operator, LinearSystem, gilbert_elliott_stationary_loss, h_radius, observability_index,
-    parity_bound_example2, phi_lyapunov, prop1_bound, spectral_abs,
+    parity_bound_example2, phi_lyapunov, prop1_bound, riccati_g, riccati_h, spectral_abs,
 )
 from .steps import load_moments
 
@@ -45,8 +45,8 @@ def prop1_closed_form(lam_abs: float, q):
 def enumerate_norms(system: LinearSystem, Sigma0, k_max: int):
     """``||P_k||`` on every channel path ``gamma_1..gamma_{k-1}``, ``k = 1..k_max`` (recursion under eq. 3).
 
-    ``P_{k+1} = g(P_k)`` if ``gamma_k = 1`` else ``h(P_k)`` (eqs. 4-5). Brute force over all
-    ``2^(k-1)`` paths, independent of :mod:`.exact` (which groups paths by transition counts).
+    ``P_{k+1} = g(P_k)`` if ``gamma_k = 1`` else ``h(P_k)`` (eqs. 4-5, the model's maps). Brute force
+    over all ``2^(k-1)`` paths, independent of :mod:`.exact` (which groups paths by transition counts).
 
     Parameters
     ----------
@@ -67,11 +67,7 @@ def enumerate_norms(system: LinearSystem, Sigma0, k_max: int):
     G = np.zeros((1, 0), dtype=int)
     out = [(G, np.linalg.eigvalsh(P)[:, -1])]
     for _ in range(1, k_max):
-        Ph = A @ P @ A.T + Q
-        S = C @ P @ C.T + R
-        APC = A @ P @ C.T
-        Pg = Ph - APC @ np.linalg.solve(S, np.swapaxes(APC, 1, 2))
-        P = np.concatenate([Ph, 0.5 * (Pg + np.swapaxes(Pg, 1, 2))])
+        P = np.concatenate([riccati_h(P, A, Q), riccati_g(P, A, C, Q, R)])
         G = np.concatenate([np.c_[G, np.zeros(len(G), int)], np.c_[G, np.ones(len(G), int)]])
         out.append((G, np.linalg.eigvalsh(P)[:, -1]))
     return out
@@ -183,10 +179,6 @@ def single_transition(smap: pd.DataFrame):
     return bool(bad == 0), "; ".join(parts)
 
 
-def _system(ex):
-    return LinearSystem.from_config(ex)
-
-
 # ----------------------------------------------------------------------------- evidence blocks
 def _section51_rows(ex1, checks, curves):
     A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
@@ -241,13 +233,13 @@ def _section52_rows(ex2, checks, tight, moments, growth_margins, growth_margin):
         rows.append(dict(quantity="exII.p_thm5_q05", variant=f"tight_tol={t.tol:g}", value=float(t.p_lower)))
     r = ck.loc["exII_thm5_p0465"]
     rows.append(dict(quantity="exII.p0465_certified", value=bool(r.certified and r.verdict == "feasible"),
-                     note=f"at p = 0.465 the LMI is certified {r.verdict} ({r.evidence}); p_underline = {lower:.6f}"))
+                     note=f"at p = {r.p:g} the LMI is certified {r.verdict} ({r.evidence}); p_underline = {lower:.6f}"))
     r = ck.loc["exII_thm2_p1"]
     rows.append(dict(quantity="exII.lmi_p1_infeasible", value=bool(r.verdict == "infeasible"),
                      note=f"{r.evidence}; solver status {r.status} (information only)"))
     r = ck.loc["exII_fig5_p045"]
     rows.append(dict(quantity="exII.fig5_certified", value=bool(r.certified and r.verdict == "feasible"),
-                     note=f"{r.evidence}; 0.45 < p_underline = {lower:.6f}"))
+                     note=f"{r.evidence}; {r.p:g} < p_underline = {lower:.6f}"))
     st = parity_structure(ex2["A"], ex2["C"], ex2["Q"])
     rate = float(parity_growth(st["lam"], 0.99, 0.5)) if st is not None else np.nan
     em2 = load_moments(moments, "II")
@@ -334,7 +326,7 @@ def _prop2_rows(params, moments):
     for name in cfg["examples"]:
         ex = params["examples"][name]
         em = load_moments(moments, name)
-        paths = enumerate_norms(_system(ex), ex["Sigma0"], cfg["k_max"])
+        paths = enumerate_norms(LinearSystem.from_config(ex), ex["Sigma0"], cfg["k_max"])
         for q in cfg["q"]:
             g1 = monotonicity_violation(em.mean(ps, q, "norm"), ps, cfg["rtol"])
             stat = monotonicity_violation(np.array([mean_norm_enumerated(paths, p, q, "stationary") for p in ps]), ps, cfg["rtol"])
@@ -357,15 +349,15 @@ def _prop2_rows(params, moments):
     # the coupled chain of Fig. 1 has the weight 1 - q - p2 on (0,1) -> (0,1): negative iff p2 + q > 1
     rows.append(dict(quantity="prop2.violation_gamma1", value=worst["violation"], note=note1))
     rows.append(dict(quantity="prop2.violation_stationary", value=worst_stat["violation"], note=note2))
-    rows.append(dict(quantity="E10_prop2_signed_measure.residual_printed", value=worst["violation"],
-                     note=f"largest relative excess of E_p2 over E_p1 (p2 < p1) that the signed-measure ordering would "
-                          f"exclude; the coupled chain's weight (0,1) -> (0,1) is 1 - q - p2 = "
-                          f"{1 - worst['q'] - worst['p2']:.3g} < 0 there. {note1}"))
-    rows.append(dict(quantity="E10_prop2_signed_measure.residual_corrected", value=max(worst_stat["violation"], 0.0)))
+    rows += erratum_evidence(
+        "E10_prop2_signed_measure", worst["violation"], max(worst_stat["violation"], 0.0),
+        f"largest relative excess of E_p2 over E_p1 (p2 < p1) that the signed-measure ordering would "
+        f"exclude; the coupled chain's weight (0,1) -> (0,1) is 1 - q - p2 = "
+        f"{1 - worst['q'] - worst['p2']:.3g} < 0 there. {note1}")
     return rows
 
 
-def _errata_rows(ex1, lower, analytic, seed):
+def _errata_rows(ex1, lower, analytic, seed, printed_p):
     A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
     rng = np.random.default_rng(seed)
     schur = schur_residual(A1, C1, 0.5, 0.65, rng)
@@ -379,14 +371,11 @@ def _errata_rows(ex1, lower, analytic, seed):
     return [
         dict(quantity="E1_C_i_undefined.residual_corrected", value=max(schur, adj),
              note=f"Schur residual {schur:.1e}, adjoint residual {adj:.1e}"),
-        dict(quantity="E2_eq11_last_block.residual_printed", value=float(m),
-             note=f"row mismatch of the printed block: m = {m}"),
-        dict(quantity="E2_eq11_last_block.residual_corrected", value=0.0),
-        dict(quantity="E3_exII_0465.residual_printed", value=0.465 - lower,
-             note=f"0.465 - certified p_underline; closed form {analytic:.9f}"),
-        dict(quantity="E3_exII_0465.residual_corrected", value=abs(analytic - lower)),
-        dict(quantity="E7_phi_definite.residual_printed", value=float(np.linalg.eigvalsh(phi0)[0]),
-             note="smallest eigenvalue of Phi_X at X = 0 (Example I, q = 0.65): not positive definite"),
+        *erratum_evidence("E2_eq11_last_block", float(m), 0.0, f"row mismatch of the printed block: m = {m}"),
+        *erratum_evidence("E3_exII_0465", printed_p - lower, abs(analytic - lower),
+                          f"{printed_p:g} - certified p_underline; closed form {analytic:.9f}"),
+        *erratum_evidence("E7_phi_definite", float(np.linalg.eigvalsh(phi0)[0]), None,
+                          "smallest eigenvalue of Phi_X at X = 0 (Example I, q = 0.65): not positive definite"),
     ]
 
 
@@ -450,6 +439,7 @@ def evidence_step(params, inputs, outputs):
     rows += _iid_rows(iid, params["iid"]["tol"])
     rows += _map_rows(smap, curves, params)
     rows += _prop2_rows(params, moments)
-    rows += _errata_rows(ex1, lower, analytic, params["errata_seed"])
+    # the printed p_underline(0.5) is the configured check point exII_thm5_p0465 (not typed here)
+    rows += _errata_rows(ex1, lower, analytic, params["errata_seed"], float(checks.loc["exII_thm5_p0465", "p"]))
     rows += _reconstruction_rows(params, sens, tight)
     return {"table": evidence_frame(rows)}

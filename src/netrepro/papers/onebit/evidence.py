@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-from ...verdicts import evidence_frame
+from ...verdicts import erratum_evidence, evidence_frame
 from .estimators import paired_ratio_interval
 from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
 from .model import prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
@@ -146,8 +146,7 @@ def errata_rows(params) -> list:
     rows = []
 
     def add(eid, printed, corrected, note):
-        rows.append(dict(quantity=f"{eid}.residual_printed", value=printed, note=note))
-        rows.append(dict(quantity=f"{eid}.residual_corrected", value=corrected))
+        rows.extend(erratum_evidence(eid, printed, corrected, note))
 
     demo = ("2-D model with non-symmetric A (config onebit.vector_check): max relative Frobenius error of the inverse "
             "BIM against the Kalman/RTS covariance over all k")
