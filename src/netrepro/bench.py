@@ -233,6 +233,13 @@ def bench_exact_mean(n_paths: int, horizon: int, repeats: int) -> list[dict]:
     ]
 
 
+def _configured(slug: str) -> dict:
+    """The paper's section of the full configuration (the benchmarks run the configured problem)."""
+    import yaml
+
+    return yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())[slug]
+
+
 def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:
     """Exact E||e(k)||^2 of the ``gainsched`` filter (printed gains, f = F1 z) against the Monte Carlo it replaces.
 
@@ -242,13 +249,11 @@ def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:
     Monte Carlo's largest relative error against the exact values over k (what the exact method
     removes: with the multiplicative noise the squared error is heavy-tailed).
     """
-    import yaml
-
     from .papers.gainsched.model import gains_from_dict, simulate, system_from_config
     from .papers.gainsched.moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
     from .papers.gainsched.steps import p_sequence
 
-    cfg = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())["gainsched"]
+    cfg = _configured("gainsched")
     sys_ = system_from_config(cfg["system"])
     gains = gains_from_dict(cfg["paper_gains"], sys_)
     p_seq = p_sequence(cfg, sys_)
@@ -286,12 +291,10 @@ def bench_markov_exact(depth: int, repeats: int) -> list[dict]:
     its own small Riccati map. Rows: the time ratio at the same depth, and the agreement of the
     two expectation polynomials on a (p, q) grid.
     """
-    import yaml
-
     from .papers.markov.exact import exact_moments, exact_moments_split, find_split
     from .papers.markov.model import LinearSystem
 
-    cfg = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())["markov"]
+    cfg = _configured("markov")
     ex = cfg["examples"]["II"]
     system, sigma0 = LinearSystem.from_config(ex), np.asarray(ex["Sigma0"], float)
     split = find_split(system, sigma0)
