@@ -350,9 +350,11 @@ def load_paper_data(slug: str, root: str | Path | None = None) -> PaperData:
 
 def referenced_tables(slug: str, root: str | Path | None = None) -> list[str]:
     """The result tables (other than the evidence table) that the paper's claims read."""
-    data = load_paper_data(slug, root)
-    tables = {e.ours["table"] for e in data.claims if e.ours.get("table")}
-    return sorted(tables)
+    return _tables_read(load_paper_data(slug, root))
+
+
+def _tables_read(data: PaperData) -> list[str]:
+    return sorted({e.ours["table"] for e in data.claims if e.ours.get("table")})
 
 
 def evidence_frame(rows) -> pd.DataFrame:
@@ -677,7 +679,7 @@ def verdicts_step(params, inputs, outputs):
     paths = inputs.get("tables", [])
     paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
     tables = {str(p): pd.read_csv(p) for p in paths}
-    missing = set(referenced_tables(slug, Path(inputs["claims_file"]).parent)) - set(tables)
+    missing = set(_tables_read(data)) - set(tables)
     if missing:
         raise InputError(f"claims of {slug} read tables that are not inputs of the rule: {sorted(missing)}")
     return {"table": claims_table(data, tables, evidence), "errata": errata_table(data, evidence),
