@@ -148,3 +148,16 @@ def test_readme_has_the_generated_results_table():
     assert START in text and END in text
     table = text.split(START, 1)[1].split(END, 1)[0]
     assert "| **total** |" in table
+
+
+# ----------------------------------------------------------------------------- notebooks
+@pytest.mark.parametrize("notebook", sorted((ROOT / "workflow" / "notebooks").glob("*.ipynb")), ids=lambda p: p.stem)
+def test_notebook_cells_have_unique_ids(notebook):
+    """nbformat >= 4.5 needs one unique id per cell; a duplicate is 'corrected' with a warning in every build."""
+    import nbformat
+
+    raw = json.loads(notebook.read_text())  # nbformat.read would 'correct' duplicates silently
+    ids = [cell.get("id") for cell in raw["cells"]]
+    assert None not in ids, f"{notebook.name}: a cell has no id"
+    assert len(set(ids)) == len(ids), f"{notebook.name}: duplicate cell ids"
+    nbformat.validate(nbformat.from_dict(raw))
