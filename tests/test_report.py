@@ -2,7 +2,7 @@
 
 import pandas as pd
 
-from netrepro.reportgen import config_keys, rule_for, scorecard, strip_external_scripts
+from netrepro.reportgen import config_keys, relocate, rule_for, scorecard, strip_external_scripts
 
 
 def test_scorecard_counts_and_total():
@@ -42,3 +42,18 @@ def test_strip_external_scripts_leaves_no_network_request():
     assert "https://" not in out
     assert "var keep = 1" in out
     assert 'rel="icon" href="data:,"' in out
+
+
+def test_relocate_makes_paths_relative_and_shortens_interpreters(tmp_path):
+    root = tmp_path.resolve()
+    text = (f"cd {root} && {root}/.venv/bin/python3 -m netrepro 'x=/usr/bin/python3.11' "
+            f"<b>/opt/conda/bin/python</b> a/bin/python ~/bin/python {root}/results/a.csv")
+    assert relocate(text, root) == ("cd . && .venv/bin/python3 -m netrepro 'x=python3.11' <b>python</b> "
+                                    "a/bin/python ~/bin/python results/a.csv")
+
+
+def test_relocate_leaves_long_words_without_interpreter_alone(tmp_path):
+    # an inline image: one long word full of '/' (the path pattern used to backtrack over it)
+    blob = "data:image/png;base64," + "iVBOR/w0K+GgoA/" * 20000
+    text = f"<img src=\"{blob}\"> ran /usr/bin/python3"
+    assert relocate(text, tmp_path) == f"<img src=\"{blob}\"> ran python3"

@@ -144,6 +144,12 @@ def strip_external_scripts(text: str) -> str:
 
 
 _PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
+_WORD = re.compile(r"[^\s'\"<>]+")
+
+
+def _short_interpreter(word: re.Match) -> str:
+    text = word.group(0)
+    return _PYTHON_PATH.sub(r"\1", text) if "/bin/python" in text else text
 
 
 def relocate(text: str, root: str | Path) -> str:
@@ -151,7 +157,11 @@ def relocate(text: str, root: str | Path) -> str:
     to it (``root`` itself ``.``), and interpreter paths (``/.../bin/python3``) their last part."""
     root = str(Path(root).resolve())
     text = text.replace(root + "/", "").replace(root, ".")
-    return _PYTHON_PATH.sub(r"\1", text)
+    if "/bin/python" not in text:
+        return text
+    # word by word: on a long word without spaces (a base64 image) the path pattern backtracks
+    # from every '/', quadratic in the word's length (seconds per notebook page)
+    return _WORD.sub(_short_interpreter, text)
 
 
 def relocate_json(obj, root: str | Path):
