@@ -155,7 +155,11 @@ def _short_interpreter(word: re.Match) -> str:
 def relocate(text: str, root: str | Path) -> str:
     """``text`` with no absolute path of the build machine: paths under ``root`` become relative
     to it (``root`` itself ``.``), and interpreter paths (``/.../bin/python3``) their last part."""
-    root = str(Path(root).resolve())
+    return _relocate_under(text, str(Path(root).resolve()))
+
+
+def _relocate_under(text: str, root: str) -> str:
+    """:func:`relocate` with ``root`` already resolved."""
     text = text.replace(root + "/", "").replace(root, ".")
     if "/bin/python" not in text:
         return text
@@ -166,35 +170,17 @@ def relocate(text: str, root: str | Path) -> str:
 
 def relocate_json(obj, root: str | Path):
     """:func:`relocate` applied to every string of a JSON value (sidecars copied into the report)."""
+    return _relocate_json_under(obj, str(Path(root).resolve()))
+
+
+def _relocate_json_under(obj, root: str):
     if isinstance(obj, str):
-        return relocate(obj, root)
+        return _relocate_under(obj, root)
     if isinstance(obj, list):
-        return [relocate_json(v, root) for v in obj]
+        return [_relocate_json_under(v, root) for v in obj]
     if isinstance(obj, dict):
-        return {k: relocate_json(v, root) for k, v in obj.items()}
+        return {k: _relocate_json_under(v, root) for k, v in obj.items()}
     return obj
-
-
-def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root: str | Path = ".") -> Path:
-    """Run ``notebook`` with papermill (parameters ``slug``, ``root``) and export static HTML."""
-    import nbformat
-    import papermill
-    from nbconvert import HTMLExporter
-
-    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
-    # path of the machine that built it (and any path a warning prints is made relative too).
-    print("command:", shlex.join(getattr(sys, "orig_argv", sys.argv)), flush=True)
-    root = Path(root).resolve()
-    html_out = Path(html_out)
-    executed = html_out.with_suffix(".ipynb")
-    papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
-                               kernel_name="python3", cwd=str(root), progress_bar=False)
-    exporter = HTMLExporter()
-    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
-    with atomic_path(html_out) as tmp:
-        tmp.write_text(relocate(strip_external_scripts(body), root))
-    os.chmod(html_out, 0o644)
-    return html_out
 
 
 # ----------------------------------------------------------------------------- index
@@ -282,12 +268,13 @@ def config_keys(params: dict, config_section: dict, slug: str) -> list[tuple[str
     param's name and holds the same value, otherwise the param's own name
     (a constant fixed in the rule, ``from_config`` False).
     """
-    flat_cfg = _flatten(config_section or {})
+    # configuration keys by their last part (a key equal to the param's, or ending in it, has its last part)
+    by_leaf: dict[str, list] = {}
+    for k, v in _flatten(config_section or {}).items():
+        by_leaf.setdefault(k.split(".")[-1], []).append((k, v))
     matches = {}
     for key, value in _flatten(params or {}).items():
-        leaf = key.split(".")[-1]
-        hits = [k for k, v in flat_cfg.items() if (k == key or k.endswith("." + key) or k.split(".")[-1] == leaf)
-                and v == value]
+        hits = [k for k, v in by_leaf.get(key.split(".")[-1], ()) if v == value]
         exact = [k for k in hits if k == key or k.endswith("." + key)]
         matches[key] = (value, exact or hits)
     # A step reads one or a few sections: an ambiguous key comes from the section its unambiguous keys come from.
