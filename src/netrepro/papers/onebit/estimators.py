@@ -268,6 +268,53 @@ def grid_smoother_at(r, eps: float, sigma_z2: float, sigma_eta: float, eval_idx,
     ev = np.asarray(eval_idx, dtype=np.int64)
     if ev.ndim != 1 or len(ev) == 0 or np.any(np.diff(ev) <= 0) or ev[0] < 0 or ev[-1] > K:
         raise InputError(f"eval_idx must be sorted, unique and within 0..{K}")
+    if quantized and band_sigmas is not None:
+        return _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z,
+                                          band_sigmas)
+    return _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z,
+                                   band_sigmas, quantized)
+
+
+def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z, band_sigmas):
+    """:func:`grid_smoother_at` for 1-bit data and a banded transition: the recursions in one compiled kernel.
+
+    Same operations in the same order as :func:`_grid_smoother_at_numpy` (bit-identical); the kernel
+    returns the filtered masses and backward messages at the evaluation steps, the means are formed here.
+    """
+    from .kernels import band_forward_backward  # numba: imported by the steps that run the smoother
+
+    n, K = r.shape
+    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
+    T = transition_matrix(x, 1.0 - eps, math.sqrt(sigma_z2), band_sigmas)
+    TT = T.T.tocsr()
+    lik_pos = ndtr(x / sigma_eta)
+    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
+    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
+    prior /= prior.sum()
+    slot = np.full(K + 1, -1, dtype=np.int64)
+    slot[ev] = np.arange(len(ev))
+    stored = np.empty((len(ev), len(x), n))
+    betas = np.empty((len(ev), len(x), n))
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    band_forward_backward(i64(TT.indptr), i64(TT.indices), np.ascontiguousarray(TT.data), i64(T.indptr),
+                          i64(T.indices), np.ascontiguousarray(T.data), lik_pos, 1.0 - lik_pos,
+                          np.ascontiguousarray(r.T) > 0, prior, slot, int(ev[0]), stored, betas)
+    filt = np.empty((n, len(ev)))
+    smooth = np.empty((n, len(ev)))
+    for i, k in enumerate(ev):
+        filt[:, i] = x @ stored[i]
+        if k == K:
+            smooth[:, i] = filt[:, i]
+        else:
+            g = stored[i] * betas[i]
+            smooth[:, i] = (x @ g) / g.sum(axis=0)
+    return filt, smooth
+
+
+def _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z, band_sigmas,
+                            quantized):
+    """:func:`grid_smoother_at` in numpy/scipy (the reference; dense or unquantized cases)."""
+    n, K = r.shape
     alpha = 1.0 - eps
     x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
     T = transition_matrix(x, alpha, math.sqrt(sigma_z2), band_sigmas)
