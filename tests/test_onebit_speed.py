@@ -18,3 +18,12 @@ def test_banded_kernel_equals_numpy_reference(eps, snr_db, n, K):
         # same operations in the same order: identical (tolerance 0)
         np.testing.assert_array_equal(fast[0], ref[0])
         np.testing.assert_array_equal(fast[1], ref[1])
+
+
+def test_shared_bootstrap_equals_one_call_per_pair():
+    rng = np.random.default_rng(5)
+    vals = {k: rng.exponential(1.0, 300) for k in "abcd"}
+    pairs = [("a", "b"), ("a", "c"), ("d", "c")]
+    got = estimators.paired_ratio_intervals(vals, pairs, 700, 9)
+    for (num, den), g in zip(pairs, got):
+        assert g == estimators.paired_ratio_interval(vals[num], vals[den], 700, 9)   # exactly

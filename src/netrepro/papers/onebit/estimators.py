@@ -24,6 +24,7 @@ __all__ = [
     "grid_smoother_at",
     "window_mse",
     "paired_ratio_interval",
+    "paired_ratio_intervals",
     "db_zero_crossing",
 ]
 
@@ -413,6 +414,53 @@ def paired_ratio_interval(num, den, n_boot: int, seed: int, level: float = 0.95)
     q = 100.0 * (1.0 - level) / 2.0
     lo, hi = np.percentile(10.0 * np.log10(ratio), [q, 100.0 - q])
     return float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)
+
+
+def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float = 0.95):
+    r""":func:`paired_ratio_interval` for several ``(num, den)`` pairs of the same runs and seed, resampled once.
+
+    Every pair gets exactly what ``paired_ratio_interval(values[num], values[den], n_boot, seed, level)``
+    returns (the same resampled run indices, the same bootstrap means); the indices and each
+    estimator's bootstrap means are computed once instead of once per pair.
+
+    Parameters
+    ----------
+    values : dict of ndarray (n_runs,)
+        Per-run values of each estimator (paired by run).
+    pairs : sequence of tuple of str
+        ``(num, den)`` keys of ``values``.
+    n_boot : int
+        Bootstrap replicates.
+    seed : int
+        Seed of the resampling generator.
+    level : float
+        Coverage of the percentile interval.
+
+    Returns
+    -------
+    list of tuple of float
+        ``(estimate_db, lo_db, hi_db)`` per pair.
+
+    Raises
+    ------
+    InputError
+        If the values differ in length or are empty.
+    """
+    arrs = {k: np.asarray(values[k], dtype=float) for pair in pairs for k in pair}
+    shapes = {a.shape for a in arrs.values()}
+    if len(shapes) != 1 or next(iter(shapes)) == (0,) or len(next(iter(shapes))) != 1:
+        raise InputError(f"values must be 1-D of the same length, got {sorted(shapes)}")
+    n = len(next(iter(arrs.values())))
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, size=(n_boot, n))
+    boot = {k: a[idx].mean(axis=1) for k, a in arrs.items()}
+    q = 100.0 * (1.0 - level) / 2.0
+    out = []
+    for num, den in pairs:
+        a, b = arrs[num], arrs[den]
+        lo, hi = np.percentile(10.0 * np.log10(boot[num] / boot[den]), [q, 100.0 - q])
+        out.append((float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)))
+    return out
 
 
 def db_zero_crossing(x, y) -> float:
