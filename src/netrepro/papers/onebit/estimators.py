@@ -57,11 +57,12 @@ def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, 
     """
     alpha = 1.0 - eps
     sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
-    theta = np.empty((n_runs, horizon + 1))
-    theta[:, 0] = sd_inf * rng.standard_normal(n_runs)
-    z = math.sqrt(sigma_z2) * rng.standard_normal((n_runs, horizon))
+    th = np.empty((horizon + 1, n_runs))           # step-major: each step updates one contiguous row
+    th[0] = sd_inf * rng.standard_normal(n_runs)
+    zT = np.ascontiguousarray((math.sqrt(sigma_z2) * rng.standard_normal((n_runs, horizon))).T)
     for k in range(horizon):
-        theta[:, k + 1] = alpha * theta[:, k] + z[:, k]
+        np.add(alpha * th[k], zT[k], out=th[k + 1])
+    theta = np.ascontiguousarray(th.T)
     y = theta[:, 1:] + sigma_eta * rng.standard_normal((n_runs, horizon))
     return theta, y, np.where(y >= 0, 1.0, -1.0)
 
@@ -132,18 +133,19 @@ def kalman_rts(y, eps, sigma_z2, sigma_eta):
     n, K = y.shape
     P = float(stationary_variance(eps, sigma_z2))
     m = np.zeros(n)
-    mf, Pf, mp, Pp = np.zeros((n, K + 1)), np.zeros(K + 1), np.zeros((n, K + 1)), np.zeros(K + 1)
+    yT = np.ascontiguousarray(np.asarray(y).T)     # step-major: each step works on contiguous rows
+    mf, Pf, mp, Pp = np.zeros((K + 1, n)), np.zeros(K + 1), np.zeros((K + 1, n)), np.zeros(K + 1)
     Pf[0] = P
     for k in range(1, K + 1):
         mpk, Ppk = alpha * m, alpha**2 * P + sigma_z2
         G = Ppk / (Ppk + sigma_eta**2)
-        m, P = mpk + G * (y[:, k - 1] - mpk), (1 - G) * Ppk
-        mp[:, k], Pp[k], mf[:, k], Pf[k] = mpk, Ppk, m, P
+        m, P = mpk + G * (yT[k - 1] - mpk), (1 - G) * Ppk
+        mp[k], Pp[k], mf[k], Pf[k] = mpk, Ppk, m, P
     ms = mf.copy()
     for k in range(K - 1, -1, -1):
         C = Pf[k] * alpha / Pp[k + 1]
-        ms[:, k] = mf[:, k] + C * (ms[:, k + 1] - mp[:, k + 1])
-    return mf, ms
+        ms[k] = mf[k] + C * (ms[k + 1] - mp[k + 1])
+    return np.ascontiguousarray(mf.T), np.ascontiguousarray(ms.T)
 
 
 
