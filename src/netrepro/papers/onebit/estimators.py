@@ -24,6 +24,7 @@ __all__ = [
     "grid_smoother_at",
     "window_mse",
     "paired_ratio_interval",
+    "paired_ratio_intervals",
     "db_zero_crossing",
 ]
 
@@ -56,11 +57,12 @@ def simulate_block(rng, n_runs: int, horizon: int, eps: float, sigma_z2: float, 
     """
     alpha = 1.0 - eps
     sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
-    theta = np.empty((n_runs, horizon + 1))
-    theta[:, 0] = sd_inf * rng.standard_normal(n_runs)
-    z = math.sqrt(sigma_z2) * rng.standard_normal((n_runs, horizon))
+    th = np.empty((horizon + 1, n_runs))           # step-major: each step updates one contiguous row
+    th[0] = sd_inf * rng.standard_normal(n_runs)
+    zT = np.ascontiguousarray((math.sqrt(sigma_z2) * rng.standard_normal((n_runs, horizon))).T)
     for k in range(horizon):
-        theta[:, k + 1] = alpha * theta[:, k] + z[:, k]
+        np.add(alpha * th[k], zT[k], out=th[k + 1])
+    theta = np.ascontiguousarray(th.T)
     y = theta[:, 1:] + sigma_eta * rng.standard_normal((n_runs, horizon))
     return theta, y, np.where(y >= 0, 1.0, -1.0)
 
@@ -131,18 +133,19 @@ def kalman_rts(y, eps, sigma_z2, sigma_eta):
     n, K = y.shape
     P = float(stationary_variance(eps, sigma_z2))
     m = np.zeros(n)
-    mf, Pf, mp, Pp = np.zeros((n, K + 1)), np.zeros(K + 1), np.zeros((n, K + 1)), np.zeros(K + 1)
+    yT = np.ascontiguousarray(np.asarray(y).T)     # step-major: each step works on contiguous rows
+    mf, Pf, mp, Pp = np.zeros((K + 1, n)), np.zeros(K + 1), np.zeros((K + 1, n)), np.zeros(K + 1)
     Pf[0] = P
     for k in range(1, K + 1):
         mpk, Ppk = alpha * m, alpha**2 * P + sigma_z2
         G = Ppk / (Ppk + sigma_eta**2)
-        m, P = mpk + G * (y[:, k - 1] - mpk), (1 - G) * Ppk
-        mp[:, k], Pp[k], mf[:, k], Pf[k] = mpk, Ppk, m, P
+        m, P = mpk + G * (yT[k - 1] - mpk), (1 - G) * Ppk
+        mp[k], Pp[k], mf[k], Pf[k] = mpk, Ppk, m, P
     ms = mf.copy()
     for k in range(K - 1, -1, -1):
         C = Pf[k] * alpha / Pp[k + 1]
-        ms[:, k] = mf[:, k] + C * (ms[:, k + 1] - mp[:, k + 1])
-    return mf, ms
+        ms[k] = mf[k] + C * (ms[k + 1] - mp[k + 1])
+    return np.ascontiguousarray(mf.T), np.ascontiguousarray(ms.T)
 
 
 
@@ -268,6 +271,53 @@ def grid_smoother_at(r, eps: float, sigma_z2: float, sigma_eta: float, eval_idx,
     ev = np.asarray(eval_idx, dtype=np.int64)
     if ev.ndim != 1 or len(ev) == 0 or np.any(np.diff(ev) <= 0) or ev[0] < 0 or ev[-1] > K:
         raise InputError(f"eval_idx must be sorted, unique and within 0..{K}")
+    if quantized and band_sigmas is not None:
+        return _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z,
+                                          band_sigmas)
+    return _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z,
+                                   band_sigmas, quantized)
+
+
+def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z, band_sigmas):
+    """:func:`grid_smoother_at` for 1-bit data and a banded transition: the recursions in one compiled kernel.
+
+    Same operations in the same order as :func:`_grid_smoother_at_numpy` (bit-identical); the kernel
+    returns the filtered masses and backward messages at the evaluation steps, the means are formed here.
+    """
+    from .kernels import band_forward_backward  # numba: imported by the steps that run the smoother
+
+    n, K = r.shape
+    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
+    T = transition_matrix(x, 1.0 - eps, math.sqrt(sigma_z2), band_sigmas)
+    TT = T.T.tocsr()
+    lik_pos = ndtr(x / sigma_eta)
+    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
+    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
+    prior /= prior.sum()
+    slot = np.full(K + 1, -1, dtype=np.int64)
+    slot[ev] = np.arange(len(ev))
+    stored = np.empty((len(ev), len(x), n))
+    betas = np.empty((len(ev), len(x), n))
+    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
+    band_forward_backward(i64(TT.indptr), i64(TT.indices), np.ascontiguousarray(TT.data), i64(T.indptr),
+                          i64(T.indices), np.ascontiguousarray(T.data), lik_pos, 1.0 - lik_pos,
+                          np.ascontiguousarray(r.T) > 0, prior, slot, int(ev[0]), stored, betas)
+    filt = np.empty((n, len(ev)))
+    smooth = np.empty((n, len(ev)))
+    for i, k in enumerate(ev):
+        filt[:, i] = x @ stored[i]
+        if k == K:
+            smooth[:, i] = filt[:, i]
+        else:
+            g = stored[i] * betas[i]
+            smooth[:, i] = (x @ g) / g.sum(axis=0)
+    return filt, smooth
+
+
+def _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z, band_sigmas,
+                            quantized):
+    """:func:`grid_smoother_at` in numpy/scipy (the reference; dense or unquantized cases)."""
+    n, K = r.shape
     alpha = 1.0 - eps
     x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
     T = transition_matrix(x, alpha, math.sqrt(sigma_z2), band_sigmas)
@@ -366,6 +416,53 @@ def paired_ratio_interval(num, den, n_boot: int, seed: int, level: float = 0.95)
     q = 100.0 * (1.0 - level) / 2.0
     lo, hi = np.percentile(10.0 * np.log10(ratio), [q, 100.0 - q])
     return float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)
+
+
+def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float = 0.95):
+    r""":func:`paired_ratio_interval` for several ``(num, den)`` pairs of the same runs and seed, resampled once.
+
+    Every pair gets exactly what ``paired_ratio_interval(values[num], values[den], n_boot, seed, level)``
+    returns (the same resampled run indices, the same bootstrap means); the indices and each
+    estimator's bootstrap means are computed once instead of once per pair.
+
+    Parameters
+    ----------
+    values : dict of ndarray (n_runs,)
+        Per-run values of each estimator (paired by run).
+    pairs : sequence of tuple of str
+        ``(num, den)`` keys of ``values``.
+    n_boot : int
+        Bootstrap replicates.
+    seed : int
+        Seed of the resampling generator.
+    level : float
+        Coverage of the percentile interval.
+
+    Returns
+    -------
+    list of tuple of float
+        ``(estimate_db, lo_db, hi_db)`` per pair.
+
+    Raises
+    ------
+    InputError
+        If the values differ in length or are empty.
+    """
+    arrs = {k: np.asarray(values[k], dtype=float) for pair in pairs for k in pair}
+    shapes = {a.shape for a in arrs.values()}
+    if len(shapes) != 1 or next(iter(shapes)) == (0,) or len(next(iter(shapes))) != 1:
+        raise InputError(f"values must be 1-D of the same length, got {sorted(shapes)}")
+    n = len(next(iter(arrs.values())))
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, size=(n_boot, n))
+    boot = {k: a[idx].mean(axis=1) for k, a in arrs.items()}
+    q = 100.0 * (1.0 - level) / 2.0
+    out = []
+    for num, den in pairs:
+        a, b = arrs[num], arrs[den]
+        lo, hi = np.percentile(10.0 * np.log10(boot[num] / boot[den]), [q, 100.0 - q])
+        out.append((float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)))
+    return out
 
 
 def db_zero_crossing(x, y) -> float:

@@ -64,7 +64,7 @@ import pandas as pd
 
 from scipy.special import ndtri
 
-from .estimators import db_zero_crossing, grid_smoother_at, kalman_rts, paired_ratio_interval, simulate_block, window_mse
+from .estimators import db_zero_crossing, grid_smoother_at, kalman_rts, paired_ratio_intervals, simulate_block, window_mse
 from .fisher import expected_fisher_1bit, expected_fisher_1bit_quad
 from .model import sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
 from .randomwalk import (
@@ -322,8 +322,9 @@ def estimator_step(params, inputs, outputs):
                                  bound=bounds[kind], bound_steady=steady[kind], mse_over_bound=m / bounds[kind],
                                  n_runs=len(v), steady_dev=dev[kind], **design_cols))
         bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
-        for qty, (ref, onebit, col) in RATIO_DEFS.items():
-            e, lo, hi = paired_ratio_interval(runs[ref], runs[onebit], est["n_boot"], seed)
+        intervals = paired_ratio_intervals(runs, [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()],
+                                           est["n_boot"], seed)   # one resampling per case, shared by the ratios
+        for (qty, (ref, onebit, col)), (e, lo, hi) in zip(RATIO_DEFS.items(), intervals):
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
                                    steady_dev=max(dev[ref], dev[onebit]), **design_cols))
