@@ -40,6 +40,8 @@ __all__ = [
     "frozen_radius",
     "scheduled_growth_rate",
     "simulate",
+    "draw_noise",
+    "simulate_draws",
     "Theorem1Result",
     "zero_gains",
     "augmented_initial_moment",
@@ -749,6 +751,74 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
         x = x @ sys.A.T + f @ sys.B.T + w[:, None] * (x @ sys.D.T)
         errs[:, k + 1] = x - xf
     return errs
+
+
+def draw_noise(rng: np.random.Generator, n_steps: int, runs: int):
+    """The draws of :func:`simulate` in its order: per step ``rng.random(runs)`` (xi of (7)), then ``rng.standard_normal(runs)``.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    n_steps : int
+        K, the length of p(0..K-1).
+    runs : int
+
+    Returns
+    -------
+    tuple of ndarray (K, runs)
+        ``(u, g)``: xi(k) = [u(k) < p(k)], w(k) = sigma g(k).
+    """
+    u, g = np.empty((n_steps, runs)), np.empty((n_steps, runs))
+    for k in range(n_steps):
+        u[k] = rng.random(runs)
+        g[k] = rng.standard_normal(runs)
+    return u, g
+
+
+def simulate_draws(sys: System, gains: Gains | None, p_seq, x0, draws, nonlinearity: str = "sine_mid", xf0=None):
+    """:func:`simulate` with the random draws given (:func:`draw_noise`), by the compiled kernel of :mod:`.kernels`.
+
+    Same recursion (1), (6), (8)-(9) and the same rounding as :func:`simulate` (the numpy
+    reference): bit-identical with it for the draws of ``rng`` when ``runs >= 7`` on the reference
+    platform (within rounding elsewhere). Common random numbers (the Nelder-Mead cost of
+    :mod:`.tuning`) draw once and call this per evaluation.
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains or None
+    p_seq : ndarray (K,)
+    x0 : ndarray (runs, n)
+    draws : tuple of ndarray (K, runs)
+        ``(u, g)`` of :func:`draw_noise`.
+    nonlinearity : str
+    xf0 : ndarray (n,) or None
+
+    Returns
+    -------
+    ndarray (runs, K+1, n)
+        The estimation errors e(k) = x(k) - x_f(k).
+    """
+    from .kernels import KINDS, simulate_kernel
+
+    x = np.ascontiguousarray(np.array(x0, dtype=float))
+    if x.ndim != 2 or x.shape[1] != sys.n:
+        raise GainschedError(f"x0 must have shape (runs, {sys.n}), got {x.shape}")
+    if nonlinearity not in KINDS:
+        raise GainschedError(f"nonlinearity kind must be 'sine_mid', 'lower' or 'upper', got {nonlinearity!r}")
+    p_seq = np.ascontiguousarray(p_seq, dtype=float)
+    u, g = (np.ascontiguousarray(d, dtype=float) for d in draws)
+    if u.shape != (len(p_seq), x.shape[0]) or g.shape != u.shape:
+        raise GainschedError(f"draws must have shape {(len(p_seq), x.shape[0])}")
+    xf = np.zeros_like(x)
+    if xf0 is not None and gains is not None:
+        xf = xf + np.asarray(xf0, dtype=float)
+    gg = gains if gains is not None else zero_gains(sys)
+    c = np.ascontiguousarray
+    return simulate_kernel(c(sys.A), c(sys.B), c(sys.C), c(sys.D), c(sys.Z), np.diag(sys.F1).copy(),
+                           np.diag(sys.F2).copy(), KINDS[nonlinearity], c(gg.G0, dtype=float), c(gg.Gf, dtype=float),
+                           c(gg.H0, dtype=float), c(gg.Hf, dtype=float), gains is not None, p_seq, x,
+                           np.ascontiguousarray(xf), u, g, float(np.sqrt(sys.sigma2)))
 
 
 # ----------------------------------------------------------------------------- helpers of the steps

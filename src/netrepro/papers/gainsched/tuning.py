@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import Gains, System, simulate
+from .model import Gains, System, draw_noise, simulate_draws
 from .moments import error_mse, mode_matrices, second_moments
 
 __all__ = ["tune_gains", "tune_gains_exact"]
@@ -58,8 +58,12 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
             Gf, Hf = np.zeros((n, n)), np.zeros((n, m))
         return Gains(G0, Gf, H0, Hf)
 
+    # common random numbers: every evaluation sees the draws of a fresh default_rng(seed + 1), drawn once here
+    # (simulate_draws is bit-identical with simulate(..., np.random.default_rng(seed + 1), ...))
+    draws = draw_noise(np.random.default_rng(seed + 1), len(p_seq), n_runs)
+
     def cost(v):
-        e = simulate(sys, unpack(v), p_seq, x0, np.random.default_rng(seed + 1), nonlinearity)
+        e = simulate_draws(sys, unpack(v), p_seq, x0, draws, nonlinearity)
         return float((e ** 2).sum(-1).mean(0).sum())
 
     from scipy.optimize import minimize
