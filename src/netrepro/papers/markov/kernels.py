@@ -139,24 +139,29 @@ def _norm(X, which_trace):
         b = 0.5 * (X[0, 1] + X[1, 0])
         t = a - d
         return 0.5 * (a + d) + math.sqrt(0.25 * (t * t) + b * b)
-    # n == 3: model._largest_eigenvalue_3x3 on 0.5 (X + X')
-    S = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            S[i, j] = 0.5 * (X[i, j] + X[j, i])
-    q = (S[0, 0] + S[1, 1] + S[2, 2]) / 3.0
-    D = np.empty(9)
-    for i in range(3):
-        for j in range(3):
-            D[3 * i + j] = S[i, j] - (q if i == j else q * 0.0)
-    sq = np.empty(9)
-    for t in range(9):
-        sq[t] = D[t] * D[t]
-    p = math.sqrt(pairwise_sum(sq, 0, 9) / 6.0)
+    # n == 3: model._largest_eigenvalue_3x3 on 0.5 (X + X'), scalars only
+    s00 = 0.5 * (X[0, 0] + X[0, 0])
+    s01 = 0.5 * (X[0, 1] + X[1, 0])
+    s02 = 0.5 * (X[0, 2] + X[2, 0])
+    s10 = 0.5 * (X[1, 0] + X[0, 1])
+    s11 = 0.5 * (X[1, 1] + X[1, 1])
+    s12 = 0.5 * (X[1, 2] + X[2, 1])
+    s20 = 0.5 * (X[2, 0] + X[0, 2])
+    s21 = 0.5 * (X[2, 1] + X[1, 2])
+    s22 = 0.5 * (X[2, 2] + X[2, 2])
+    q = (s00 + s11 + s22) / 3.0
+    z = q * 0.0  # off-diagonal entries of q I (nan if q is not finite, as in numpy)
+    d00, d01, d02 = s00 - q, s01 - z, s02 - z
+    d10, d11, d12 = s10 - z, s11 - q, s12 - z
+    d20, d21, d22 = s20 - z, s21 - z, s22 - q
+    # np.sum over the 9 squares: numpy's pairwise sum of 9 terms (8 partial sums, then the ninth)
+    ssq = (((d00 * d00 + d01 * d01) + (d02 * d02 + d10 * d10)) + ((d11 * d11 + d12 * d12) + (d20 * d20 + d21 * d21))
+           ) + d22 * d22
+    p = math.sqrt(ssq / 6.0)
     if not p > 0:
         return q
-    b00, b11, b22 = D[0] / p, D[4] / p, D[8] / p
-    b01, b02, b12 = D[1] / p, D[2] / p, D[5] / p
+    b00, b11, b22 = d00 / p, d11 / p, d22 / p
+    b01, b02, b12 = d01 / p, d02 / p, d12 / p
     det = b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) + b02 * (b01 * b12 - b11 * b02)
     r = det / 2.0
     if r != r:
