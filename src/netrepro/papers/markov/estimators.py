@@ -61,7 +61,7 @@ def plain_mc(system, Sigma0, p, q, n_paths, horizon, rng):
     return sym_norm(P), arrivals
 
 
-def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
+def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm", kernel="compiled"):
     """Conditional (Rao-Blackwellised) estimator of ``E||P_k||`` integrating the trailing loss run.
 
     With ``l = max{i <= k-1 : gamma_i = 1}`` the last reception before ``k``,
@@ -77,6 +77,12 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
     ----------
     arrivals : bool array ``(N, T)`` with ``arrivals[:, 0]`` all True.
     P : optional ``(N, T+1, n, n)`` covariances ``P_1..P_{T+1}`` along the same paths.
+    which : {"norm", "trace"}
+        The functional of ``P_k``.
+    kernel : {"compiled", "numpy"}
+        ``"compiled"`` (n = 2, 3): :func:`.kernels.rb_norm_kernel`, the same arithmetic path by path
+        (equal to the numpy form bit for bit where numpy's small products use FMAs, as OpenBLAS's do);
+        ``"numpy"``: the batched numpy reference below.
 
     Returns
     -------
@@ -89,6 +95,19 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm"):
     if P is None:
         P = covariance_paths_ge(system, Sigma0, arrivals)
     N, T = arrivals.shape
+    if kernel == "compiled" and A.shape[0] in (2, 3):
+        from .kernels import rb_norm_kernel  # numba: imported by the steps that run the estimator
+
+        W = np.zeros((T + 1, T))
+        for kk in range(2, T + 2):  # the weights of the numpy form below, row k-1
+            ii = np.arange(1, kk)
+            W[kk - 1, :kk - 1] = np.where(ii < kk - 1, p * (1.0 - q) ** np.maximum(kk - 2 - ii, 0), 1.0)
+        out = np.empty((N, T + 1))
+        with np.errstate(over="ignore", invalid="ignore"):
+            rb_norm_kernel(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(arrivals),
+                           np.ascontiguousarray(A, dtype=float), np.ascontiguousarray(Q, dtype=float), W,
+                           which != "norm", out)
+        return out
     normf = sym_norm if which == "norm" else (lambda M: np.trace(M, axis1=-2, axis2=-1))
     out = np.empty((N, T + 1))
     out[:, 0] = normf(P[:, 0])

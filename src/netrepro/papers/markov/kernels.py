@@ -1,0 +1,205 @@
+"""Compiled (numba) kernels of the `markov` paper: the conditional (Rao-Blackwellised) estimator
+of ``E||P_k||`` (:func:`.estimators.rb_mean_norm`, eq. 4 along the trailing loss run).
+
+The numpy form of :func:`.estimators.rb_mean_norm` keeps, for every path, the ``k - 1`` matrices
+``h^{k-1-i}(P_{i+1})`` and pushes them all through ``h`` (eq. 4) at every ``k``: ``O(N T^2)`` tiny
+matrix products, each a separate BLAS call. :func:`rb_norm_kernel` runs the same recursion path
+by path in one compiled loop, with the arithmetic of the numpy form:
+
+* ``h(X) = A X A' + Q`` as ``(A X) A'`` with every dot product accumulated left to right by fused
+  multiply-adds (``fastmath={"contract"}``, no reassociation), which is what OpenBLAS's small
+  ``dgemm`` kernels do (the unit test compares both bit for bit on this machine);
+* ``||X||`` by the closed forms of :func:`.model.sym_norm` (``n = 2, 3``), ``inf`` for non-finite;
+* the weighted sum over the last reception time by numpy's pairwise summation (``np.sum``).
+
+Compiled code is cached on disk by numba (next to this file).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["rb_norm_kernel", "pairwise_sum"]
+
+
+@njit(cache=True, boundscheck=False)
+def _pairwise_block(a, lo, n):
+    """numpy's pairwise summation of ``a[lo:lo+n]`` for ``n <= 128`` (8 partial sums, then the rest)."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0 = a[lo]
+    r1 = a[lo + 1]
+    r2 = a[lo + 2]
+    r3 = a[lo + 3]
+    r4 = a[lo + 4]
+    r5 = a[lo + 5]
+    r6 = a[lo + 6]
+    r7 = a[lo + 7]
+    i = 8
+    stop = n - (n % 8)
+    while i < stop:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, boundscheck=False)
+def pairwise_sum(a, lo, n):
+    """``np.sum(a[lo:lo+n])`` with numpy's pairwise summation: blocks of at most 128 summed by
+    :func:`_pairwise_block`, longer ranges split at ``n2 = n // 2 - (n // 2) % 8`` and the halves added
+    (left + right). Written with an explicit stack: numba's on-disk cache does not support recursion."""
+    if n <= 128:
+        return _pairwise_block(a, lo, n)
+    # post-order traversal of the split tree; each frame: (lo, n, state), partial results on a value stack
+    f_lo = np.empty(128, np.int64)
+    f_n = np.empty(128, np.int64)
+    f_state = np.empty(128, np.int64)
+    vals = np.empty(128)
+    top, nv = 0, 0
+    f_lo[0], f_n[0], f_state[0] = lo, n, 0
+    while top >= 0:
+        l, m, st = f_lo[top], f_n[top], f_state[top]
+        if m <= 128:
+            vals[nv] = _pairwise_block(a, l, m)
+            nv += 1
+            top -= 1
+            continue
+        n2 = m // 2
+        n2 -= n2 % 8
+        if st == 0:  # push the left half
+            f_state[top] = 1
+            top += 1
+            f_lo[top], f_n[top], f_state[top] = l, n2, 0
+        elif st == 1:  # push the right half
+            f_state[top] = 2
+            top += 1
+            f_lo[top], f_n[top], f_state[top] = l + n2, m - n2, 0
+        else:  # both halves done: left + right
+            right = vals[nv - 1]
+            left = vals[nv - 2]
+            nv -= 2
+            vals[nv] = left + right
+            nv += 1
+            top -= 1
+    return vals[0]
+
+
+@njit(cache=True, boundscheck=False, fastmath={"contract"})
+def _h_inplace(X, A, Q, tmp):
+    """``X <- A X A' + Q`` (eq. 4), products accumulated left to right (as the BLAS kernel does)."""
+    n = A.shape[0]
+    for i in range(n):
+        for j in range(n):
+            s = A[i, 0] * X[0, j]
+            for l in range(1, n):
+                s += A[i, l] * X[l, j]
+            tmp[i, j] = s
+    for i in range(n):
+        for j in range(n):
+            s = tmp[i, 0] * A[j, 0]
+            for l in range(1, n):
+                s += tmp[i, l] * A[j, l]
+            X[i, j] = s + Q[i, j]
+
+
+@njit(cache=True, boundscheck=False)
+def _norm(X, which_trace):
+    """:func:`.model.sym_norm` (largest eigenvalue, closed forms for n = 2, 3) or the trace of one matrix."""
+    n = X.shape[0]
+    if which_trace:
+        s = 0.0
+        for i in range(n):
+            s += X[i, i]
+        return s
+    for i in range(n):
+        for j in range(n):
+            if not math.isfinite(X[i, j]):
+                return np.inf
+    if n == 1:
+        return X[0, 0]
+    if n == 2:
+        a, d = X[0, 0], X[1, 1]
+        b = 0.5 * (X[0, 1] + X[1, 0])
+        t = a - d
+        return 0.5 * (a + d) + math.sqrt(0.25 * (t * t) + b * b)
+    # n == 3: model._largest_eigenvalue_3x3 on 0.5 (X + X'), scalars only
+    s00 = 0.5 * (X[0, 0] + X[0, 0])
+    s01 = 0.5 * (X[0, 1] + X[1, 0])
+    s02 = 0.5 * (X[0, 2] + X[2, 0])
+    s10 = 0.5 * (X[1, 0] + X[0, 1])
+    s11 = 0.5 * (X[1, 1] + X[1, 1])
+    s12 = 0.5 * (X[1, 2] + X[2, 1])
+    s20 = 0.5 * (X[2, 0] + X[0, 2])
+    s21 = 0.5 * (X[2, 1] + X[1, 2])
+    s22 = 0.5 * (X[2, 2] + X[2, 2])
+    q = (s00 + s11 + s22) / 3.0
+    z = q * 0.0  # off-diagonal entries of q I (nan if q is not finite, as in numpy)
+    d00, d01, d02 = s00 - q, s01 - z, s02 - z
+    d10, d11, d12 = s10 - z, s11 - q, s12 - z
+    d20, d21, d22 = s20 - z, s21 - z, s22 - q
+    # np.sum over the 9 squares: numpy's pairwise sum of 9 terms (8 partial sums, then the ninth)
+    ssq = (((d00 * d00 + d01 * d01) + (d02 * d02 + d10 * d10)) + ((d11 * d11 + d12 * d12) + (d20 * d20 + d21 * d21))
+           ) + d22 * d22
+    p = math.sqrt(ssq / 6.0)
+    if not p > 0:
+        return q
+    b00, b11, b22 = d00 / p, d11 / p, d22 / p
+    b01, b02, b12 = d01 / p, d02 / p, d12 / p
+    det = b00 * (b11 * b22 - b12 * b12) - b01 * (b01 * b22 - b12 * b02) + b02 * (b01 * b12 - b11 * b02)
+    r = det / 2.0
+    if r != r:
+        r = 0.0
+    r = min(max(r, -1.0), 1.0)
+    phi = math.acos(r) / 3.0
+    return q + 2.0 * p * math.cos(phi)
+
+
+@njit(cache=True, boundscheck=False)
+def rb_norm_kernel(P, arrivals, A, Q, W, which_trace, out):
+    """Per-path values of :func:`.estimators.rb_mean_norm` (eq. 4 along the trailing loss run).
+
+    Parameters
+    ----------
+    P : ``(N, T+1, n, n)`` covariances ``P_1..P_{T+1}`` along each path.
+    arrivals : bool ``(N, T)``.
+    A, Q : ``(n, n)``.
+    W : ``(T+1, T)``: ``W[k-1, i-1]`` the weight of the last reception ``i`` for ``P_k``.
+    which_trace : bool, trace instead of the norm.
+    out : ``(N, T+1)``, filled.
+    """
+    N, T1 = P.shape[0], P.shape[1]
+    T = T1 - 1
+    n = A.shape[0]
+    H = np.empty((T, n, n))
+    tmp = np.empty((n, n))
+    row = np.empty(T)
+    for a in range(N):
+        out[a, 0] = _norm(P[a, 0], which_trace)
+        for k in range(2, T + 2):
+            for c in range(k - 2):
+                _h_inplace(H[c], A, Q, tmp)
+            H[k - 2] = P[a, k - 1]
+            for c in range(k - 1):
+                if arrivals[a, c]:
+                    row[c] = W[k - 1, c] * _norm(H[c], which_trace)
+                else:
+                    row[c] = 0.0
+            out[a, k - 1] = pairwise_sum(row, 0, k - 1)
+    return out

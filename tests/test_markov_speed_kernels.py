@@ -1,0 +1,35 @@
+"""The compiled conditional estimator (papers/markov/kernels.py) against the numpy reference."""
+
+import numpy as np
+import pytest
+
+from netrepro.papers.markov import estimators as est
+from netrepro.papers.markov.kernels import pairwise_sum
+from netrepro.papers.markov.model import LinearSystem
+
+EX = {
+    "I": dict(A=[[1.3, 0.3], [0.0, 1.2]], C=[[1.0, 1.0]], Q=np.eye(2).tolist(), R=[[1.0]], Sigma0=np.eye(2).tolist()),
+    "II": dict(A=[[1.2, 0, 0], [0, 1.2, 0], [0, 0, -1.2]], C=[[1.0, 0, 1], [0, 1, 1]], Q=np.eye(3).tolist(),
+               R=np.eye(2).tolist(), Sigma0=np.eye(3).tolist()),
+}
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 8, 9, 100, 128, 129, 300, 1031])
+def test_pairwise_sum_is_numpy_sum(n):
+    x = np.random.default_rng(n).normal(size=n) * 10.0 ** np.random.default_rng(n + 1).uniform(-5, 5, size=n)
+    assert pairwise_sum(x, 0, n) == x.sum()
+
+
+@pytest.mark.parametrize("name,p,q,T", [("I", 0.5, 0.65, 40), ("I", 0.9, 0.2, 40), ("II", 0.45, 0.5, 30),
+                                        ("II", 0.9, 0.25, 30)])
+@pytest.mark.parametrize("which", ["norm", "trace"])
+def test_rb_kernel_matches_numpy(name, p, q, T, which):
+    ex = EX[name]
+    system, S0 = LinearSystem.from_config(ex), np.asarray(ex["Sigma0"], float)
+    arr = est.gilbert_elliott_arrivals(np.random.default_rng(3), 200, T, p, q, initial=1)
+    ref = est.rb_mean_norm(system, S0, p, q, arr, which=which, kernel="numpy")
+    got = est.rb_mean_norm(system, S0, p, q, arr, which=which)
+    # 2 x 2 and traces: bit for bit; the 3 x 3 norm's arccos (numpy's own vs libm) may differ by an ulp
+    np.testing.assert_allclose(got, ref, rtol=1e-14, atol=0)
+    if name == "I" or which == "trace":
+        assert np.array_equal(got, ref)
