@@ -183,6 +183,28 @@ def _relocate_json_under(obj, root: str):
     return obj
 
 
+def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root: str | Path = ".") -> Path:
+    """Run ``notebook`` with papermill (parameters ``slug``, ``root``) and export static HTML."""
+    import nbformat
+    import papermill
+    from nbconvert import HTMLExporter
+
+    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
+    # path of the machine that built it (and any path a warning prints is made relative too).
+    print("command:", shlex.join(getattr(sys, "orig_argv", sys.argv)), flush=True)
+    root = Path(root).resolve()
+    html_out = Path(html_out)
+    executed = html_out.with_suffix(".ipynb")
+    papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
+                               kernel_name="python3", cwd=str(root), progress_bar=False)
+    exporter = HTMLExporter()
+    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
+    with atomic_path(html_out) as tmp:
+        tmp.write_text(relocate(strip_external_scripts(body), root))
+    os.chmod(html_out, 0o644)
+    return html_out
+
+
 # ----------------------------------------------------------------------------- index
 def provenance_chain(path: str | Path, seen=None) -> list[dict]:
     """Sidecars of ``path`` and of every upstream input that has one (depth first, no repeats)."""
