@@ -80,7 +80,22 @@ def _argmin(x):
 
 @njit(cache=True, error_model="numpy")
 def pairwise_kernel(Minv, lam, n_iter):
-    """:func:`min_fused_trace_pairwise` on ``Minv (M, N, 2, 2)`` from ``lam (M, N)`` (updated in place)."""
+    """:func:`min_fused_trace_pairwise` on ``Minv (M, N, 2, 2)`` from ``lam (M, N)`` (updated in place).
+
+    Parameters
+    ----------
+    Minv : ndarray ``(M, N, 2, 2)``
+        Per decision ``M`` and agent ``N`` the information matrices of the fused trace (22)-(24).
+    lam : ndarray ``(M, N)``
+        Starting weights on the simplex; overwritten with the final weights.
+    n_iter : int
+        Pairwise Frank-Wolfe iterations.
+
+    Returns
+    -------
+    trace : ndarray ``(M,)``
+        The fused trace at the final weights.
+    """
     m, n = lam.shape
     trace = np.empty(m)
     A = np.empty((2, 2))

@@ -64,7 +64,20 @@ def _pairwise_block(a, lo, n):
 def pairwise_sum(a, lo, n):
     """``np.sum(a[lo:lo+n])`` with numpy's pairwise summation: blocks of at most 128 summed by
     :func:`_pairwise_block`, longer ranges split at ``n2 = n // 2 - (n // 2) % 8`` and the halves added
-    (left + right). Written with an explicit stack: numba's on-disk cache does not support recursion."""
+    (left + right). Written with an explicit stack: numba's on-disk cache does not support recursion.
+
+    Parameters
+    ----------
+    a : ndarray
+        One-dimensional float array.
+    lo, n : int
+        First index and length of the range.
+
+    Returns
+    -------
+    float
+        The sum, rounded as ``np.sum`` rounds it.
+    """
     if n <= 128:
         return _pairwise_block(a, lo, n)
     # post-order traversal of the split tree; each frame: (lo, n, state), partial results on a value stack
@@ -183,6 +196,11 @@ def rb_norm_kernel(P, arrivals, A, Q, W, which_trace, out):
     W : ``(T+1, T)``: ``W[k-1, i-1]`` the weight of the last reception ``i`` for ``P_k``.
     which_trace : bool, trace instead of the norm.
     out : ``(N, T+1)``, filled.
+
+    Returns
+    -------
+    out : ndarray ``(N, T+1)``
+        The per-path values (the ``out`` argument).
     """
     N, T1 = P.shape[0], P.shape[1]
     T = T1 - 1
