@@ -52,7 +52,8 @@ Benchmarks
     full-matrix tree, at the same depth, with their agreement.
 ``onebit_grid_smoother``
     The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
-    transition against the dense one (same estimates to rounding).
+    transition against the dense one (same estimates to rounding), and the compiled banded kernel the
+    pipeline runs against its numpy/scipy form (same estimates bit for bit).
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
     rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
@@ -607,8 +608,9 @@ def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: in
 
 
 def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]:
-    """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded sparse vs dense transition."""
-    from .papers.onebit.estimators import grid_smoother_at, simulate_block, state_grid
+    """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded vs dense transition, and the
+    compiled banded kernel (what the pipeline runs) against its numpy/scipy form (the tested reference)."""
+    from .papers.onebit.estimators import _grid_smoother_at_numpy, grid_smoother_at, simulate_block, state_grid
     from .papers.onebit.model import sigma_z2_from_snr, stationary_variance
 
     eps = 1e-3
@@ -620,12 +622,23 @@ def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]
     fb, sb = grid_smoother_at(r, eps, s, 1.0, ev)
     fd, sd_ = grid_smoother_at(r, eps, s, 1.0, ev, band_sigmas=None)
     diff = float(max(np.abs(fb - fd).max(), np.abs(sb - sd_).max()) / math.sqrt(float(stationary_variance(eps, s))))
+    def banded_numpy():
+        return _grid_smoother_at_numpy(r, eps, s, 1.0, ev, 6.0, 1.0, 8.0, True)
+
+    t_numpy = median_time(banded_numpy, max(1, repeats // 2))
+    fn, sn = banded_numpy()
+    kernel_diff = float(max(np.abs(fb - fn).max(), np.abs(sb - sn).max()))
     steps = n_runs * horizon
     n_grid = len(state_grid(eps, s))
     return [
         BenchRow("onebit_grid_smoother", f"run_steps_per_s_banded_vs_dense_{n_grid}pts", steps / t_band,
                  steps / t_dense, t_dense / t_band, "run-steps/s"),
         BenchRow("onebit_grid_smoother", "max_rel_diff", diff, 1e-10, _div(1e-10, diff) if diff > 0 else np.inf, "1"),
+        BenchRow("onebit_grid_smoother", f"run_steps_per_s_kernel_vs_numpy_banded_{n_grid}pts", steps / t_band,
+                 steps / t_numpy, t_numpy / t_band, "run-steps/s"),
+        # the kernel repeats the numpy/scipy arithmetic in the same order: any difference is a defect
+        BenchRow("onebit_grid_smoother", "kernel_max_abs_diff", kernel_diff, 0.0, np.inf if kernel_diff == 0 else 0.0,
+                 "1"),
     ]
 
 
@@ -852,7 +865,7 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
         _progress("markov: exact E||P_k|| by the block-split tree vs the full-matrix tree")
         rows += bench_markov_exact(*sizes["markov"], reps)
     if want("grid"):
-        _progress("grid: onebit grid filter/smoother, banded vs dense transition")
+        _progress("grid: onebit grid filter/smoother, banded vs dense transition, compiled vs numpy banded")
         rows += bench_grid_transition(*sizes["grid"], reps)
     if pipeline and not quick and want("pipeline"):
         _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
