@@ -114,6 +114,13 @@ def _trace_det(A):
     return A[..., 0, 0] + A[..., 1, 1], A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
 
 
+def _start_weights(Minv, lam0):
+    """``(N, lam, lead)``: agents, a fresh copy of the starting weights (uniform by default), batch shape."""
+    n = Minv.shape[-3]
+    lam = np.full(Minv.shape[:-2], 1.0 / n) if lam0 is None else np.array(lam0, dtype=float)
+    return n, lam, lam.shape[:-1]
+
+
 def _min_fused_trace_pairwise_numpy(Minv, n_iter: int = 60, lam0=None):
     """``min_lambda tr (sum_j lam_j M_j^{-1})^{-1}`` on the simplex by pairwise Frank-Wolfe with exact line search.
 
@@ -140,9 +147,7 @@ def _min_fused_trace_pairwise_numpy(Minv, n_iter: int = 60, lam0=None):
         ``f`` at the final weights (non-increasing over the iterations).
     lam : ndarray, shape ``(..., N)``
     """
-    n = Minv.shape[-3]
-    lam = np.full(Minv.shape[:-2], 1.0 / n) if lam0 is None else np.array(lam0, dtype=float)
-    lead = lam.shape[:-1]
+    n, lam, lead = _start_weights(Minv, lam0)
     idx = tuple(np.indices(lead))
     for _ in range(n_iter):
         A = np.einsum("...n,...nij->...ij", lam, Minv)
@@ -196,9 +201,7 @@ def min_fused_trace_pairwise(Minv, n_iter: int = 60, lam0=None):
     lam : ndarray, shape ``(..., N)``
     """
     Minv = np.asarray(Minv, dtype=float)
-    n = Minv.shape[-3]
-    lam = np.full(Minv.shape[:-2], 1.0 / n) if lam0 is None else np.array(lam0, dtype=float)
-    lead = lam.shape[:-1]
+    n, lam, lead = _start_weights(Minv, lam0)
     Mf = np.ascontiguousarray(np.broadcast_to(Minv, lead + Minv.shape[-3:])).reshape(-1, n, 2, 2)
     lf = np.ascontiguousarray(lam).reshape(-1, n)
     from .evader_kernels import pairwise_kernel  # numba is imported (and the kernel loaded) only when used

@@ -3,7 +3,7 @@
 Imported lazily by :func:`netrepro.papers.onebit.estimators.grid_smoother_at` (numba costs import time).
 The kernels perform the same floating-point operations in the same order as the numpy/scipy reference
 (CSR sparse-times-dense products accumulated row by row from 0, likelihood product, column sums in grid
-order, division), so they are bit-identical to it (checked in tests/test_onebit_speed.py).
+order, division), so they are bit-identical to it (checked in tests/papers/onebit/test_kernels.py).
 """
 
 from __future__ import annotations
@@ -12,6 +12,27 @@ import numpy as np
 from numba import njit
 
 __all__ = ["band_forward_backward"]
+
+
+@njit(cache=True, boundscheck=False, error_model="numpy", inline="always")
+def _csr_row_product(ptr, idx, val, i, src, drow):
+    """``drow = (M @ src)[i]`` for CSR ``M``, accumulated from 0 in the order of the stored entries (as scipy)."""
+    for c in range(drow.shape[0]):
+        drow[c] = 0.0
+    for jj in range(ptr[i], ptr[i + 1]):
+        a = val[jj]
+        srow = src[idx[jj]]
+        for c in range(drow.shape[0]):
+            drow[c] += a * srow[c]
+
+
+@njit(cache=True, boundscheck=False, error_model="numpy", inline="always")
+def _divide_columns(M, colsum):
+    """``M /= colsum`` column by column (normalisation per run)."""
+    for i in range(M.shape[0]):
+        row = M[i]
+        for c in range(row.shape[0]):
+            row[c] = row[c] / colsum[c]
 
 
 @njit(cache=True, boundscheck=False, error_model="numpy")
@@ -58,23 +79,14 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
             colsum[c] = 0.0
         for i in range(G):
             drow = nxt[i]
-            for c in range(n):
-                drow[c] = 0.0
-            for jj in range(f_ptr[i], f_ptr[i + 1]):
-                a = f_val[jj]
-                srow = cur[f_idx[jj]]
-                for c in range(n):
-                    drow[c] += a * srow[c]
+            _csr_row_product(f_ptr, f_idx, f_val, i, cur, drow)
             lp = lik_pos[i]
             ln = lik_neg[i]
             for c in range(n):
                 v = drow[c] * (lp if pos[c] else ln)
                 drow[c] = v
                 colsum[c] += v
-        for i in range(G):
-            drow = nxt[i]
-            for c in range(n):
-                drow[c] = drow[c] / colsum[c]
+        _divide_columns(nxt, colsum)
         cur, nxt = nxt, cur
         if slot[k + 1] >= 0:
             stored_post[slot[k + 1]] = cur
@@ -96,18 +108,9 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
             colsum[c] = 0.0
         for i in range(G):
             drow = beta[i]
-            for c in range(n):
-                drow[c] = 0.0
-            for jj in range(b_ptr[i], b_ptr[i + 1]):
-                a = b_val[jj]
-                srow = tmp[b_idx[jj]]
-                for c in range(n):
-                    drow[c] += a * srow[c]
+            _csr_row_product(b_ptr, b_idx, b_val, i, tmp, drow)
             for c in range(n):
                 colsum[c] += drow[c]
-        for i in range(G):
-            drow = beta[i]
-            for c in range(n):
-                drow[c] = drow[c] / colsum[c]
+        _divide_columns(beta, colsum)
         if slot[k - 1] >= 0:
             stored_beta[slot[k - 1]] = beta
