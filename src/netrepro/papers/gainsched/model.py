@@ -741,9 +741,10 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
     errs = np.empty((runs, len(p_seq) + 1, sys.n))
     errs[:, 0] = x - xf
     sd = np.sqrt(sys.sigma2)
+    u, g = draw_noise(rng, len(p_seq), runs)
     for k, p in enumerate(p_seq):
-        xi = (rng.random(runs) < p).astype(float)
-        w = sd * rng.standard_normal(runs)
+        xi = (u[k] < p).astype(float)
+        w = sd * g[k]
         y = xi[:, None] * (x @ sys.C.T)
         if gains is not None:
             xf = xf @ gains.G(p).T + y @ gains.H(p).T
