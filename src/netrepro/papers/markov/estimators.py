@@ -61,6 +61,13 @@ def plain_mc(system, Sigma0, p, q, n_paths, horizon, rng):
     return sym_norm(P), arrivals
 
 
+def _trailing_run_weights(p, q, k):
+    """Weights of ``h^{k-1-i}(P_{i+1})``, ``i = 1..k-1``, in :func:`rb_mean_norm`: the probability of the
+    trailing loss run after the last reception ``i`` (``p (1-q)^{k-2-i}``), 1 for ``i = k-1``."""
+    i = np.arange(1, k)
+    return np.where(i < k - 1, p * (1.0 - q) ** np.maximum(k - 2 - i, 0), 1.0)
+
+
 def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm", kernel="compiled"):
     """Conditional (Rao-Blackwellised) estimator of ``E||P_k||`` integrating the trailing loss run.
 
@@ -99,9 +106,8 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm", kernel="c
         from .kernels import rb_norm_kernel  # numba: imported by the steps that run the estimator
 
         W = np.zeros((T + 1, T))
-        for kk in range(2, T + 2):  # the weights of the numpy form below, row k-1
-            ii = np.arange(1, kk)
-            W[kk - 1, :kk - 1] = np.where(ii < kk - 1, p * (1.0 - q) ** np.maximum(kk - 2 - ii, 0), 1.0)
+        for kk in range(2, T + 2):
+            W[kk - 1, :kk - 1] = _trailing_run_weights(p, q, kk)
         out = np.empty((N, T + 1))
         with np.errstate(over="ignore", invalid="ignore"):
             rb_norm_kernel(np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(arrivals),
@@ -117,8 +123,7 @@ def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm", kernel="c
         with np.errstate(over="ignore", invalid="ignore"):
             H = riccati_h(H, A, Q) if H.shape[1] else H
             H = np.concatenate([H, P[:, k - 1][:, None]], axis=1)  # P_k = h^0(P_k), i = k-1
-        i = np.arange(1, k)
-        w = np.where(i < k - 1, p * (1.0 - q) ** np.maximum(k - 2 - i, 0), 1.0)
+        w = _trailing_run_weights(p, q, k)
         g = arrivals[:, :k - 1]  # gamma_1..gamma_{k-1}
         with np.errstate(over="ignore", invalid="ignore"):
             vals = normf(H)
