@@ -278,6 +278,16 @@ def grid_smoother_at(r, eps: float, sigma_z2: float, sigma_eta: float, eval_idx,
                                    band_sigmas, quantized)
 
 
+def _grid_model(eps, sigma_z2, sigma_eta, grid_half_width, points_per_sigma_z, band_sigmas):
+    """Grid, transition (21), likelihood of r = +1 (28) and normalised stationary prior of the grid recursions."""
+    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
+    T = transition_matrix(x, 1.0 - eps, math.sqrt(sigma_z2), band_sigmas)
+    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
+    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
+    prior /= prior.sum()
+    return x, T, ndtr(x / sigma_eta), prior
+
+
 def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, points_per_sigma_z, band_sigmas):
     """:func:`grid_smoother_at` for 1-bit data and a banded transition: the recursions in one compiled kernel.
 
@@ -287,13 +297,8 @@ def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width,
     from .kernels import band_forward_backward  # numba: imported by the steps that run the smoother
 
     n, K = r.shape
-    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
-    T = transition_matrix(x, 1.0 - eps, math.sqrt(sigma_z2), band_sigmas)
+    x, T, lik_pos, prior = _grid_model(eps, sigma_z2, sigma_eta, grid_half_width, points_per_sigma_z, band_sigmas)
     TT = T.T.tocsr()
-    lik_pos = ndtr(x / sigma_eta)
-    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
-    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
-    prior /= prior.sum()
     slot = np.full(K + 1, -1, dtype=np.int64)
     slot[ev] = np.arange(len(ev))
     stored = np.empty((len(ev), len(x), n))
@@ -318,11 +323,9 @@ def _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, po
                             quantized):
     """:func:`grid_smoother_at` in numpy/scipy (the reference; dense or unquantized cases)."""
     n, K = r.shape
-    alpha = 1.0 - eps
-    x = state_grid(eps, sigma_z2, grid_half_width, points_per_sigma_z)
-    T = transition_matrix(x, alpha, math.sqrt(sigma_z2), band_sigmas)
+    x, T, lik_pos, prior = _grid_model(eps, sigma_z2, sigma_eta, grid_half_width, points_per_sigma_z, band_sigmas)
     TT = T.T.tocsr() if sparse.issparse(T) else np.ascontiguousarray(T.T)
-    lik_pos = ndtr(x / sigma_eta)[:, None]
+    lik_pos = lik_pos[:, None]
     rT = np.ascontiguousarray(r.T)
 
     def likelihood(k):  # p(r_{k+1} | x), (n_grid, n_runs)
@@ -330,9 +333,6 @@ def _grid_smoother_at_numpy(r, eps, sigma_z2, sigma_eta, ev, grid_half_width, po
             return np.where(rT[k] > 0, lik_pos, 1.0 - lik_pos)
         return np.exp(-0.5 * ((rT[k][None, :] - x[:, None]) / sigma_eta) ** 2)
 
-    sd_inf = math.sqrt(float(stationary_variance(eps, sigma_z2)))
-    prior = np.exp(-0.5 * (x / sd_inf) ** 2)
-    prior /= prior.sum()
     post = np.repeat(prior[:, None], n, axis=1)
     slot = {int(k): i for i, k in enumerate(ev)}
     stored = np.empty((len(ev), len(x), n))
