@@ -29,3 +29,73 @@ def test_timing_columns_and_claim_notes_are_not_compared(tmp_path):
     assert compare_tables(ref, got) == []
     pd.DataFrame({"x": [1.5], "solve_time_s": [0.9], "note": ["took 4 s"]}).to_csv(got, index=False)
     assert compare_tables(ref, got)
+
+
+def _pair(tmp_path, ref_frame, got_frame, name="p/t.csv"):
+    ref, got = tmp_path / "ref" / name, tmp_path / "res" / name
+    for path, frame in ((ref, ref_frame), (got, got_frame)):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        frame.to_csv(path, index=False)
+    return ref, got
+
+
+def test_numbers_inside_text_are_compared_with_the_numeric_tolerance(tmp_path):
+    ref, got = _pair(tmp_path, pd.DataFrame({"s": ["slack 0.8027613281380114 > 0"]}),
+                     pd.DataFrame({"s": ["slack 0.8027613281380112 > 0"]}))
+    assert compare_tables(ref, got) == []
+    pd.DataFrame({"s": ["slack 0.81 > 0"]}).to_csv(got, index=False)
+    assert "column 's' differs" in compare_tables(ref, got)[0]
+    pd.DataFrame({"s": ["slack 0.8027613281380114 < 0"]}).to_csv(got, index=False)
+    assert "column 's' differs" in compare_tables(ref, got)[0]
+
+
+def test_platform_rules_weaken_only_the_rows_and_columns_they_name(tmp_path):
+    reference = pd.DataFrame({"design": ["a", "b"], "x": [1.0, 2.0], "slack": [1e-9, 2e-9],
+                              "ev": ["min slack 1e-9 > 0", "min slack 2e-9 > 0"], "status": ["optimal", "optimal"]})
+    rules = [{"table": "p/t.csv", "rows": {"design": ["a"]}, "columns": ["x"], "check": "finite", "reason": "r"},
+             {"table": "p/t.csv", "columns": ["slack"], "check": "sign", "reason": "r"},
+             {"table": "p/t.csv", "columns": ["ev"], "check": "text", "reason": "r"},
+             {"table": "p/t.csv", "columns": ["status"], "check": "info", "reason": "r"}]
+    changed = reference.assign(x=[1.5, 2.0], slack=[3e-9, 5e-10], ev=["min slack 4e-9 > 0", "min slack 7e-9 > 0"],
+                               status=["optimal_inaccurate", "optimal"])
+    ref, got = _pair(tmp_path, reference, changed)
+    assert compare_tables(ref, got, rules=rules) == []
+    assert len(compare_tables(ref, got)) == 4  # without the rules every change is caught
+    for broken, column in ((changed.assign(x=[1.5, 2.5]), "x"),            # row b is not covered
+                           (changed.assign(x=[float("nan"), 2.0]), "x"),   # finite: NaN pattern kept
+                           (changed.assign(slack=[-1e-9, 5e-10]), "slack"),  # sign flip = other decision
+                           (changed.assign(ev=["min slack 4e-9 < 0", "min slack 7e-9 > 0"]), "ev")):
+        broken.to_csv(got, index=False)
+        assert f"column '{column}' differs" in compare_tables(ref, got, rules=rules)[0]
+
+
+def test_malformed_platform_rules_are_named(tmp_path):
+    import pytest
+
+    from netrepro.regression import load_platform_rules
+
+    path = tmp_path / "rules.yaml"
+    path.write_text("- {table: p/t.csv, columns: [x], check: loose, reason: r}\n")
+    with pytest.raises(ValueError, match="entry 0 .p/t.csv.*check"):
+        load_platform_rules(path)
+    ref, got = _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
+    with pytest.raises(ValueError, match="column 'y'"):
+        compare_tables(ref, got, rules=[{"table": "p/t.csv", "columns": ["y"], "check": "sign", "reason": "r"}])
+    path.write_text("- {table: p/other.csv, columns: [x], check: sign, reason: r}\n")
+    with pytest.raises(ValueError, match="p/other.csv"):
+        compare_trees(tmp_path / "ref", tmp_path / "res", platform_rules=path)
+
+
+def test_committed_platform_rules_name_existing_reference_columns_with_a_reason():
+    from pathlib import Path
+
+    from netrepro.regression import PLATFORM_RULES, load_platform_rules
+
+    reference = Path(__file__).parent / "reference"
+    rules = load_platform_rules(PLATFORM_RULES)
+    assert rules, "tests/platform_dependent.yaml is missing or empty"
+    for table, entries in rules.items():
+        columns = set(pd.read_csv(reference / table, nrows=0).columns)
+        for rule in entries:
+            assert set(rule["columns"]) <= columns, (table, rule["columns"])
+            assert len(rule["reason"].split()) >= 5, (table, rule["reason"])

@@ -6,7 +6,11 @@ columns exactly, numeric columns within ``rtol``/``atol`` (seeds are fixed, so
 differences only come from floating-point details of the platform).
 ``python -m netrepro.regression update`` refreshes the references from ``results/``.
 Measured times (columns named like ``*time*``, ``seconds``, ...) and the free-text
-``note`` of claims tables are not compared.
+``note`` of claims tables are not compared. Numbers printed inside text are compared
+with the numeric tolerance, the words exactly. The few values that legitimately
+differ between CPUs (a solver point that is not unique, an unconverged iterative
+solver, certificate margins at the solver's accuracy) are listed, with their reason
+and the weaker check they get, in ``tests/platform_dependent.yaml``.
 """
 
 from __future__ import annotations
@@ -19,27 +23,101 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import yaml
 
-__all__ = ["compare_tables", "compare_trees", "main"]
+__all__ = ["compare_tables", "compare_trees", "load_platform_rules", "main"]
 
 RTOL = 1e-6
 ATOL = 1e-9
 # measured times are not reproducible values; claim notes may quote them
 VOLATILE_COLUMNS = re.compile(r"time|seconds|per_second|extrapolated|fit_exponent", re.I)
+PLATFORM_RULES = Path(__file__).resolve().parents[2] / "tests" / "platform_dependent.yaml"
+CHECKS = ("sign", "text", "finite", "info")
+# a decimal number as printed in a table or a sentence (sign, digits, optional exponent)
+NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
 def _volatile(path: Path, column: str) -> bool:
     return bool(VOLATILE_COLUMNS.search(column)) or (path.parent.name == "claims" and column == "note")
 
 
-def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL) -> list[str]:
-    """Differences between two CSV tables, as readable strings (empty when they agree)."""
+def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, list[dict]]:
+    """``table -> [rule, ...]`` from ``tests/platform_dependent.yaml`` (empty if there is none).
+
+    Every rule names its table, columns, check and reason; a malformed rule stops the
+    comparison with a message naming it.
+    """
+    if path is None or not Path(path).is_file():
+        return {}
+    rules = {}
+    for i, rule in enumerate(yaml.safe_load(Path(path).read_text()) or []):
+        missing = {"table", "columns", "check", "reason"} - set(rule)
+        if missing or rule["check"] not in CHECKS:
+            raise ValueError(f"{path}: entry {i} ({rule.get('table')}): needs table, columns, "
+                             f"check (one of {', '.join(CHECKS)}) and reason; got {sorted(rule)}")
+        rules.setdefault(rule["table"], []).append(rule)
+    return rules
+
+
+def _split_numbers(text: str) -> tuple[list[str], np.ndarray]:
+    """The words of ``text`` (numbers masked) and its numbers."""
+    return NUMBER.split(text), np.array([float(x) for x in NUMBER.findall(text)])
+
+
+def _texts_agree(a: str, b: str, rtol: float, atol: float, numbers: bool = True) -> bool:
+    """Same words, and (with ``numbers``) the same numbers within the tolerance."""
+    if a == b:
+        return True
+    words_a, nums_a = _split_numbers(a)
+    words_b, nums_b = _split_numbers(b)
+    if words_a != words_b:
+        return False
+    return not numbers or bool(np.allclose(nums_a, nums_b, rtol=rtol, atol=atol, equal_nan=True))
+
+
+def _weak_agree(check: str, a: pd.Series, b: pd.Series, rtol: float, atol: float) -> np.ndarray:
+    """Row-wise agreement under a platform rule's weaker check."""
+    if check == "info":
+        return np.ones(len(a), dtype=bool)
+    if not (pd.api.types.is_numeric_dtype(a) and pd.api.types.is_numeric_dtype(b)) or check == "text":
+        sa, sb = a.fillna("").astype(str).to_numpy(), b.fillna("").astype(str).to_numpy()
+        return np.array([_texts_agree(x, y, rtol, atol, numbers=False) for x, y in zip(sa, sb)], dtype=bool)
+    x, y = a.to_numpy(dtype=float), b.to_numpy(dtype=float)
+    same_pattern = (np.isnan(x) == np.isnan(y)) & (np.isinf(x) == np.isinf(y))
+    if check == "sign":
+        return same_pattern & ((np.sign(x) == np.sign(y)) | np.isnan(x))
+    return same_pattern
+
+
+def _covered_rows(rule: dict, ref: pd.DataFrame, where: str) -> np.ndarray:
+    """Rows of the reference table a platform rule covers (all, or those its ``rows`` select)."""
+    covered = np.ones(len(ref), dtype=bool)
+    for column, values in (rule.get("rows") or {}).items():
+        if column not in ref.columns:
+            raise ValueError(f"{where}: platform rule selects rows by {column!r}, not a column")
+        covered &= ref[column].astype(str).isin([str(v) for v in values]).to_numpy()
+    return covered
+
+
+def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()) -> list[str]:
+    """Differences between two CSV tables, as readable strings (empty when they agree).
+
+    ``rules`` are this table's entries of ``tests/platform_dependent.yaml``: in the rows and
+    columns they cover, their weaker check replaces the comparison of values.
+    """
     ref, got = pd.read_csv(reference), pd.read_csv(result)
     problems = []
     if list(ref.columns) != list(got.columns):
         return [f"{result}: columns {list(got.columns)} differ from reference {list(ref.columns)}"]
     if len(ref) != len(got):
         return [f"{result}: {len(got)} rows, reference has {len(ref)}"]
+    weak = {}
+    for rule in rules:
+        rows = _covered_rows(rule, ref, str(result))
+        for col in rule["columns"]:
+            if col not in ref.columns:
+                raise ValueError(f"{result}: platform rule names column {col!r}, which the table lacks")
+            weak.setdefault(col, []).append((rows, rule["check"]))
     for col in ref.columns:
         if _volatile(Path(result), col):
             continue
@@ -47,18 +125,30 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL) -> list[
         if pd.api.types.is_numeric_dtype(a) and pd.api.types.is_numeric_dtype(b):
             x, y = a.to_numpy(dtype=float), b.to_numpy(dtype=float)
             ok = np.isclose(x, y, rtol=rtol, atol=atol, equal_nan=True) | (np.isinf(x) & (x == y))
-            if not ok.all():
-                i = int(np.argmin(ok))
-                problems.append(f"{result}: column {col!r} differs in {int((~ok).sum())} rows "
-                                f"(first at row {i}: {y[i]!r} vs reference {x[i]!r})")
-        elif not a.fillna("").astype(str).equals(b.fillna("").astype(str)):
-            i = int(np.argmax(a.fillna("").astype(str).to_numpy() != b.fillna("").astype(str).to_numpy()))
-            problems.append(f"{result}: column {col!r} differs (first at row {i}: {b.iloc[i]!r} vs {a.iloc[i]!r})")
+        else:
+            sa, sb = a.fillna("").astype(str).to_numpy(), b.fillna("").astype(str).to_numpy()
+            ok = np.array([_texts_agree(u, v, rtol, atol) for u, v in zip(sa, sb)], dtype=bool)
+        for rows, check in weak.get(col, []):
+            ok = np.where(rows, _weak_agree(check, a, b, rtol, atol), ok)
+        if not ok.all():
+            i = int(np.argmin(ok))
+            problems.append(f"{result}: column {col!r} differs in {int((~ok).sum())} rows "
+                            f"(first at row {i}: {b.iloc[i]!r} vs reference {a.iloc[i]!r})")
     return problems
 
 
-def compare_trees(reference_dir: Path, results_dir: Path, **tol) -> tuple[int, list[str]]:
-    """Compare every reference table with its result; returns (number compared, problems)."""
+def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None,
+                  **tol) -> tuple[int, list[str]]:
+    """Compare every reference table with its result; returns (number compared, problems).
+
+    ``platform_rules``: the file of platform-dependent values (``None``: compare all strictly;
+    the command line passes ``tests/platform_dependent.yaml``).
+    """
+    rules = load_platform_rules(platform_rules)
+    unknown = sorted(set(rules) - {p.relative_to(reference_dir).as_posix()
+                                   for p in Path(reference_dir).rglob("*.csv")})
+    if unknown:
+        raise ValueError(f"platform rules name tables without a reference: {', '.join(unknown)}")
     problems, count = [], 0
     for ref in sorted(Path(reference_dir).rglob("*.csv")):
         rel = ref.relative_to(reference_dir)
@@ -67,7 +157,7 @@ def compare_trees(reference_dir: Path, results_dir: Path, **tol) -> tuple[int, l
         if not got.is_file():
             problems.append(f"{got}: missing (reference {ref})")
             continue
-        problems.extend(compare_tables(ref, got, **tol))
+        problems.extend(compare_tables(ref, got, rules=rules.get(rel.as_posix(), ()), **tol))
     return count, problems
 
 
@@ -76,6 +166,8 @@ def main(argv=None) -> int:
     parser.add_argument("command", choices=["compare", "update"])
     parser.add_argument("--reference", default="tests/reference")
     parser.add_argument("--results", default="results")
+    parser.add_argument("--platform-rules", default=str(PLATFORM_RULES),
+                        help="values that differ between CPUs and their weaker checks ('' for none)")
     args = parser.parse_args(argv)
     if args.command == "update":
         ref = Path(args.reference)
@@ -89,7 +181,8 @@ def main(argv=None) -> int:
             shutil.copy2(table, target)
         print(f"reference tables written to {ref}")
         return 0
-    count, problems = compare_trees(Path(args.reference), Path(args.results))
+    count, problems = compare_trees(Path(args.reference), Path(args.results),
+                                    platform_rules=args.platform_rules or None)
     for line in problems:
         print("DIFF", line)
     print(f"regression: {count} reference tables compared, {len(problems)} differences")
