@@ -62,3 +62,19 @@ def test_require_pd():
         require_pd("Q", [[1, 2], [2, 1]])
     with pytest.raises(ConfigError, match="symmetric"):
         require_pd("Q", [[1, 2], [0, 1]])
+
+
+def test_load_yaml_gives_what_the_pure_python_parser_gives():
+    """The fast loader (libyaml when present) against PyYAML's own safe_load, on every data file."""
+    from pathlib import Path
+
+    import yaml
+
+    from netrepro.io import load_yaml
+
+    root = Path(__file__).resolve().parents[1]
+    files = [*root.glob("src/**/*.yaml"), *root.glob("workflow/**/*.yaml"), *root.glob("config/*.yaml")]
+    assert len(files) > 20
+    for path in files:
+        text = path.read_text()
+        assert repr(load_yaml(text)) == repr(yaml.safe_load(text)), path

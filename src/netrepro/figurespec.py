@@ -25,6 +25,7 @@ from pathlib import Path
 import yaml
 
 from .errors import ConfigError
+from .io import load_yaml
 
 __all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]
 
@@ -82,7 +83,7 @@ def load_figure_specs(slug: str, src: Path = _SRC) -> list[FigureSpec]:
     path = figure_list_path(slug, src)
     if not path.is_file():
         raise ConfigError(f"paper {slug!r} has no figure list {path}")
-    data = yaml.safe_load(path.read_text()) or {}
+    data = load_yaml(path.read_text()) or {}
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: expected a mapping of figure ids to entries, got {type(data).__name__}")
     specs = []

@@ -16,7 +16,18 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file"]
+__all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml"]
+
+
+def load_yaml(text: str):
+    """``yaml.safe_load`` through libyaml's parser when PyYAML has it (same objects, ~10x faster).
+
+    The workflow parses the papers' claims, errata, findings and figure lists at every start
+    (also a no-op rerun), where the pure-Python parser took seconds.
+    """
+    import yaml
+
+    return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # noqa: S506 (a safe loader)
 
 
 @contextlib.contextmanager

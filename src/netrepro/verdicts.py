@@ -51,6 +51,7 @@ import pandas as pd
 import yaml
 
 from .errors import ConfigError, InputError
+from .io import load_yaml
 
 __all__ = [
     "VERDICTS",
@@ -201,7 +202,7 @@ def paper_dir(slug: str) -> Path:
 
 def _read_yaml_list(path: Path) -> list:
     try:
-        data = yaml.safe_load(path.read_text())
+        data = load_yaml(path.read_text())
     except yaml.YAMLError as exc:
         raise ConfigError(f"{path}: not valid YAML: {exc}") from None
     return [] if data is None else data
@@ -211,7 +212,7 @@ def _schema_errors(path: Path, kind: str, data) -> None:
     """Raise a ConfigError naming file, entry and field for the first schema violations."""
     import jsonschema
 
-    schema = yaml.safe_load((_SCHEMA_DIR / f"{kind}.schema.yaml").read_text())
+    schema = load_yaml((_SCHEMA_DIR / f"{kind}.schema.yaml").read_text())
     validator = jsonschema.Draft202012Validator(schema)
     errors = sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if not errors:
