@@ -204,12 +204,14 @@ class Theorem3:
                     for l in range(2):
                         M = self.vertex(ps[i], ps[j], ps[r], ps[l])
                         size = M.shape[0]
-                        Msym = 0.5 * (M + M.T)
+                        # M is structurally symmetric (every upper block is the transpose of the expression
+                        # below it, the diagonal blocks are symmetric), so it equals 0.5 (M + M^T) coefficient
+                        # for coefficient, exactly: the solver data are the same, with half the expression tree
+                        Msym = M
                         if self.output_slack:
                             # error row [I, -L̄] in T-coordinates, Schur complement of + [I, -L̄]^T [I, -L̄]
                             Erow = cp.hstack([np.eye(n), -v["Lbar"], np.zeros((n, size - nn))])
-                            big = cp.bmat([[Msym, Erow.T], [Erow, -np.eye(n)]])
-                            big = 0.5 * (big + big.T)
+                            big = cp.bmat([[Msym, Erow.T], [Erow, -np.eye(n)]])  # structurally symmetric too
                             self._vertices.append(big)
                             self._blocks.append((f"vertex{i}{j}{r}{l}", -big))
                             cons.append(big << -eps * np.eye(size + n))
@@ -776,7 +778,7 @@ class FixedGainsVertexLMI:
                 for r in range(2):
                     for l in range(2):
                         M = self.vertex(ps[i], ps[j], ps[r], ps[l])
-                        Msym = 0.5 * (M + M.T)
+                        Msym = M  # structurally symmetric: equals 0.5 (M + M^T) exactly (see Theorem3)
                         cons.append(Msym << -self.t * np.eye(M.shape[0]))
                         blocks.append((f"vertex{i}{j}{r}{l}", -Msym))
         blocks += [("Q0", self.Q0), ("Qp", self.Qp)]
