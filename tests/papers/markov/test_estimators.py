@@ -71,3 +71,23 @@ def test_linear_trace_estimator_is_unbiased(system):
     mean, _, _ = estimators.rb_mean_trace(system, np.eye(system.n), p, q, arr, n_batches=len(arr), z=1.96)
     assert np.allclose(mean, per_path.mean(axis=0), rtol=1e-10)
 
+
+
+def test_riccati_step_equals_where_of_both_maps():
+    """rb_trace_grid's per-path step: g on received, h on lost paths, bit for bit the np.where form."""
+    from netrepro.papers.markov.estimators import _riccati_step
+    from netrepro.papers.markov.model import LinearSystem, riccati_g, riccati_h
+
+    rng = np.random.default_rng(5)
+    for A, C in (([[1.3, 0.3], [0.0, 1.2]], [[1.0, 1.0]]),
+                 ([[1.2, 0, 0], [0, 1.2, 0], [0, 0, -1.2]], [[1.0, 0, 1], [0, 1, 1]])):
+        n, m = len(A), len(C)
+        s = LinearSystem.from_config(dict(A=A, C=C, Q=np.eye(n).tolist(), R=np.eye(m).tolist()))
+        X = rng.normal(size=(500, n, n))
+        P = X @ np.swapaxes(X, -1, -2) * 10.0 ** rng.uniform(-2, 6, size=(500, 1, 1))
+        P[:3] = np.inf
+        for received in (rng.random(500) < 0.4, np.ones(500, bool), np.zeros(500, bool)):
+            with np.errstate(over="ignore", invalid="ignore"):
+                ref = np.where(received[:, None, None], riccati_g(P, s.A, s.C, s.Q, s.R), riccati_h(P, s.A, s.Q))
+                got = _riccati_step(P, received, s.A, s.C, s.Q, s.R)
+            assert np.array_equal(got, ref, equal_nan=True)

@@ -141,3 +141,15 @@ def test_tight_variants_bracket_the_closed_form(markov_tables):
     assert ((t.p_lower <= p_c) & (t.p_upper >= p_c)).all()
     # below ~1e-7 the certified bracket stops shrinking with the tolerance (solver accuracy near the edge)
     assert ((t.p_upper - t.p_lower)[t.tol <= 1e-6] < 1e-6).all()
+
+
+def test_path_weights_from_codes_equal_the_direct_form():
+    """path_weights via transition_codes: bit for bit the product of the nested-where step probabilities."""
+    G = np.array(np.meshgrid(*[[0, 1]] * 6, indexing="ij")).reshape(6, -1).T
+    for p, q in ((0.3, 0.7), (0.97, 0.05), (np.float64(0.123456789), 0.9)):
+        a, b = G[:, :-1], G[:, 1:]
+        step = np.where(a == 1, np.where(b == 1, 1 - p, p), np.where(b == 1, q, 1 - q))
+        for gamma1 in (0, 1):
+            ref = np.where(G[:, 0] == gamma1, 1.0, 0.0) * np.prod(step, axis=1)
+            assert np.array_equal(evidence.path_weights(G, p, q, gamma1), ref)
+            assert np.array_equal(evidence.path_weights(G, p, q, gamma1, evidence.transition_codes(G)), ref)

@@ -69,3 +69,16 @@ def test_block_split_rejected_when_coupled():
     assert exact.find_split(EX1, np.eye(2)) is None
     with pytest.raises(InputError):
         exact.example2_split().blocks(coupled, np.eye(3))
+
+
+def test_transition_groups_equal_np_unique():
+    """_transition_groups: the groups, order and assignment np.unique(key) gives, without the sort."""
+    from netrepro.papers.markov.exact import _branch_channel, _transition_groups, _transition_key
+
+    state, counts = np.ones(1, dtype=bool), np.zeros((1, 4), dtype=np.int16)
+    for d in range(1, 13):
+        if d > 1:
+            state, counts = _branch_channel(state, counts)
+        uniq, first, inv = np.unique(_transition_key(counts, d), return_index=True, return_inverse=True)
+        group_counts, got_inv = _transition_groups(counts, d)
+        assert np.array_equal(group_counts, counts[first]) and np.array_equal(got_inv, inv.ravel())

@@ -27,8 +27,6 @@ Every decision of the stability map comes from one of these, each a number we co
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import solve_discrete_lyapunov
-from scipy.optimize import minimize
 
 from ...errors import InputError
 from .model import H_matrix, LinearSystem, loss_factor, riccati_g, spectral_abs
@@ -65,6 +63,8 @@ def thm1_radius(A, C, qs, n_starts: int = 4, seed: int = 0):
         ``rho1``: the radius of the returned gain at each ``q`` (an upper bound of the true minimum,
         recomputed from ``K`` by :func:`~.model.H_matrix`); ``K``: array ``(len(qs), n, m)``.
     """
+    from scipy.optimize import minimize  # scipy.optimize: only the stability map needs it (~0.5 s import)
+
     A, C = np.atleast_2d(np.asarray(A, float)), np.atleast_2d(np.asarray(C, float))
     n, m = A.shape[0], C.shape[0]
     qs = np.atleast_1d(np.asarray(qs, float))
@@ -283,6 +283,8 @@ def two_reception_bound(system: LinearSystem, Sigma0, p, q, n_gaps: int = 400):
     InputError
         If ``n != 2 m`` or some ``O_j`` is singular.
     """
+    from scipy.linalg import solve_discrete_lyapunov  # imported where used (the stability map)
+
     A, C, Q, R = system.A, system.C, system.Q, system.R
     n, m = A.shape[0], C.shape[0]
     if n != 2 * m:

@@ -190,6 +190,17 @@ def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int, z: float):
     return mean, mean - half, mean + half
 
 
+def _riccati_step(P, received, A, C, Q, R):
+    """One step of eqs. (4)-(5) for a batch of paths: ``g(P)`` (eq. 5) where ``received``, else ``h(P)``
+    (eq. 4), each map evaluated only on its own paths (every batched product and solve acts on one
+    matrix at a time, so this equals ``np.where(received, g(P), h(P))`` bit for bit at half the work)."""
+    out = np.empty_like(P)
+    out[received] = riccati_g(P[received], A, C, Q, R)
+    lost = ~received
+    out[lost] = riccati_h(P[lost], A, Q)
+    return out
+
+
 def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_batches: int, z: float):
     """:func:`rb_mean_trace` for many ``(p, q)`` points at once (all paths of all points in one batch).
 
@@ -229,7 +240,7 @@ def rb_trace_grid(system, Sigma0, ps, qs, n_paths: int, horizon: int, rng, n_bat
     S = np.empty((npts * B, T, n, n))
     with np.errstate(over="ignore", invalid="ignore"):
         for k in range(T):
-            P = np.where(arr[:, k, None, None], riccati_g(P, A, C, Q, R), riccati_h(P, A, Q))
+            P = _riccati_step(P, arr[:, k], A, C, Q, R)
             S[:, k] = np.add.reduceat(np.where(arr[:, k, None, None], P, 0.0), starts, axis=0) / per
     f = np.add.reduceat(arr.astype(float), starts, axis=0) / per  # (npts*B, T)
     W, c = [np.eye(n)], [0.0]

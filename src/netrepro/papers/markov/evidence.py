@@ -18,8 +18,8 @@ from .model import (
 )
 from .steps import load_moments
 
-__all__ = ["evidence_step", "enumerate_norms", "path_weights", "mean_norm_enumerated", "monotonicity_violation",
-           "prop1_closed_form", "single_transition"]
+__all__ = ["evidence_step", "enumerate_norms", "transition_codes", "path_weights", "mean_norm_enumerated",
+           "monotonicity_violation", "prop1_closed_form", "single_transition"]
 
 
 # ----------------------------------------------------------------------------- helpers (pure)
@@ -73,7 +73,24 @@ def enumerate_norms(system: LinearSystem, Sigma0, k_max: int):
     return out
 
 
-def path_weights(G, p: float, q: float, gamma1: int) -> np.ndarray:
+def transition_codes(G) -> np.ndarray:
+    """Transition of every step of each path ``G``: 0 for 1 -> 1, 1 for 1 -> 0, 2 for 0 -> 1, 3 for 0 -> 0.
+
+    Parameters
+    ----------
+    G : ndarray
+        ``(N, t)`` paths of 0/1, ``t >= 1``.
+
+    Returns
+    -------
+    ndarray
+        ``(N, t - 1)`` integer codes (independent of ``p, q``: computed once per set of paths).
+    """
+    a, b = G[:, :-1], G[:, 1:]
+    return np.where(a == 1, np.where(b == 1, 0, 1), np.where(b == 1, 2, 3))
+
+
+def path_weights(G, p: float, q: float, gamma1: int, codes=None) -> np.ndarray:
     """Probability of each path ``G`` (rows ``gamma_1..gamma_t``) given ``gamma_1``, under eq. (3).
 
     Parameters
@@ -84,6 +101,8 @@ def path_weights(G, p: float, q: float, gamma1: int) -> np.ndarray:
         Failure and recovery rates.
     gamma1 : int
         The conditioning initial state.
+    codes : ndarray, optional
+        :func:`transition_codes` of ``G`` (computed here if not given).
 
     Returns
     -------
@@ -92,12 +111,13 @@ def path_weights(G, p: float, q: float, gamma1: int) -> np.ndarray:
     """
     if G.shape[1] == 0:
         return np.ones(len(G))
-    a, b = G[:, :-1], G[:, 1:]
-    step = np.where(a == 1, np.where(b == 1, 1 - p, p), np.where(b == 1, q, 1 - q))
+    if codes is None:
+        codes = transition_codes(G)
+    step = np.array([1 - p, p, q, 1 - q], dtype=float)[codes]  # the step probabilities of eq. (3)
     return np.where(G[:, 0] == gamma1, 1.0, 0.0) * np.prod(step, axis=1)
 
 
-def mean_norm_enumerated(paths, p: float, q: float, start: str = "gamma1") -> np.ndarray:
+def mean_norm_enumerated(paths, p: float, q: float, start: str = "gamma1", codes=None) -> np.ndarray:
     """``E||P_k||``, ``k = 1..k_max``, from :func:`enumerate_norms`.
 
     Parameters
@@ -109,16 +129,19 @@ def mean_norm_enumerated(paths, p: float, q: float, start: str = "gamma1") -> np
     start : {"gamma1", "stationary"}
         ``gamma_1 = 1`` (the paper's convention below eq. 3) or ``gamma_1`` drawn from the
         stationary law ``P(gamma = 1) = q / (p + q)`` (the proof of Proposition 2).
+    codes : list, optional
+        :func:`transition_codes` of each ``G`` of ``paths`` (for many ``p, q`` on the same paths).
 
     Returns
     -------
     ndarray
         ``(k_max,)``.
     """
-    one = np.array([w @ n for w, n in ((path_weights(G, p, q, 1), n) for G, n in paths)])
+    codes = codes if codes is not None else [None] * len(paths)
+    one = np.array([w @ n for w, n in ((path_weights(G, p, q, 1, c), n) for (G, n), c in zip(paths, codes))])
     if start == "gamma1":
         return one
-    zero = np.array([w @ n for w, n in ((path_weights(G, p, q, 0), n) for G, n in paths)])
+    zero = np.array([w @ n for w, n in ((path_weights(G, p, q, 0, c), n) for (G, n), c in zip(paths, codes))])
     zero[0] = one[0]
     pi1 = q / (p + q)
     return pi1 * one + (1 - pi1) * zero
@@ -327,9 +350,10 @@ def _prop2_rows(params, moments):
         ex = params["examples"][name]
         em = load_moments(moments, name)
         paths = enumerate_norms(LinearSystem.from_config(ex), ex["Sigma0"], cfg["k_max"])
+        codes = [transition_codes(G) if G.shape[1] else None for G, _ in paths]
         for q in cfg["q"]:
             g1 = monotonicity_violation(em.mean(ps, q, "norm"), ps, cfg["rtol"])
-            stat = monotonicity_violation(np.array([mean_norm_enumerated(paths, p, q, "stationary") for p in ps]), ps, cfg["rtol"])
+            stat = monotonicity_violation(np.array([mean_norm_enumerated(paths, p, q, "stationary", codes) for p in ps]), ps, cfg["rtol"])
             g1.update(example=name, q=q, K=em.depth + 1)
             stat.update(example=name, q=q, K=cfg["k_max"])
             worst = g1 if worst is None or g1["violation"] > worst["violation"] else worst

@@ -35,6 +35,26 @@ def _transition_key(counts, d):
 
 
 
+def _transition_groups(counts, d):
+    """Paths grouped by their transition counts, as ``np.unique`` of :func:`_transition_key` groups them
+    (groups in increasing key order) but without sorting the ``2^(d-1)`` keys: a key is below ``(d+1)^4``,
+    so a table of the keys present gives each group's rank, and a key decodes to its counts.
+
+    Returns
+    -------
+    (group_counts, inv)
+        ``(G, 4)`` transition counts of each group; ``inv``: the group of each path.
+    """
+    key = _transition_key(counts, d)
+    base = d + 1
+    present = np.zeros(base ** 4, dtype=bool)
+    present[key] = True
+    uniq = np.flatnonzero(present)
+    inv = (np.cumsum(present) - 1)[key]
+    group_counts = np.column_stack([uniq // base ** 3, uniq // base ** 2 % base, uniq // base % base, uniq % base])
+    return group_counts, inv
+
+
 @dataclass
 class ExactMoments:
     """``E||P_k||`` and ``E tr P_k`` for ``k = 1..depth+1`` as polynomials in the transition probabilities.
@@ -128,11 +148,10 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
                 P_loss = riccati_h(P, A, Q)
             P = np.concatenate([P_recv, P_loss])
             state, counts = _branch_channel(state, counts)
-        key = _transition_key(counts, d)
-        uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
-        s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(uniq))
-        s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(uniq))
-        coef.append(np.column_stack([counts[first].astype(float), s_norm, s_tr]))
+        group_counts, inv = _transition_groups(counts, d)
+        s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(group_counts))
+        s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(group_counts))
+        coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))
     return ExactMoments(coef, float(sym_norm(P1[None])[0]), float(np.trace(P1)))
 
 
@@ -258,13 +277,12 @@ def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSp
                 Ps = [np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
                       for P, (A, C, Q, R, _) in zip(Ps, blocks)]
             state, counts = _branch_channel(state, counts)
-        key = _transition_key(counts, d)
-        uniq, first, inv = np.unique(key, return_index=True, return_inverse=True)
+        group_counts, inv = _transition_groups(counts, d)
         norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)
         tr = sum(np.trace(P, axis1=-2, axis2=-1) for P in Ps)
-        s_norm = np.bincount(inv, weights=norm, minlength=len(uniq))
-        s_tr = np.bincount(inv, weights=tr, minlength=len(uniq))
-        coef.append(np.column_stack([counts[first].astype(float), s_norm, s_tr]))
+        s_norm = np.bincount(inv, weights=norm, minlength=len(group_counts))
+        s_tr = np.bincount(inv, weights=tr, minlength=len(group_counts))
+        coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))
     S0 = np.asarray(Sigma0, float)
     return ExactMoments(coef, float(sym_norm(S0[None])[0]), float(np.trace(S0)))
 

@@ -60,11 +60,12 @@ def _pairwise_block(a, lo, n):
     return res
 
 
-@njit(cache=True, boundscheck=False)
+STACK_DEPTH = 128  # frames of the pairwise split tree (its depth is about log2(n / 128) + 2)
+
+
 def pairwise_sum(a, lo, n):
-    """``np.sum(a[lo:lo+n])`` with numpy's pairwise summation: blocks of at most 128 summed by
-    :func:`_pairwise_block`, longer ranges split at ``n2 = n // 2 - (n // 2) % 8`` and the halves added
-    (left + right). Written with an explicit stack: numba's on-disk cache does not support recursion.
+    """``np.sum(a[lo:lo+n])`` with numpy's pairwise summation (:func:`_pairwise_sum_into` with fresh
+    work arrays).
 
     Parameters
     ----------
@@ -78,17 +79,28 @@ def pairwise_sum(a, lo, n):
     float
         The sum, rounded as ``np.sum`` rounds it.
     """
-    if n <= 128:
-        return _pairwise_block(a, lo, n)
-    # post-order traversal of the split tree; each frame: (lo, n, state), partial results on a value stack
-    f_lo = np.empty(128, np.int64)
-    f_n = np.empty(128, np.int64)
-    f_state = np.empty(128, np.int64)
-    vals = np.empty(128)
+    frames, vals = _pairwise_work()
+    return _pairwise_sum_into(np.ascontiguousarray(a, dtype=float), lo, n, frames, vals)
+
+
+def _pairwise_work():
+    """Work arrays of :func:`_pairwise_sum_into`: allocated by the caller, not in compiled code (each
+    ``np.empty`` form is one more overload to compile on a cold cache)."""
+    return np.empty((STACK_DEPTH, 3), np.int64), np.empty(STACK_DEPTH)
+
+
+@njit(cache=True, boundscheck=False)
+def _pairwise_sum_into(a, lo, n, frames, vals):
+    """``np.sum(a[lo:lo+n])`` with numpy's pairwise summation: blocks of at most 128 summed by
+    :func:`_pairwise_block`, longer ranges split at ``n2 = n // 2 - (n // 2) % 8`` and the halves added
+    (left + right). Written with an explicit stack (``frames``: ``(lo, n, state)`` rows, ``vals``:
+    partial sums): numba's on-disk cache does not support recursion. Every range, a single block
+    too, goes through the stack so that :func:`_pairwise_block` is compiled for one signature only.
+    """
     top, nv = 0, 0
-    f_lo[0], f_n[0], f_state[0] = lo, n, 0
+    frames[0, 0], frames[0, 1], frames[0, 2] = lo, n, 0
     while top >= 0:
-        l, m, st = f_lo[top], f_n[top], f_state[top]
+        l, m, st = frames[top, 0], frames[top, 1], frames[top, 2]
         if m <= 128:
             vals[nv] = _pairwise_block(a, l, m)
             nv += 1
@@ -97,13 +109,13 @@ def pairwise_sum(a, lo, n):
         n2 = m // 2
         n2 -= n2 % 8
         if st == 0:  # push the left half
-            f_state[top] = 1
+            frames[top, 2] = 1
             top += 1
-            f_lo[top], f_n[top], f_state[top] = l, n2, 0
+            frames[top, 0], frames[top, 1], frames[top, 2] = l, n2, 0
         elif st == 1:  # push the right half
-            f_state[top] = 2
+            frames[top, 2] = 2
             top += 1
-            f_lo[top], f_n[top], f_state[top] = l + n2, m - n2, 0
+            frames[top, 0], frames[top, 1], frames[top, 2] = l + n2, m - n2, 0
         else:  # both halves done: left + right
             right = vals[nv - 1]
             left = vals[nv - 2]
@@ -130,6 +142,16 @@ def _h_inplace(X, A, Q, tmp):
             for l in range(1, n):
                 s += tmp[i, l] * A[j, l]
             X[i, j] = s + Q[i, j]
+
+
+@njit(cache=True, boundscheck=False)
+def _copy_into(dst, src):
+    """``dst[:, :] = src`` element by element: numba's slice assignment compiles its shape-mismatch
+    error message (dozens of string overloads, seconds of cold compile) for a copy of n x n floats."""
+    n = src.shape[0]
+    for i in range(n):
+        for j in range(n):
+            dst[i, j] = src[i, j]
 
 
 @njit(cache=True, boundscheck=False)
@@ -179,12 +201,14 @@ def _norm(X, which_trace):
     r = det / 2.0
     if r != r:
         r = 0.0
-    r = min(max(r, -1.0), 1.0)
+    if r < -1.0:  # clip to [-1, 1] by comparisons (min/max would compile two more overloads)
+        r = -1.0
+    elif r > 1.0:
+        r = 1.0
     phi = math.acos(r) / 3.0
     return q + 2.0 * p * math.cos(phi)
 
 
-@njit(cache=True, boundscheck=False)
 def rb_norm_kernel(P, arrivals, A, Q, W, which_trace, out):
     """Per-path values of :func:`.estimators.rb_mean_norm` (eq. 4 along the trailing loss run).
 
@@ -202,22 +226,29 @@ def rb_norm_kernel(P, arrivals, A, Q, W, which_trace, out):
     out : ndarray ``(N, T+1)``
         The per-path values (the ``out`` argument).
     """
+    T, n = P.shape[1] - 1, A.shape[0]
+    frames, vals = _pairwise_work()
+    # work arrays from here rather than np.empty in the compiled loop (fewer overloads to compile)
+    return _rb_norm_paths(P, arrivals, A, Q, W, which_trace, out, np.empty((max(T, 1), n, n)), np.empty((n, n)),
+                          np.empty(max(T, 1)), frames, vals)
+
+
+@njit(cache=True, boundscheck=False)
+def _rb_norm_paths(P, arrivals, A, Q, W, which_trace, out, H, tmp, row, frames, vals):
+    """The loop of :func:`rb_norm_kernel` over paths and ``k``; ``H`` ``(T, n, n)``, ``tmp`` ``(n, n)``,
+    ``row`` ``(T,)``, ``frames`` and ``vals`` (:func:`_pairwise_work`) are work arrays."""
     N, T1 = P.shape[0], P.shape[1]
     T = T1 - 1
-    n = A.shape[0]
-    H = np.empty((T, n, n))
-    tmp = np.empty((n, n))
-    row = np.empty(T)
     for a in range(N):
         out[a, 0] = _norm(P[a, 0], which_trace)
         for k in range(2, T + 2):
             for c in range(k - 2):
                 _h_inplace(H[c], A, Q, tmp)
-            H[k - 2] = P[a, k - 1]
+            _copy_into(H[k - 2], P[a, k - 1])
             for c in range(k - 1):
                 if arrivals[a, c]:
                     row[c] = W[k - 1, c] * _norm(H[c], which_trace)
                 else:
                     row[c] = 0.0
-            out[a, k - 1] = pairwise_sum(row, 0, k - 1)
+            out[a, k - 1] = _pairwise_sum_into(row, 0, k - 1, frames, vals)
     return out

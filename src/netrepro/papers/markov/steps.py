@@ -64,7 +64,6 @@ import time
 import numpy as np
 import pandas as pd
 
-from ...engines.certify import bisect_certified
 from . import estimators as est
 from . import expectations as xp
 from .exact import ExactMoments, exact_moments_auto, find_split
@@ -207,6 +206,8 @@ def tight_variants_step(params, inputs, outputs):
 
 def iid_line_step(params, inputs, outputs):
     """The i.i.d. line p + q = 1 (Remark 4): Sinopoli's bounds on lambda_c and Theorem 5's crossing."""
+    from ...engines.certify import bisect_certified  # scipy.sparse: only the LMI steps need the engine
+
     tol = params["iid"]["tol"]
     rows = []
     for name, ex in params["examples"].items():
