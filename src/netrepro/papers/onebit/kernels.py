@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["band_forward_backward"]
+__all__ = ["band_forward_backward", "smoothing_gain_iterations"]
 
 
 @njit(cache=True, boundscheck=False, error_model="numpy")
@@ -137,3 +137,20 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
         _divide_columns(beta, colsum)
         if slot[k - 1] >= 0:
             _store(stored_beta, slot[k - 1], beta)
+
+
+@njit(cache=True, error_model="numpy")
+def smoothing_gain_iterations(F, s, a2, kappa_star, rtol, n_steps, kappa, last):
+    r"""``n_steps`` steps of the smoothing gain (27)/(37)-(38), :math:`\kappa \leftarrow a^2 I/(1 + \sigma_z^2 I)`, :math:`I = F + \kappa`.
+
+    In place on ``kappa`` (one lane per element); ``last[lane]`` receives the last step ``d`` (1-based)
+    with ``|kappa / kappa_star - 1| > rtol``. Same operations in the same order as
+    :func:`netrepro.papers.onebit.randomwalk.rw_smoothing_gain_step` in a numpy loop.
+    """
+    for d in range(1, n_steps + 1):
+        for lane in range(kappa.shape[0]):
+            info = F[lane] + kappa[lane]
+            k = a2 * info / (1.0 + s[lane] * info)
+            kappa[lane] = k
+            if abs(k / kappa_star[lane] - 1) > rtol:
+                last[lane] = d
