@@ -80,7 +80,7 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
     prior : ndarray (n_grid,)
         Normalised prior masses at k = 0.
     slot : ndarray of int64 (K+1,)
-        Output slot of step k (-1: not stored).
+        Output slot of step k (-1: not stored). The forward recursion stops at the last stored step.
     stop : int
         The backward recursion runs k = K..stop+1 (produces beta at steps K-1..stop).
     stored_post, stored_beta : ndarray (n_slots, n_grid, n_runs)
@@ -96,7 +96,10 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
             cur[i, c] = prior[i]
     if slot[0] >= 0:
         _store(stored_post, slot[0], cur)
-    for k in range(K):
+    last = K  # the filter is needed up to the last stored step only (the backward pass starts from beta = 1)
+    while last > 0 and slot[last] < 0:
+        last -= 1
+    for k in range(last):
         pos = positive[k]
         for c in range(n):
             colsum[c] = 0.0
