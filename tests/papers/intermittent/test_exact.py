@@ -98,3 +98,17 @@ def test_fast():
     for lam in (LAM_C + 0.1, LAM_C - 0.1):
         exact.exact_mean(P0, A, R1, [R2], [lam], 60)
     assert time.perf_counter() - start < 5.0
+
+
+def test_cheb_coeffs_cached_cosines_equal_direct_dct():
+    from netrepro.papers.intermittent import exact as ex
+
+    vals = np.linspace(0.3, 2.0, 33).astype(ex._LD) ** 3
+    n = len(vals) - 1
+    j = np.arange(n + 1, dtype=ex._LD)
+    w = np.ones(n + 1, dtype=ex._LD)
+    w[[0, -1]] = 0.5
+    direct = (ex._LD(2) / n) * (np.cos(ex._PI * np.outer(j, j) / n) @ (w * vals))
+    direct[[0, -1]] *= 0.5
+    for _ in range(2):  # second call reads the cached matrix
+        np.testing.assert_array_equal(ex._cheb_coeffs(vals), direct)

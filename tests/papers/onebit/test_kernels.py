@@ -27,3 +27,17 @@ def test_shared_bootstrap_equals_one_call_per_pair():
     got = estimators.paired_ratio_intervals(vals, pairs, 700, 9)
     for (num, den), g in zip(pairs, got):
         assert g == estimators.paired_ratio_interval(vals[num], vals[den], 700, 9)   # exactly
+
+
+@pytest.mark.parametrize("eps", [1e-3, 1e-1])
+def test_smoothing_gain_iterations_equal_numpy_loop(eps):
+    from netrepro.papers.onebit import randomwalk
+
+    s = np.asarray(model.sigma_z2_from_snr(np.array([-30.0, -5.0, 0.0, 20.0]), eps), dtype=float)
+    for F in (np.array([0.01, 0.3, 0.5, 0.6]), np.ones(4)):
+        star = randomwalk.rw_smoothing_gain_fixed_point(F, eps, s)
+        fast = randomwalk.rw_smoothing_gain_iterated(F, eps, s, star, 3000, 1e-9)
+        ref = randomwalk._rw_smoothing_gain_iterated_numpy(F, eps, s, star, 3000, 1e-9)
+        np.testing.assert_array_equal(fast[0], ref[0])   # same operations, same order: tolerance 0
+        np.testing.assert_array_equal(fast[1], ref[1])
+        assert ref[1].max() > 0

@@ -50,6 +50,7 @@ E(p_inf) = mu_inf / (1 - pi_0 a^2) + (1 - pi_0) sum_m pi_0^m c_m.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -237,13 +238,21 @@ def _cheb_nodes(n):
     return np.cos(_PI * np.arange(n + 1, dtype=_LD) / n)
 
 
+@functools.lru_cache(maxsize=None)
+def _dct1_matrix(n):
+    """cos(pi j l / n), j, l = 0..n, in extended precision (read-only; cached: the extended cosines are slow)."""
+    j = np.arange(n + 1, dtype=_LD)
+    m = np.cos(_PI * np.outer(j, j) / n)
+    m.flags.writeable = False
+    return m
+
+
 def _cheb_coeffs(values):
     """Chebyshev coefficients of the interpolant at the points cos(pi j / n), j = 0..n (a DCT-I)."""
     n = len(values) - 1
-    j = np.arange(n + 1, dtype=_LD)
     w = np.ones(n + 1, dtype=_LD)
     w[[0, -1]] = 0.5
-    c = (_LD(2) / n) * (np.cos(_PI * np.outer(j, j) / n) @ (w * np.asarray(values, dtype=_LD)))
+    c = (_LD(2) / n) * (_dct1_matrix(n) @ (w * np.asarray(values, dtype=_LD)))
     c[[0, -1]] *= 0.5
     return c
 
@@ -263,24 +272,40 @@ def _backward(setup, n_iter, degree, stop_width=None):
     s_t0 = setup.s_of_t(1 / (_LD(setup.p0) + _LD(setup.R_ref)))
     w = setup.weights_ld
 
-    def defect_bound(exact_check, c_new, sup_old, size_old):
-        """sup-norm bound of the defect on [0, t*]: sup_old bounds the old function on E_rho, size_old on [0, t*]."""
-        d = exact_check - C.chebval(_cheb_nodes(N2), c_new)
+    # every point at which a coefficient set is evaluated, in one array: one Clenshaw pass per set
+    # (elementwise, so each value is the one a separate chebval call gives)
+    parts = (_cheb_nodes(N2), np.reshape(s_t0, 1), s_nodes.ravel(), s_check.ravel())
+    x_all = np.concatenate(parts)
+    cuts = np.cumsum([len(q) for q in parts])[:-1]
+
+    def evaluate(c):
+        """c at the check nodes (own interpolant), at t0, and at the images of the nodes and check nodes."""
+        at_check, at_t0, at_nodes, at_images = np.split(C.chebval(x_all, c), cuts)
+        return at_check, at_t0[0], at_nodes.reshape(s_nodes.shape), at_images.reshape(s_check.shape)
+
+    def defect_bound(exact_check, approx_check, c_new, sup_old, size_old):
+        """sup-norm bound of the defect on [0, t*]: sup_old bounds the old function on E_rho, size_old on [0, t*].
+
+        ``approx_check`` is ``c_new`` evaluated at the check nodes."""
+        d = exact_check - approx_check
         coef = _cheb_coeffs(d)
         fp = 8 * (N2 + 1) * _EPS * (size_old + np.abs(c_new).sum())
         return float(np.abs(coef).sum() + tail * (sup_old + float(np.abs(c_new) @ pow_rho)) + fp)
 
     v_check = setup.V(check_t, extended=True)
     c = _cheb_coeffs(setup.V(nodes_t, extended=True))
-    err = defect_bound(v_check, c, setup.V_sup, float(np.abs(v_check).max()))
-    mus, errs = [float(C.chebval(s_t0, c))], [err]
+    at_check, at_t0, at_nodes, at_images = evaluate(c)
+    err = defect_bound(v_check, at_check, c, setup.V_sup, float(np.abs(v_check).max()))
+    mus, errs = [float(at_t0)], [err]
     n = 0
     while n < n_iter - 1:
-        c_new = _cheb_coeffs(w @ C.chebval(s_nodes, c))
-        err += defect_bound(w @ C.chebval(s_check, c), c_new, float(np.abs(c) @ pow_rho), float(np.abs(c).sum()))
+        c_new = _cheb_coeffs(w @ at_nodes)
+        exact_check = w @ at_images
+        at_check, at_t0, at_nodes, at_images = evaluate(c_new)
+        err += defect_bound(exact_check, at_check, c_new, float(np.abs(c) @ pow_rho), float(np.abs(c).sum()))
         c = c_new
         n += 1
-        mus.append(float(C.chebval(s_t0, c)))
+        mus.append(float(at_t0))
         errs.append(err)
         if stop_width is not None and n % 10 == 0:
             lo, hi = _range(c)

@@ -4,6 +4,8 @@ Imported lazily by :func:`netrepro.papers.onebit.estimators.grid_smoother_at` (n
 The kernels perform the same floating-point operations in the same order as the numpy/scipy reference
 (CSR sparse-times-dense products accumulated row by row from 0, likelihood product, column sums in grid
 order, division), so they are bit-identical to it (checked in tests/papers/onebit/test_kernels.py).
+Plain loops only: array slice assignment and inlined helpers cost seconds of compile time in every cold
+job, and the compile time counts as much as the run time.
 """
 
 from __future__ import annotations
@@ -11,28 +13,49 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["band_forward_backward"]
+__all__ = ["band_forward_backward", "smoothing_gain_iterations"]
 
 
-@njit(cache=True, boundscheck=False, error_model="numpy", inline="always")
+@njit(cache=True, boundscheck=False, error_model="numpy")
 def _csr_row_product(ptr, idx, val, i, src, drow):
-    """``drow = (M @ src)[i]`` for CSR ``M``, accumulated from 0 in the order of the stored entries (as scipy)."""
-    for c in range(drow.shape[0]):
+    """``drow = (M @ src)[i]`` for CSR ``M``, accumulated from 0 in the order of the stored entries (as scipy).
+
+    Four stored entries per pass over ``drow`` (the sum keeps its order: ``(((d + a0 s0) + a1 s1) + ...)``),
+    so ``drow`` is loaded and stored once per four products instead of once per product.
+    """
+    n = drow.shape[0]
+    jj = ptr[i]
+    end = ptr[i + 1]
+    for c in range(n):
         drow[c] = 0.0
-    for jj in range(ptr[i], ptr[i + 1]):
+    while jj + 4 <= end:
+        a0, a1, a2, a3 = val[jj], val[jj + 1], val[jj + 2], val[jj + 3]
+        s0, s1, s2, s3 = src[idx[jj]], src[idx[jj + 1]], src[idx[jj + 2]], src[idx[jj + 3]]
+        for c in range(n):
+            drow[c] = (((drow[c] + a0 * s0[c]) + a1 * s1[c]) + a2 * s2[c]) + a3 * s3[c]
+        jj += 4
+    while jj < end:
         a = val[jj]
         srow = src[idx[jj]]
-        for c in range(drow.shape[0]):
+        for c in range(n):
             drow[c] += a * srow[c]
+        jj += 1
 
 
-@njit(cache=True, boundscheck=False, error_model="numpy", inline="always")
+@njit(cache=True, boundscheck=False, error_model="numpy")
 def _divide_columns(M, colsum):
     """``M /= colsum`` column by column (normalisation per run)."""
     for i in range(M.shape[0]):
-        row = M[i]
-        for c in range(row.shape[0]):
-            row[c] = row[c] / colsum[c]
+        for c in range(M.shape[1]):
+            M[i, c] = M[i, c] / colsum[c]
+
+
+@njit(cache=True, boundscheck=False, error_model="numpy")
+def _store(out, s, M):
+    """``out[s] = M`` (a loop: compiles much faster than the slice assignment)."""
+    for i in range(M.shape[0]):
+        for c in range(M.shape[1]):
+            out[s, i, c] = M[i, c]
 
 
 @njit(cache=True, boundscheck=False, error_model="numpy")
@@ -57,7 +80,7 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
     prior : ndarray (n_grid,)
         Normalised prior masses at k = 0.
     slot : ndarray of int64 (K+1,)
-        Output slot of step k (-1: not stored).
+        Output slot of step k (-1: not stored). The forward recursion stops at the last stored step.
     stop : int
         The backward recursion runs k = K..stop+1 (produces beta at steps K-1..stop).
     stored_post, stored_beta : ndarray (n_slots, n_grid, n_runs)
@@ -72,8 +95,11 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
         for c in range(n):
             cur[i, c] = prior[i]
     if slot[0] >= 0:
-        stored_post[slot[0]] = cur
-    for k in range(K):
+        _store(stored_post, slot[0], cur)
+    last = K  # the filter is needed up to the last stored step only (the backward pass starts from beta = 1)
+    while last > 0 and slot[last] < 0:
+        last -= 1
+    for k in range(last):
         pos = positive[k]
         for c in range(n):
             colsum[c] = 0.0
@@ -89,7 +115,7 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
         _divide_columns(nxt, colsum)
         cur, nxt = nxt, cur
         if slot[k + 1] >= 0:
-            stored_post[slot[k + 1]] = cur
+            _store(stored_post, slot[k + 1], cur)
     beta = cur
     tmp = nxt
     for i in range(G):
@@ -113,4 +139,21 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
                 colsum[c] += drow[c]
         _divide_columns(beta, colsum)
         if slot[k - 1] >= 0:
-            stored_beta[slot[k - 1]] = beta
+            _store(stored_beta, slot[k - 1], beta)
+
+
+@njit(cache=True, error_model="numpy")
+def smoothing_gain_iterations(F, s, a2, kappa_star, rtol, n_steps, kappa, last):
+    r"""``n_steps`` steps of the smoothing gain (27)/(37)-(38), :math:`\kappa \leftarrow a^2 I/(1 + \sigma_z^2 I)`, :math:`I = F + \kappa`.
+
+    In place on ``kappa`` (one lane per element); ``last[lane]`` receives the last step ``d`` (1-based)
+    with ``|kappa / kappa_star - 1| > rtol``. Same operations in the same order as
+    :func:`netrepro.papers.onebit.randomwalk.rw_smoothing_gain_step` in a numpy loop.
+    """
+    for d in range(1, n_steps + 1):
+        for lane in range(kappa.shape[0]):
+            info = F[lane] + kappa[lane]
+            k = a2 * info / (1.0 + s[lane] * info)
+            kappa[lane] = k
+            if abs(k / kappa_star[lane] - 1) > rtol:
+                last[lane] = d

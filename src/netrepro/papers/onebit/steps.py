@@ -80,7 +80,7 @@ from .randomwalk import (
     rw_lag_iterated,
     rw_lag_needed,
     rw_smoothing_gain_fixed_point,
-    rw_smoothing_gain_step,
+    rw_smoothing_gain_iterated,
 )
 
 __all__ = [
@@ -175,17 +175,11 @@ def convergence_step(params, inputs, outputs):
         Fq = expected_fisher_1bit(out["var_inf"] / se**2) / se**2
         Fi = np.full_like(s, 1.0 / se**2)
         # smoothing gain: Delta steps of (27)/(38) with the stationary E[F_q]
-        kq, ki = np.zeros_like(s), np.zeros_like(s)
-        last_q = np.zeros(len(s), dtype=np.int64)
-        last_i = np.zeros(len(s), dtype=np.int64)
+        n_lag = c["n_lag_steps"][params["one_minus_alpha"].index(eps)]
         kq_star = rw_smoothing_gain_fixed_point(Fq, eps, s)
         ki_star = rw_smoothing_gain_fixed_point(Fi, eps, s)
-        for d in range(1, c["n_lag_steps"][params["one_minus_alpha"].index(eps)] + 1):
-            kq = rw_smoothing_gain_step(kq, Fq, eps, s)
-            ki = rw_smoothing_gain_step(ki, Fi, eps, s)
-            last_q[np.abs(kq / kq_star - 1) > c["rtol"]] = d
-            last_i[np.abs(ki / ki_star - 1) > c["rtol"]] = d
-        n_lag = c["n_lag_steps"][params["one_minus_alpha"].index(eps)]
+        kq, last_q = rw_smoothing_gain_iterated(Fq, eps, s, kq_star, n_lag, c["rtol"])
+        ki, last_i = rw_smoothing_gain_iterated(Fi, eps, s, ki_star, n_lag, c["rtol"])
         for i, snr in enumerate(snr_db):
             base = dict(alpha=1.0 - eps, snr_db=snr)
             for qty, fp, it, n, kc in (
