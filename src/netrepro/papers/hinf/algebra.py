@@ -10,9 +10,31 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation"]
+__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled"]
 
 I2 = np.eye(2)
+
+# below this many 2x2 matrices a call stays in numpy: importing numba and loading a kernel cost more
+COMPILED_MIN_BATCH = 64
+
+
+def use_compiled(kernel: str, n_matrices: int) -> bool:
+    """Whether a function with a compiled and a numpy form (bit-identical) runs the compiled one.
+
+    Parameters
+    ----------
+    kernel : {"auto", "compiled", "numpy"}
+        ``"auto"``: compiled for batches of at least ``COMPILED_MIN_BATCH`` matrices.
+    n_matrices : int
+        Number of 2x2 matrices in the call.
+
+    Returns
+    -------
+    bool
+    """
+    if kernel not in ("auto", "compiled", "numpy"):
+        raise ValueError(f"kernel must be 'auto', 'compiled' or 'numpy', got {kernel!r}")
+    return kernel == "compiled" or (kernel == "auto" and n_matrices >= COMPILED_MIN_BATCH)
 
 
 def det2(a):
