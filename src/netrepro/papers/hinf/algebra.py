@@ -8,23 +8,29 @@ agents without a LAPACK call per matrix.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 __all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled"]
 
 I2 = np.eye(2)
 
-# below this many 2x2 matrices a call stays in numpy: importing numba and loading a kernel cost more
+# below this many 2x2 matrices a call stays in numpy even where numba is loaded
 COMPILED_MIN_BATCH = 64
 
 
 def use_compiled(kernel: str, n_matrices: int) -> bool:
     """Whether a function with a compiled and a numpy form (bit-identical) runs the compiled one.
 
+    Importing numba and loading a kernel cost a process about 1-2 s, more than the compiled forms save in
+    a single scenario; so ``"auto"`` runs them only where numba is already loaded: by the steps that run
+    many filter updates (they import :mod:`.filter_kernels` up front) or that use another kernel.
+
     Parameters
     ----------
     kernel : {"auto", "compiled", "numpy"}
-        ``"auto"``: compiled for batches of at least ``COMPILED_MIN_BATCH`` matrices.
+        ``"auto"``: compiled if numba is loaded and the call has at least ``COMPILED_MIN_BATCH`` matrices.
     n_matrices : int
         Number of 2x2 matrices in the call.
 
@@ -34,7 +40,9 @@ def use_compiled(kernel: str, n_matrices: int) -> bool:
     """
     if kernel not in ("auto", "compiled", "numpy"):
         raise ValueError(f"kernel must be 'auto', 'compiled' or 'numpy', got {kernel!r}")
-    return kernel == "compiled" or (kernel == "auto" and n_matrices >= COMPILED_MIN_BATCH)
+    if kernel == "auto":
+        return "numba" in sys.modules and n_matrices >= COMPILED_MIN_BATCH
+    return kernel == "compiled"
 
 
 def det2(a):
