@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled"]
+__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled", "kernel_operand"]
 
 I2 = np.eye(2)
 
@@ -43,6 +43,25 @@ def use_compiled(kernel: str, n_matrices: int) -> bool:
     if kernel == "auto":
         return "numba" in sys.modules and n_matrices >= COMPILED_MIN_BATCH
     return kernel == "compiled"
+
+
+def kernel_operand(a, shape):
+    """``a`` broadcast to ``shape`` as a C-ordered, writable float64 array (one compiled signature).
+
+    Parameters
+    ----------
+    a : array_like
+    shape : tuple of int
+
+    Returns
+    -------
+    ndarray
+        ``a`` itself when it already is such an array of that shape, else a copy.
+    """
+    if (isinstance(a, np.ndarray) and a.shape == shape and a.dtype == np.float64 and a.flags.c_contiguous
+            and a.flags.writeable):
+        return a
+    return np.array(np.broadcast_to(a, shape), dtype=float, order="C")
 
 
 def det2(a):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ModelError
-from .algebra import I2, inv2, min_eig2, sym2, use_compiled
+from .algebra import I2, inv2, kernel_operand, min_eig2, sym2, use_compiled
 
 __all__ = [
     "FilterDoesNotExist", "hinf_information", "hinf_update", "decentralized_update", "kalman_update",
@@ -128,8 +128,8 @@ def _hinf_update_compiled(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar):
     # numpy's ``xhat @ A.T`` is a dgemv (another rounding order) when xhat has a single row per stack
     xpred_gemv = xhat.ndim == 1 or xhat.shape[-2] == 1
 
-    def flat(a, tail):  # fresh C-ordered writable copies: one compiled signature
-        return np.array(np.broadcast_to(a, lead + tail), dtype=float, order="C").reshape((-1,) + tail)
+    def flat(a, tail):
+        return kernel_operand(a, lead + tail).reshape((-1,) + tail)
 
     xnew, Sig, Delta = np.empty(lead + (2,)), np.empty(lead + (2, 2)), np.empty(lead + (2, 2))
     info_eig = np.empty(lead)

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .algebra import I2, inv2, rotation, use_compiled
+from .algebra import I2, inv2, kernel_operand, rotation, use_compiled
 
 __all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law"]
 
@@ -52,8 +52,8 @@ def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar, kernel: str = "auto")
         return _sigma_gradient_numpy(Delta, dDelta, S, dS, gamma_inv2, Lbar)
     from .filter_kernels import sigma_gradient_kernel  # numba: imported by the steps that move agents
 
-    def flat(a):  # fresh C-ordered writable copies: one compiled signature
-        return np.array(np.broadcast_to(a, lead + (2, 2)), dtype=float, order="C").reshape(-1, 2, 2)
+    def flat(a):
+        return kernel_operand(a, lead + (2, 2)).reshape(-1, 2, 2)
 
     Sigma, dSigma = np.empty(lead + (2, 2)), np.empty(lead + (2, 2))
     sigma_gradient_kernel(flat(Delta), flat(dDelta), flat(S), flat(dS), float(gamma_inv2),
