@@ -8,11 +8,60 @@ agents without a LAPACK call per matrix.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation"]
+__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled", "kernel_operand"]
 
 I2 = np.eye(2)
+
+# below this many 2x2 matrices a call stays in numpy even where numba is loaded
+COMPILED_MIN_BATCH = 64
+
+
+def use_compiled(kernel: str, n_matrices: int) -> bool:
+    """Whether a function with a compiled and a numpy form (bit-identical) runs the compiled one.
+
+    Importing numba and loading a kernel cost a process about 1-2 s, more than the compiled forms save in
+    a single scenario; so ``"auto"`` runs them only where numba is already loaded: by the steps that run
+    many filter updates (they import :mod:`.filter_kernels` up front) or that use another kernel.
+
+    Parameters
+    ----------
+    kernel : {"auto", "compiled", "numpy"}
+        ``"auto"``: compiled if numba is loaded and the call has at least ``COMPILED_MIN_BATCH`` matrices.
+    n_matrices : int
+        Number of 2x2 matrices in the call.
+
+    Returns
+    -------
+    bool
+    """
+    if kernel not in ("auto", "compiled", "numpy"):
+        raise ValueError(f"kernel must be 'auto', 'compiled' or 'numpy', got {kernel!r}")
+    if kernel == "auto":
+        return "numba" in sys.modules and n_matrices >= COMPILED_MIN_BATCH
+    return kernel == "compiled"
+
+
+def kernel_operand(a, shape):
+    """``a`` broadcast to ``shape`` as a C-ordered, writable float64 array (one compiled signature).
+
+    Parameters
+    ----------
+    a : array_like
+    shape : tuple of int
+
+    Returns
+    -------
+    ndarray
+        ``a`` itself when it already is such an array of that shape, else a copy.
+    """
+    if (isinstance(a, np.ndarray) and a.shape == shape and a.dtype == np.float64 and a.flags.c_contiguous
+            and a.flags.writeable):
+        return a
+    return np.array(np.broadcast_to(a, shape), dtype=float, order="C")
 
 
 def det2(a):

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import ModelError
-from .algebra import I2, inv2, min_eig2, sym2
+from .algebra import I2, inv2, kernel_operand, min_eig2, sym2, use_compiled
 
 __all__ = [
     "FilterDoesNotExist", "hinf_information", "hinf_update", "decentralized_update", "kalman_update",
@@ -52,7 +52,8 @@ def hinf_information(Delta, S, gamma_inv2: float, Lbar):
     return sym2(inv2(Delta) + S - gamma_inv2 * Lbar)
 
 
-def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: bool = True):
+def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: bool = True,
+                kernel: str = "auto"):
     """One step of the centralized H-infinity filter, eq (6), in its information form.
 
     .. math::
@@ -82,6 +83,9 @@ def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: 
         ``gamma^{-2}``.
     check : bool
         Raise :class:`FilterDoesNotExist` when ``Sigma_k^{-1}`` is not positive definite.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: :func:`.filter_kernels.hinf_update_kernel`, the same arithmetic filter by filter
+        (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see :func:`.algebra.use_compiled`.
 
     Returns
     -------
@@ -93,6 +97,18 @@ def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: 
     FilterDoesNotExist
         If ``check`` and ``Sigma_k^{-1}`` is not positive definite (gamma below gamma_0).
     """
+    if use_compiled(kernel, np.size(Sigma) // 4):
+        xnew, Sig, Delta, info_eig = _hinf_update_compiled(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar)
+    else:
+        xnew, Sig, Delta, info_eig = _hinf_update_numpy(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar)
+    if check and not np.all(info_eig > 0):
+        raise FilterDoesNotExist(
+            f"Sigma^-1 not positive definite (min eigenvalue {np.min(info_eig):.3g}): gamma below gamma_0")
+    return xnew, Sig, Delta, info_eig
+
+
+def _hinf_update_numpy(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar):
+    """Eq (6) in numpy (the reference form of :func:`hinf_update`): ``xhat, Sigma, Delta, min_info_eig``."""
     Delta = A @ Sigma @ A.T + BWB
     xpred = xhat @ A.T
     G = Delta @ inv2(I2 + S @ Delta)
@@ -100,9 +116,27 @@ def hinf_update(xhat, Sigma, y_info, S, A, BWB, gamma_inv2: float, Lbar, check: 
     Omega = I2 - gamma_inv2 * Lbar @ Delta + S @ Delta
     Sig = sym2(Delta @ inv2(Omega))
     info_eig = min_eig2(hinf_information(Delta, S, gamma_inv2, Lbar))
-    if check and not np.all(info_eig > 0):
-        raise FilterDoesNotExist(
-            f"Sigma^-1 not positive definite (min eigenvalue {np.min(info_eig):.3g}): gamma below gamma_0")
+    return xnew, Sig, Delta, info_eig
+
+
+def _hinf_update_compiled(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar):
+    """Eq (6) by :func:`.filter_kernels.hinf_update_kernel`, bit-identical to :func:`_hinf_update_numpy`."""
+    from .filter_kernels import hinf_update_kernel  # numba: imported by the steps that run a filter
+
+    xhat, Sigma, y_info, S = (np.asarray(a, dtype=float) for a in (xhat, Sigma, y_info, S))
+    lead = np.broadcast_shapes(xhat.shape[:-1], Sigma.shape[:-2], y_info.shape[:-1], S.shape[:-2])
+    # numpy's ``xhat @ A.T`` is a dgemv (another rounding order) when xhat has a single row per stack
+    xpred_gemv = xhat.ndim == 1 or xhat.shape[-2] == 1
+
+    def flat(a, tail):
+        return kernel_operand(a, lead + tail).reshape((-1,) + tail)
+
+    xnew, Sig, Delta = np.empty(lead + (2,)), np.empty(lead + (2, 2)), np.empty(lead + (2, 2))
+    info_eig = np.empty(lead)
+    hinf_update_kernel(flat(xhat, (2,)), flat(Sigma, (2, 2)), flat(y_info, (2,)), flat(S, (2, 2)),
+                       *(np.array(m, dtype=float, order="C") for m in (A, BWB)), float(gamma_inv2),
+                       np.array(Lbar, dtype=float, order="C"), bool(xpred_gemv), xnew.reshape(-1, 2),
+                       Sig.reshape(-1, 2, 2), Delta.reshape(-1, 2, 2), info_eig.reshape(-1))
     return xnew, Sig, Delta, info_eig
 
 
@@ -179,7 +213,19 @@ def kalman_update(xhat, P, y, M, A, BWB):
     return xnew, sym2(Pnew)
 
 
-def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6):
+def _exists_numpy(S_seq, Sigma0, A, BWB, gamma_inv2, Lbar):
+    """Is ``Sigma_k^{-1}`` of eq (6) positive definite at every step ``k`` of ``S_seq (K, ..., 2, 2)``?"""
+    Sig = np.broadcast_to(np.asarray(Sigma0, dtype=float), S_seq.shape[1:]).copy()
+    for S in S_seq:
+        Delta = A @ Sig @ A.T + BWB
+        info = hinf_information(Delta, S, gamma_inv2, Lbar)
+        if not np.all(min_eig2(info) > 0):
+            return False
+        Sig = sym2(inv2(info))
+    return True
+
+
+def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6, kernel="auto"):
     """Minimum attenuation level ``gamma_0`` of eq (6) along a sequence of informations.
 
     ``gamma_0`` is the infimum of the ``gamma`` for which ``Sigma_k^{-1} > 0`` for every step
@@ -196,6 +242,10 @@ def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6):
         Bracket of the bisection.
     tol : float
         Tolerance on ``log gamma``.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: each existence test by :func:`.filter_kernels.exists_kernel` (same arithmetic, filter
+        by filter, stopping at the first failure; same answer); ``"numpy"``: the reference form; ``"auto"``:
+        see :func:`.algebra.use_compiled` (counting every step's matrices).
 
     Returns
     -------
@@ -203,17 +253,17 @@ def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6):
         ``gamma_0`` (``lo`` if the filter exists at ``lo``, inf if not even at ``hi``).
     """
     S_seq = np.asarray(S_seq, dtype=float)
+    if use_compiled(kernel, S_seq.size // 4):
+        from .filter_kernels import exists_kernel  # numba: imported by the steps that run a filter
 
-    def exists(gamma):
-        g2 = gamma ** -2.0
-        Sig = np.broadcast_to(np.asarray(Sigma0, dtype=float), S_seq.shape[1:]).copy()
-        for S in S_seq:
-            Delta = A @ Sig @ A.T + BWB
-            info = hinf_information(Delta, S, g2, Lbar)
-            if not np.all(min_eig2(info) > 0):
-                return False
-            Sig = sym2(inv2(info))
-        return True
+        flat = np.array(S_seq.reshape((S_seq.shape[0], -1, 2, 2)), dtype=float, order="C")
+        mats = [np.array(m, dtype=float, order="C") for m in (Sigma0, A, BWB, Lbar)]
+
+        def exists(gamma):
+            return exists_kernel(flat, mats[0], mats[1], mats[2], gamma ** -2.0, mats[3])
+    else:
+        def exists(gamma):
+            return _exists_numpy(S_seq, Sigma0, A, BWB, gamma ** -2.0, Lbar)
 
     if exists(lo):
         return lo

@@ -6,14 +6,16 @@ position, using the gradient recursion (14) for ``Sigma_k^z``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .algebra import I2, inv2, rotation
+from .algebra import I2, inv2, kernel_operand, rotation, use_compiled
 
 __all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law"]
 
 
-def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
+def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar, kernel: str = "auto"):
     """Covariance ``Sigma_k`` and its derivative w.r.t. one sensor coordinate, eqs (14)-(16) corrected.
 
     With ``Omega = I + S Delta - gamma^{-2} L^T Q L Delta`` (eq (11); the paper's (16) prints
@@ -36,11 +38,31 @@ def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
         ``gamma^{-2}``.
     Lbar : ndarray, shape ``(2, 2)``
         ``L^T Q L``.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: :func:`.filter_kernels.sigma_gradient_kernel`, the same arithmetic matrix by matrix
+        (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see :func:`.algebra.use_compiled`.
 
     Returns
     -------
     Sigma, dSigma : ndarray, shape ``(..., 2, 2)``
     """
+    shapes = [np.shape(a) for a in (Delta, dDelta, S, dS)]
+    lead = np.broadcast_shapes(*(sh[:-2] for sh in shapes))
+    if not use_compiled(kernel, math.prod(lead)):
+        return _sigma_gradient_numpy(Delta, dDelta, S, dS, gamma_inv2, Lbar)
+    from .filter_kernels import sigma_gradient_kernel  # numba: imported by the steps that move agents
+
+    def flat(a):
+        return kernel_operand(a, lead + (2, 2)).reshape(-1, 2, 2)
+
+    Sigma, dSigma = np.empty(lead + (2, 2)), np.empty(lead + (2, 2))
+    sigma_gradient_kernel(flat(Delta), flat(dDelta), flat(S), flat(dS), float(gamma_inv2),
+                          np.array(Lbar, dtype=float, order="C"), Sigma.reshape(-1, 2, 2), dSigma.reshape(-1, 2, 2))
+    return Sigma, dSigma
+
+
+def _sigma_gradient_numpy(Delta, dDelta, S, dS, gamma_inv2, Lbar):
+    """Eqs (14)-(16) corrected in numpy (the reference form of :func:`sigma_gradient`): ``Sigma, dSigma``."""
     Omega = I2 + S @ Delta - gamma_inv2 * Lbar @ Delta
     Oi = inv2(Omega)
     DOi = Delta @ Oi

@@ -8,10 +8,12 @@ position directly (``C_i = I_2``) with noise ``m_i`` of covariance
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...errors import InputError
-from .algebra import rotation
+from .algebra import rotation, use_compiled
 
 __all__ = [
     "NoiseModel", "geometry", "noise_variances", "noise_covariance", "noise_information",
@@ -109,7 +111,7 @@ def noise_covariance(r, theta, model: NoiseModel):
     return T @ R @ np.swapaxes(T, -1, -2)
 
 
-def noise_information(r, theta, model: NoiseModel, derivatives: bool = False):
+def noise_information(r, theta, model: NoiseModel, derivatives: bool = False, kernel: str = "auto"):
     """Information matrix ``M^{-1}`` and (optionally) its derivatives, eqs (17)-(18), corrected.
 
     .. math::
@@ -129,11 +131,38 @@ def noise_information(r, theta, model: NoiseModel, derivatives: bool = False):
     model : NoiseModel
     derivatives : bool
         Also return the derivatives with respect to ``r`` and ``theta``.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: the products by :func:`.filter_kernels.noise_information_kernel`, the same arithmetic
+        matrix by matrix (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see
+        :func:`.algebra.use_compiled`.
 
     Returns
     -------
     Minv or (Minv, dMinv_dr, dMinv_dtheta) : ndarray, shape ``r.shape + (2, 2)``
     """
+    shape = np.broadcast_shapes(np.shape(r), np.shape(theta))
+    if not use_compiled(kernel, math.prod(shape)):
+        return _noise_information_numpy(r, theta, model, derivatives)
+    from .filter_kernels import noise_information_kernel  # numba: imported by the steps that simulate
+
+    fr, fb = noise_variances(np.broadcast_to(r, shape), model)
+    theta = np.asarray(theta, dtype=float)
+    c, s = (np.array(np.broadcast_to(f(theta), shape), dtype=float, order="C").ravel() for f in (np.cos, np.sin))
+    rinv_r, rinv_b = 1.0 / fr.ravel(), 1.0 / fb.ravel()
+    if derivatives:
+        g = -2.0 * model.a2 * (np.asarray(r, dtype=float) - model.a1)
+        d_r, d_b = (np.array(np.broadcast_to(v, shape), dtype=float, order="C").ravel()
+                    for v in (g / fr**2, g * model.alpha / fb**2))  # R^{-2} diag(1, alpha)
+    else:
+        d_r = d_b = rinv_r
+    out = [np.empty(shape + (2, 2)) for _ in range(3 if derivatives else 1)]
+    flat = [o.reshape(-1, 2, 2) for o in out] + [out[0].reshape(-1, 2, 2)] * (2 if not derivatives else 0)
+    noise_information_kernel(c, s, rinv_r, rinv_b, d_r, d_b, bool(derivatives), *flat)
+    return tuple(out) if derivatives else out[0]
+
+
+def _noise_information_numpy(r, theta, model: NoiseModel, derivatives: bool = False):
+    """Eqs (3), (17)-(18) corrected in numpy (the reference form of :func:`noise_information`)."""
     fr, fb = noise_variances(r, model)
     T = rotation(theta)
     Tt = np.swapaxes(T, -1, -2)

@@ -313,6 +313,7 @@ def tables_step(params, inputs, outputs):
 # --------------------------------------------------------------------------- sensitivity
 def sensitivity_step(params, inputs, outputs):
     """One-at-a-time sweeps of the main reconstructed parameters (gamma, consensus gains, h, control gain)."""
+    from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     return {"table": _sensitivity(params, evasive=False)}
 
 
@@ -386,6 +387,7 @@ def paired_evasive_step(params, inputs, outputs):
     decentralized) for both families. ``mean_diff`` = error of ``filter_a`` minus error of ``filter_b``,
     each the mean over the claims' window ``late_start <= k <= horizon`` and the agents, paired per run.
     """
+    from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, pc = params, params["paired"]
     start = int(cfg["claims"]["late_start"])
     rows, prov = [], {}
@@ -424,6 +426,7 @@ def fig2_horizon_step(params, inputs, outputs):
     seed and ``fig2_horizon.runs`` runs, with the configured ``K_i`` and
     with ``K_i = 0`` (scenario ``<name>_ki0``); a horizon ``H`` uses the window ``late_start <= k <= H``.
     """
+    from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, fh = params, params["fig2_horizon"]
     start = int(cfg["claims"]["late_start"])
     K = max(int(h) for h in fh["horizons"])

@@ -1,0 +1,80 @@
+"""The compiled filter, gradient and noise kernels reproduce their numpy reference forms bit for bit (speed).
+
+Tolerance 0: :mod:`netrepro.papers.hinf.filter_kernels` replays numpy's BLAS rounding (``fma``) matrix by matrix.
+"""
+
+import numpy as np
+import pytest
+
+from netrepro.papers.hinf import filters as F
+from netrepro.papers.hinf.motion import sigma_gradient
+from netrepro.papers.hinf.noise import NoiseModel, geometry, noise_information
+
+MODEL = NoiseModel(a0=0.3528, a1=15.625, a2=0.0008, alpha=5.0)
+A_ROT = np.array([[1.0, 0.1], [-0.05, 0.98]])
+
+
+def _information(lead, seed):
+    rng = np.random.default_rng(seed)
+    x = rng.normal(scale=5.0, size=lead + (2,))
+    P = rng.normal(scale=30.0, size=lead + (2,))
+    r, th = geometry(x, P[..., None, :])
+    return r[..., 0], th[..., 0]
+
+
+def _same(a, b):
+    return all(np.shape(u) == np.shape(v) and np.array_equal(u, v) for u, v in zip(a, b))
+
+
+@pytest.mark.parametrize("lead", [(40, 10), (60,), (1,), (9, 1), (1, 4), ()])
+@pytest.mark.parametrize("gamma_inv2", [0.0, 1 / 9, 0.3])
+@pytest.mark.parametrize("A", [np.eye(2), A_ROT])
+def test_hinf_update_kernel_matches_numpy(lead, gamma_inv2, A):
+    rng = np.random.default_rng(1)
+    r, th = _information(lead, 2)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    Sig = np.broadcast_to(4.0 * np.eye(2), lead + (2, 2)).copy()
+    xh, BWB, L = rng.normal(size=lead + (2,)), 0.01 * np.eye(2), np.eye(2)
+    for _ in range(25):
+        y = rng.normal(size=lead + (2,))
+        a = F.hinf_update(xh, Sig, y, S, A, BWB, gamma_inv2, L, check=False, kernel="numpy")
+        b = F.hinf_update(xh, Sig, y, S, A, BWB, gamma_inv2, L, check=False, kernel="compiled")
+        assert _same(a, b)
+        xh, Sig = a[0], a[1]
+
+
+@pytest.mark.parametrize("A", [np.eye(2), A_ROT])
+def test_minimum_attenuation_kernel_matches_numpy(A):
+    r, th = _information((30, 5, 4), 3)
+    S_seq = noise_information(r, th, MODEL, kernel="numpy")  # (K, runs, N, 2, 2)
+    args = (4.0 * np.eye(2), A, 0.01 * np.eye(2), np.eye(2))
+    for seq in (S_seq, S_seq.sum(2), np.broadcast_to(S_seq[0, 0], (30, 4, 2, 2))):
+        assert F.minimum_attenuation(seq, *args, kernel="numpy") == F.minimum_attenuation(seq, *args, kernel="compiled")
+
+
+@pytest.mark.parametrize("lead", [(30, 4), (7,), ()])
+@pytest.mark.parametrize("gamma_inv2", [0.0, 1 / 9])
+def test_sigma_gradient_kernel_matches_numpy(lead, gamma_inv2):
+    r, th = _information(lead, 4)
+    S, dMr, dMt = noise_information(r, th, MODEL, derivatives=True, kernel="numpy")
+    rng = np.random.default_rng(5)
+    Delta = np.broadcast_to(np.array([[2.0, 0.3], [0.3, 1.5]]), lead + (2, 2)) + 0.1 * rng.random(lead + (2, 2))
+    dDelta = rng.normal(size=lead + (2, 2))
+    for dS in (dMr, dMt):
+        for dD in (dDelta, np.zeros((2, 2))):
+            a = sigma_gradient(Delta, dD, S, dS, gamma_inv2, np.eye(2), kernel="numpy")
+            b = sigma_gradient(Delta, dD, S, dS, gamma_inv2, np.eye(2), kernel="compiled")
+            assert _same(a, b)
+
+
+@pytest.mark.parametrize("lead", [(50, 16, 4), (3,), ()])
+def test_noise_information_kernel_matches_numpy(lead):
+    r, th = _information(lead, 6)
+    for deriv in (False, True):
+        a = noise_information(r, th, MODEL, derivatives=deriv, kernel="numpy")
+        b = noise_information(r, th, MODEL, derivatives=deriv, kernel="compiled")
+        assert _same(a, b) if deriv else _same([a], [b])
+    # broadcast range against bearings
+    a = noise_information(15.0, th, MODEL, derivatives=True, kernel="numpy")
+    b = noise_information(15.0, th, MODEL, derivatives=True, kernel="compiled")
+    assert _same(a, b)
