@@ -8,9 +8,9 @@ of :func:`.evader._min_fused_trace_pairwise_numpy`, so that its results are bit-
 from __future__ import annotations
 
 import numpy as np
-from llvmlite import ir as llvm_ir
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
+
+from .filter_kernels import fma
 
 __all__ = ["pairwise_kernel"]
 
@@ -19,20 +19,8 @@ __all__ = ["pairwise_kernel"]
 # The kernels below replay, per instance and in the same floating-point order, the numpy expressions of the
 # solvers above, so that their results are bit-identical: ``einsum("...n,...nij->...ij")`` sums the weights
 # sequentially, ``Ai @ Ai`` (numpy's stacked 2x2 matmul through OpenBLAS) rounds ``fma(a_i1, b_1j, a_i0 b_0j)``
-# and ``einsum("...ij,...nji->...n")`` adds ``(t_00 + t_10) + (t_01 + t_11)``. No fastmath.
-@intrinsic
-def _fma(typingctx, x, y, z):
-    """Correctly rounded ``x * y + z`` (``llvm.fma.f64``)."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        dbl = llvm_ir.DoubleType()
-        fn = builder.module.declare_intrinsic("llvm.fma", [dbl], llvm_ir.FunctionType(dbl, [dbl, dbl, dbl]))
-        return builder.call(fn, args)
-
-    return sig, codegen
-
-
+# and ``einsum("...ij,...nji->...n")`` adds ``(t_00 + t_10) + (t_01 + t_11)``. No fastmath; ``fma`` is
+# :func:`.filter_kernels.fma`, the correctly rounded ``llvm.fma``.
 @njit(cache=True, error_model="numpy")
 def _fused_A(M, lam, A):
     """``A = sum_n lam_n M_n`` (sequential, as ``einsum``) into ``A (2, 2)``."""
@@ -59,7 +47,7 @@ def _trace_grad(M, Ai, C, grad):
     """``grad_n = -tr(Ai Ai M_n)`` as ``-einsum("ij,nji->n", Ai @ Ai, M)``; ``C`` receives ``Ai @ Ai``."""
     for i in range(2):
         for j in range(2):
-            C[i, j] = _fma(Ai[i, 1], Ai[1, j], Ai[i, 0] * Ai[0, j])
+            C[i, j] = fma(Ai[i, 1], Ai[1, j], Ai[i, 0] * Ai[0, j])
     for n in range(M.shape[0]):
         grad[n] = -((C[0, 0] * M[n, 0, 0] + C[1, 0] * M[n, 0, 1]) + (C[0, 1] * M[n, 1, 0] + C[1, 1] * M[n, 1, 1]))
 
