@@ -26,7 +26,20 @@ __all__ = ["fma", "hinf_update_kernel", "exists_kernel", "sigma_gradient_kernel"
 
 @intrinsic
 def fma(typingctx, x, y, z):
-    """Correctly rounded ``x * y + z`` (``llvm.fma.f64``)."""
+    """Correctly rounded ``x * y + z`` (``llvm.fma.f64``), callable from compiled code only.
+
+    Parameters
+    ----------
+    typingctx : numba typing context
+        Supplied by numba.
+    x, y, z : float64
+        The operands (inside a compiled function: ``fma(x, y, z)``).
+
+    Returns
+    -------
+    tuple
+        The signature and the code generator numba's ``@intrinsic`` expects.
+    """
     sig = types.float64(types.float64, types.float64, types.float64)
 
     def codegen(context, builder, signature, args):

@@ -149,6 +149,30 @@ def smoothing_gain_iterations(F, s, a2, kappa_star, rtol, n_steps, kappa, last):
     In place on ``kappa`` (one lane per element); ``last[lane]`` receives the last step ``d`` (1-based)
     with ``|kappa / kappa_star - 1| > rtol``. Same operations in the same order as
     :func:`netrepro.papers.onebit.randomwalk.rw_smoothing_gain_step` in a numpy loop.
+
+    Parameters
+    ----------
+    F : ndarray, shape (lanes,)
+        Filter Fisher information of each lane.
+    s : ndarray, shape (lanes,)
+        :math:`\sigma_z^2` of each lane.
+    a2 : float
+        :math:`a^2`.
+    kappa_star : ndarray, shape (lanes,)
+        Fixed point of each lane (the convergence reference).
+    rtol : float
+        Relative distance from ``kappa_star`` counted as not yet converged.
+    n_steps : int
+        Number of steps.
+    kappa : ndarray, shape (lanes,)
+        Start values; overwritten by the values after ``n_steps`` steps.
+    last : ndarray of int, shape (lanes,)
+        Receives the last step still farther than ``rtol`` from ``kappa_star`` (unchanged if none).
+
+    Returns
+    -------
+    None
+        The results are written into ``kappa`` and ``last``.
     """
     for d in range(1, n_steps + 1):
         for lane in range(kappa.shape[0]):
