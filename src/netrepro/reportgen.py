@@ -196,7 +196,8 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
     html_out = Path(html_out)
     executed = html_out.with_suffix(".ipynb")
     papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
-                               kernel_name="python3", cwd=str(root), progress_bar=False)
+                               kernel_name="python3", cwd=str(root), progress_bar=False,
+                               request_save_on_cell_execute=False)
     exporter = HTMLExporter()
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
     with atomic_path(html_out) as tmp:
