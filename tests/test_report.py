@@ -1,5 +1,7 @@
 """Unit tests of the report generator's pure parts (no workflow run)."""
 
+from pathlib import Path
+
 import pandas as pd
 
 from netrepro.reportgen import config_keys, relocate, rule_for, scorecard, strip_external_scripts
@@ -57,3 +59,15 @@ def test_relocate_leaves_long_words_without_interpreter_alone(tmp_path):
     blob = "data:image/png;base64," + "iVBOR/w0K+GgoA/" * 20000
     text = f"<img src=\"{blob}\"> ran /usr/bin/python3"
     assert relocate(text, tmp_path) == f"<img src=\"{blob}\"> ran python3"
+
+
+def test_source_pages_in_two_processes_equal_the_serial_pages():
+    """The report rule (threads: 2) highlights the source pages in two processes: same pages, same order."""
+    from netrepro.reportgen import _source_page, _source_pages
+
+    root = Path(__file__).resolve().parents[1]
+    rels = ["src/netrepro/io.py", "src/netrepro/errors.py", "src/netrepro/reportgen.py", "src/netrepro/runner.py"]
+    serial = [_source_page(rel, (root / rel).read_text()) for rel in rels]
+    assert _source_pages(root, rels, workers=2) == serial
+    assert _source_pages(root, rels, workers=1) == serial
+    assert _source_pages(root, rels[:1], workers=4) == serial[:1]  # never more processes than files

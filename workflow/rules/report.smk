@@ -24,6 +24,8 @@ rule report:
         "logs/report.log",
     conda:
         CONDA_ENV
+    # the report runs last: a second process highlights half of the source pages
+    threads: 2
     params:
         cfg=as_json(
             {
