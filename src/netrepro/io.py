@@ -14,7 +14,6 @@ import os
 import tempfile
 from pathlib import Path
 
-import pandas as pd
 
 __all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml"]
 
@@ -75,6 +74,8 @@ def write_table(frame: pd.DataFrame, path: str | os.PathLike) -> Path:
 
 def read_table(path: str | os.PathLike) -> pd.DataFrame:
     """Read a CSV table written by :func:`write_table`."""
+    import pandas as pd
+
     return pd.read_csv(path)
 
 

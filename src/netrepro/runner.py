@@ -35,9 +35,6 @@ import time
 import warnings
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-
 from .io import write_table
 from .provenance import PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, verify_output, verify_tree, write_sidecar
 
@@ -103,6 +100,9 @@ def _clear_stale(outputs: dict) -> None:
 
 def _nonfinite(frame: pd.DataFrame) -> dict:
     """``{column: {"nan": n, "inf": m}}`` for numeric columns holding NaN or inf (a flag in the sidecar)."""
+    import numpy as np
+    import pandas as pd
+
     counts = {}
     for col in frame.columns:
         values = frame[col]
@@ -129,6 +129,8 @@ def _summarize_warnings(caught) -> list[dict]:
 
 def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dict) -> None:
     """Run one step and write its outputs and their provenance sidecars."""
+    import pandas as pd  # here, not at import: `verify` (before every notebook) needs no pandas
+
     func = resolve(func_spec)
     inputs = {k: _as_paths(v) for k, v in inputs.items()}
     outputs = {k: Path(v) for k, v in outputs.items()}
