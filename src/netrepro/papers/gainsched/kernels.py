@@ -102,8 +102,7 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
                     for q in range(1, m):
                         a2 = _fma(y[q], H[k, i, q], a2)
                     xfn[i] = a1 + a2
-                for i in range(n):
-                    xf[i] = xfn[i]
+                xf, xfn = xfn, xf  # swap the buffers instead of copying (less code to compile)
             for i in range(nz):  # f(x @ Z.T)
                 zi = x[0] * Z[i, 0]
                 for q in range(1, n):
@@ -124,7 +123,7 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
                 for q in range(1, nz):
                     fb = _fma(f[q], B[i, q], fb)
                 xn[i] = (xa + fb) + w * xd
+            x, xn = xn, x
             for i in range(n):
-                x[i] = xn[i]
                 errs[r, k + 1, i] = x[i] - xf[i]
     return errs
