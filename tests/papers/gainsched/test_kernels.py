@@ -37,3 +37,19 @@ def test_kernel_rejects_bad_input():
         simulate_draws(sys, None, p_seq, np.zeros((3, 2)), draws, "cubic")
     with pytest.raises(GainschedError):
         simulate_draws(sys, None, p_seq, np.zeros((4, 2)), draws)
+
+
+@pytest.mark.parametrize("kind", ["sine_mid", "lower", "upper"])
+@pytest.mark.parametrize("with_gains,runs,seed", [(True, 7, 1), (True, 64, 2), (False, 33, 3), (True, 1000, 4)])
+def test_kernel_bit_identical_with_numpy_reference(kind, with_gains, runs, seed):
+    # the tuning's Nelder-Mead path depends on every bit of the cost: the kernel must equal simulate exactly
+    sys = _sys()
+    rng = np.random.default_rng(seed)
+    gains = Gains(0.3 * rng.standard_normal((2, 2)), 0.3 * rng.standard_normal((2, 2)),
+                  rng.standard_normal((2, 1)), rng.standard_normal((2, 1))) if with_gains else None
+    p_seq = p_schedule(np.arange(30), sys.p1, sys.p2, 1.0)
+    x0 = 2.0 * rng.standard_normal((runs, 2))
+    ref = simulate(sys, gains, p_seq, x0, np.random.default_rng(seed + 10), kind, xf0=[0.2, -0.1])
+    got = simulate_draws(sys, gains, p_seq, x0, draw_noise(np.random.default_rng(seed + 10), 30, runs), kind,
+                         xf0=[0.2, -0.1])
+    np.testing.assert_array_equal(got, ref)

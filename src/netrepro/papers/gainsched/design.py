@@ -193,6 +193,9 @@ class Theorem3:
             cons += [v["Q0"] + p * v["Qp"] >> eps * np.eye(nn) for p in ps]
         L = np.hstack([np.eye(n), -np.eye(n)])
         self.n_vertices = 0
+        # sub-blocks shared by several vertices (Q̄^i, Λ^l, Γ1^{ij}, ...), built once: the same expression
+        # trees as building them per vertex, so the solver data are identical, with less to canonicalise
+        self._parts = {}
         self._vertices = []
         self._blocks = []
         self._certifier = None
@@ -397,22 +400,34 @@ class Theorem3:
         nn, nz = 2 * s.n, s.nz
         theta = pj * (1.0 - pr)
         FZN = s.F @ s.Z @ s.N
-        G1, G3, G4, Bh, Lam = self.Gamma1(pi, pj), self.Gamma3(pi, pj, pr), self.Gamma4(), self.Bhat(), self.Lambda(pl)
+        part = self._part
+        G1 = part(("Gamma1", pi, pj), self.Gamma1, pi, pj)
+        G3 = part(("Gamma3", pi, pj, pr), self.Gamma3, pi, pj, pr)
+        Bh = part(("Bhat",), self.Bhat)
+        Lam = part(("Lambda", pl), self.Lambda, pl)
+        mQ = part(("-Qbar", pi), lambda p: -self.Qbar(p), pi)
         O = np.zeros
         if not self.noise_row:
             return cp.bmat([
-                [-self.Qbar(pi), FZN.T, G1.T, G3.T],
+                [mQ, FZN.T, G1.T, G3.T],
                 [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn))],
                 [G1, Bh, -Lam, O((nn, nn))],
                 [G3, O((nn, nz)), O((nn, nn)), -theta * Lam],
             ])
+        G4 = part(("Gamma4",), self.Gamma4)
         return cp.bmat([
-            [-self.Qbar(pi), FZN.T, G1.T, G3.T, G4.T],
+            [mQ, FZN.T, G1.T, G3.T, G4.T],
             [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn)), O((nz, nn))],
             [G1, Bh, -Lam, O((nn, nn)), O((nn, nn))],
             [G3, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
             [G4, O((nn, nz)), O((nn, nn)), O((nn, nn)), -self.sigma2 * Lam],
         ])
+
+    def _part(self, key, build, *args):
+        """The sub-block ``build(*args)`` of the vertices, built on first use and reused (keyed by ``key``)."""
+        if key not in self._parts:
+            self._parts[key] = build(*args)
+        return self._parts[key]
 
     def n_scalar_variables(self) -> int:
         """Number of scalar decision variables (Q̄0, Q̄p, S11, R1, R2, Ḡ, H̄).
@@ -770,6 +785,7 @@ class FixedGainsVertexLMI:
         self.S = cp.Variable((nn, nn), name="S")
         self.t = cp.Variable(name="t")
         ps = (sys.p1, sys.p2)
+        self._parts = {}  # sub-blocks shared by several vertices, built once (see Theorem3)
         cons = [cp.abs(self.Q0) <= bound, cp.abs(self.Qp) <= bound, cp.abs(self.S) <= bound, self.t <= margin_cap,
                 self.Q0 >> eps * np.eye(nn), self.Qp >> eps * np.eye(nn)]
         blocks = []
@@ -808,20 +824,29 @@ class FixedGainsVertexLMI:
         Dbar = np.vstack([s.D, np.zeros((n, n))])
         theta = pj * (1.0 - pr)
         S = self.S
-        Lam = S + S.T - (self.Q0 + pl * self.Qp)
-        Om1 = S.T @ (Acal + Bbar @ s.F1 @ s.Z @ N)
-        Om2 = theta * (S.T @ (Cbar @ N))
-        SB = S.T @ Bbar
-        SD = self.sigma2 * (S.T @ (Dbar @ N))
+        part = self._part
+        ST = part(("S^T",), lambda: S.T)
+        Lam = part(("Lambda", pl), lambda: S + ST - (self.Q0 + pl * self.Qp))
+        Om1 = ST @ (Acal + Bbar @ s.F1 @ s.Z @ N)
+        Om2 = theta * (ST @ (Cbar @ N))
+        SB = part(("SB",), lambda: ST @ Bbar)
+        SD = part(("SD",), lambda: self.sigma2 * (ST @ (Dbar @ N)))
+        mQ = part(("-Q", pi), lambda: -(self.Q0 + pi * self.Qp))
         FZN = s.F @ s.Z @ N
         O = np.zeros
         return cp.bmat([
-            [-(self.Q0 + pi * self.Qp), FZN.T, Om1.T, Om2.T, SD.T],
+            [mQ, FZN.T, Om1.T, Om2.T, SD.T],
             [FZN, -2 * np.eye(nz), SB.T, O((nz, nn)), O((nz, nn))],
             [Om1, SB, -Lam, O((nn, nn)), O((nn, nn))],
             [Om2, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
             [SD, O((nn, nz)), O((nn, nn)), O((nn, nn)), -self.sigma2 * Lam],
         ])
+
+    def _part(self, key, build):
+        """The sub-block ``build()`` of the vertices, built on first use and reused (keyed by ``key``)."""
+        if key not in self._parts:
+            self._parts[key] = build()
+        return self._parts[key]
 
     def certify(self, sigma2: float):
         """Solve at ``sigma2`` and decide with the shared engine (status is information only).

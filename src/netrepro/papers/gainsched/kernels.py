@@ -64,8 +64,6 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
     nz = Z.shape[0]
     K = p_seq.shape[0]
     errs = np.empty((R, K + 1, n))
-    c1 = 0.5 * (d1 + d2)
-    c2 = 0.5 * (d2 - d1)
     G = np.empty((K, n, n))
     H = np.empty((K, n, m))
     for k in range(K):
@@ -104,14 +102,13 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
                     for q in range(1, m):
                         a2 = _fma(y[q], H[k, i, q], a2)
                     xfn[i] = a1 + a2
-                for i in range(n):
-                    xf[i] = xfn[i]
+                xf, xfn = xfn, xf  # swap the buffers instead of copying (less code to compile)
             for i in range(nz):  # f(x @ Z.T)
                 zi = x[0] * Z[i, 0]
                 for q in range(1, n):
                     zi = _fma(x[q], Z[i, q], zi)
-                if kind == 0:
-                    f[i] = c1[i] * zi + c2[i] * np.sin(zi)
+                if kind == 0:  # (F1 + F2)/2 z + (F2 - F1)/2 sin z, the numpy reference's rounding order
+                    f[i] = (0.5 * (d1[i] + d2[i])) * zi + (0.5 * (d2[i] - d1[i])) * np.sin(zi)
                 elif kind == 1:
                     f[i] = d1[i] * zi
                 else:
@@ -126,7 +123,7 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
                 for q in range(1, nz):
                     fb = _fma(f[q], B[i, q], fb)
                 xn[i] = (xa + fb) + w * xd
+            x, xn = xn, x
             for i in range(n):
-                x[i] = xn[i]
                 errs[r, k + 1, i] = x[i] - xf[i]
     return errs

@@ -444,11 +444,12 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
     nn, nz = 2 * sys.n, sys.nz
     use_cp = any(type(x).__module__.startswith("cvxpy") for x in (Q_now, Q_next, S))
     T = (lambda X: X.T)
-    Lam = -Q_next + S + T(S)
-    Om1 = T(S) @ (aug["A"] + aug["B"] @ sys.F1 @ sys.Z @ N)
-    Om2 = theta * (T(S) @ aug["C"] @ N)
-    SB = T(S) @ aug["B"]
-    SD = s2 * (T(S) @ aug["D"] @ N)
+    ST = T(S)  # one transpose shared by the blocks (the same expression tree as transposing each time)
+    Lam = -Q_next + S + ST
+    Om1 = ST @ (aug["A"] + aug["B"] @ sys.F1 @ sys.Z @ N)
+    Om2 = theta * (ST @ aug["C"] @ N)
+    SB = ST @ aug["B"]
+    SD = s2 * (ST @ aug["D"] @ N)
     FZN = sys.F @ sys.Z @ N
     O = np.zeros
     rows = [
@@ -545,11 +546,13 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     grid = np.linspace(sys.p1, sys.p2, max(2, n_grid))
     cons = [cp.abs(S) <= bound, cp.abs(Q0) <= bound, cp.abs(Qp) <= bound, t <= margin_cap]
     blocks = []
-    for p in grid:
-        cons.append(Q0 + p * Qp >> t * np.eye(nn))
-        blocks.append((f"Q({p:.4g})", Q0 + p * Qp))
-        for pn in grid:
-            M = theorem1_matrix(sys, gains, Q0 + p * Qp, Q0 + pn * Qp, S, p)
+    # Q(p) of each grid point built once and shared by the blocks that use it (same solver data, less to compile)
+    Qs = [Q0 + p * Qp for p in grid]
+    for p, Qnow in zip(grid, Qs):
+        cons.append(Qnow >> t * np.eye(nn))
+        blocks.append((f"Q({p:.4g})", Qnow))
+        for pn, Qnext in zip(grid, Qs):
+            M = theorem1_matrix(sys, gains, Qnow, Qnext, S, p)
             size = M.shape[0]
             # M is structurally symmetric (upper blocks are transposes of the same expressions, diagonal
             # blocks symmetric): it equals 0.5 (M + M^T) exactly, with half the expression tree to compile

@@ -11,7 +11,7 @@ import numpy as np
 from .model import Gains, System, draw_noise, simulate_draws
 from .moments import error_mse, mode_matrices, second_moments
 
-__all__ = ["tune_gains", "tune_gains_exact"]
+__all__ = ["tune_gains", "tune_gains_exact", "sum_mse"]
 
 
 def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, scheduled: bool, maxiter: int,
@@ -63,8 +63,7 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
     draws = draw_noise(np.random.default_rng(seed + 1), len(p_seq), n_runs)
 
     def cost(v):
-        e = simulate_draws(sys, unpack(v), p_seq, x0, draws, nonlinearity)
-        return float((e ** 2).sum(-1).mean(0).sum())
+        return sum_mse(simulate_draws(sys, unpack(v), p_seq, x0, draws, nonlinearity))
 
     from scipy.optimize import minimize
 
@@ -78,6 +77,28 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
     best = res.x if res.fun <= cost(v0) else v0
     return unpack(best), {"cost": float(min(res.fun, cost(v0))), "n_eval": int(res.nfev), "start_cost": cost(v0)}
 
+
+def sum_mse(e) -> float:
+    """Monte Carlo sum_k E||e(k)||^2 of errors ``e`` (runs, K+1, n): ``float((e ** 2).sum(-1).mean(0).sum())``.
+
+    For n = 2 the squared norms are formed as e_1^2 + e_2^2 directly, the same two roundings as
+    numpy's sum over a last axis of length 2 (about 8x faster than the reduction over that short
+    axis); the mean over runs and the sum over k are numpy's own, on an array of the same layout,
+    so the value is bit-identical. Other n: the expression above.
+
+    Parameters
+    ----------
+    e : ndarray (runs, K+1, n)
+
+    Returns
+    -------
+    float
+    """
+    e = np.asarray(e, dtype=float)
+    if e.ndim == 3 and e.shape[2] == 2:
+        e1, e2 = e[:, :, 0], e[:, :, 1]
+        return float((e1 * e1 + e2 * e2).mean(0).sum())
+    return float((e ** 2).sum(-1).mean(0).sum())
 
 
 def tune_gains_exact(sys: System, p_seq, F, X0, scheduled: bool, maxiter: int, start: Gains | None = None):
