@@ -303,10 +303,8 @@ def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width,
     slot[ev] = np.arange(len(ev))
     stored = np.empty((len(ev), len(x), n))
     betas = np.empty((len(ev), len(x), n))
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
-    band_forward_backward(i64(TT.indptr), i64(TT.indices), np.ascontiguousarray(TT.data), i64(T.indptr),
-                          i64(T.indices), np.ascontiguousarray(T.data), lik_pos, 1.0 - lik_pos,
-                          np.ascontiguousarray(r.T) > 0, prior, slot, int(ev[0]), stored, betas)
+    band_forward_backward(TT.indptr, TT.indices, TT.data, T.indptr, T.indices, T.data, lik_pos, 1.0 - lik_pos,
+                          r.T > 0, prior, slot, int(ev[0]), stored, betas)
     filt = np.empty((n, len(ev)))
     smooth = np.empty((n, len(ev)))
     for i, k in enumerate(ev):
