@@ -86,6 +86,18 @@ def test_band_forward_backward_rejects_csr_outside_the_grid():
         band_forward_backward(*args[:6], lik_pos[1:], *args[7:])
 
 
+@pytest.mark.parametrize("eps,snr_db,n,K", [(1e-1, 10.0, 1, 1), (1e-2, -5.0, 37, 300), (1e-3, 0.0, 250, 40),
+                                            (np.float64(0.5), 20.0, 3, 7)])
+def test_kalman_rts_equals_numpy_loop(eps, snr_db, n, K):
+    s = float(model.sigma_z2_from_snr(snr_db, eps))
+    _, y, _ = estimators.simulate_block(np.random.default_rng(n), n, K, eps, s, 1.0)
+    fast = estimators.kalman_rts(y, eps, s, 1.0)
+    ref = estimators._kalman_rts_numpy(y, eps, s, 1.0)
+    np.testing.assert_array_equal(fast[0], ref[0])   # same operations, same order: tolerance 0
+    np.testing.assert_array_equal(fast[1], ref[1])
+    assert fast[0].shape == fast[1].shape == (n, K + 1)
+
+
 def test_shared_bootstrap_equals_one_call_per_pair():
     rng = np.random.default_rng(5)
     vals = {k: rng.exponential(1.0, 300) for k in "abcd"}

@@ -33,7 +33,7 @@ from numba.extending import intrinsic
 
 from ...errors import InputError
 
-__all__ = ["band_forward_backward", "smoothing_gain_iterations"]
+__all__ = ["band_forward_backward", "kalman_rts_recursions", "smoothing_gain_iterations"]
 
 _VEC = 8              # vectors of 8 doubles (one AVX-512 register each) per block
 _BLOCK = 8 * _VEC     # runs (columns) per block
@@ -235,6 +235,63 @@ def _band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, li
             for i in range(G):
                 for c in range(n):
                     stored_beta[slot[k - 1], i, c] = beta[i, c]
+
+
+@njit(cache=True, boundscheck=False, error_model="numpy")
+def kalman_rts_recursions(y, alpha, alpha2, P0, sigma_z2, sigma_eta2, mf, ms, work):
+    r"""Means of the scalar Kalman filter and RTS smoother of (21) observed through (20), one run per row.
+
+    Variances: :math:`P_{k|k-1} = \alpha^2 P_{k-1} + \sigma_z^2`, :math:`G_k = P_{k|k-1} / (P_{k|k-1} +
+    \sigma_\eta^2)`, :math:`P_k = (1 - G_k) P_{k|k-1}` from :math:`P_0`; :math:`C_k = P_k \alpha / P_{k+1|k}`.
+    Means: :math:`m_{k|k-1} = \alpha m_{k-1}`, :math:`m_k = m_{k|k-1} + G_k (y_k - m_{k|k-1})` from
+    :math:`m_0 = 0`; :math:`m^s_k = m_k + C_k (m^s_{k+1} - m_{k+1|k})` from :math:`m^s_K = m_K`.
+    Same operations in the same order as the numpy loop
+    :func:`netrepro.papers.onebit.estimators._kalman_rts_numpy`.
+
+    Parameters
+    ----------
+    y : ndarray (n_runs, K)
+        Unquantized measurements (20), k = 1..K.
+    alpha, alpha2 : float
+        Transition coefficient of (21) and its square (``alpha**2``, computed by the caller as the reference does).
+    P0 : float
+        Prior variance (the stationary variance).
+    sigma_z2, sigma_eta2 : float
+        Transition and measurement noise variances.
+    mf, ms : ndarray (n_runs, K+1)
+        Receive the filtered and smoothed means, k = 0..K (output).
+    work : ndarray (5, K+1)
+        Work buffer.
+
+    Returns
+    -------
+    None
+        The results are written into ``mf`` and ``ms``.
+    """
+    n, K = y.shape
+    gain, Pf, Pp, C, mp = work[0], work[1], work[2], work[3], work[4]
+    P = P0
+    Pf[0] = P
+    for k in range(1, K + 1):
+        Ppk = alpha2 * P + sigma_z2
+        G = Ppk / (Ppk + sigma_eta2)
+        P = (1.0 - G) * Ppk
+        Pp[k] = Ppk
+        Pf[k] = P
+        gain[k] = G
+    for k in range(K):
+        C[k] = Pf[k] * alpha / Pp[k + 1]
+    for c in range(n):
+        m = 0.0
+        mf[c, 0] = 0.0
+        for k in range(1, K + 1):
+            mpk = alpha * m
+            mp[k] = mpk
+            m = mpk + gain[k] * (y[c, k - 1] - mpk)
+            mf[c, k] = m
+        ms[c, K] = m
+        for k in range(K - 1, -1, -1):
+            ms[c, k] = mf[c, k] + C[k] * (ms[c, k + 1] - mp[k + 1])
 
 
 @njit(cache=True, error_model="numpy")
