@@ -84,6 +84,9 @@ def test_band_forward_backward_rejects_csr_outside_the_grid():
         band_forward_backward(*args[:4], bad, *args[5:])
     with pytest.raises(InputError):
         band_forward_backward(*args[:6], lik_pos[1:], *args[7:])
+    with pytest.raises(InputError):
+        band_forward_backward(*args[:12], out[:, 1:], out.copy()[:, 1:])
+    band_forward_backward(*args)   # the valid call
 
 
 @pytest.mark.parametrize("eps,snr_db,n,K", [(1e-1, 10.0, 1, 1), (1e-2, -5.0, 37, 300), (1e-3, 0.0, 250, 40),

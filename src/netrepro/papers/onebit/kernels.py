@@ -1,6 +1,9 @@
-"""Compiled (numba) kernels of the `onebit` paper: the banded point-mass filter and smoother.
+"""Compiled (numba) kernels of the `onebit` paper: the banded point-mass filter and smoother, the
+Kalman filter / RTS smoother means and the smoothing gain iteration.
 
-Imported lazily by :func:`netrepro.papers.onebit.estimators.grid_smoother_at` (numba costs import time).
+Imported lazily by :func:`netrepro.papers.onebit.estimators.grid_smoother_at`,
+:func:`~netrepro.papers.onebit.estimators.kalman_rts` and
+:func:`netrepro.papers.onebit.randomwalk.rw_smoothing_gain_iterated` (numba costs import time).
 The kernels perform the same floating-point operations in the same order as the numpy/scipy reference
 (CSR sparse-times-dense products accumulated row by row from 0, likelihood product, column sums in grid
 order, division), so they are bit-identical to it (checked in tests/papers/onebit/test_kernels.py).
@@ -176,9 +179,9 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
     Raises
     ------
     InputError
-        If the CSR arrays or the likelihoods do not fit the grid of ``prior``.
+        If the CSR arrays, the likelihoods, ``slot`` or the output arrays do not fit the grid of ``prior``
+        and the shape of ``positive``.
     """
-
     G = len(prior)
     for name, ptr, idx, val in (("forward", f_ptr, f_idx, f_val), ("backward", b_ptr, b_idx, b_val)):
         # the compiled block step reads the grid rows named by the CSR arrays without bounds checks
@@ -188,6 +191,9 @@ def band_forward_backward(f_ptr, f_idx, f_val, b_ptr, b_idx, b_val, lik_pos, lik
     if len(lik_pos) != G or len(lik_neg) != G:
         raise InputError(f"band_forward_backward: the likelihoods need {G} grid points")
     K, n = positive.shape
+    if (len(slot) != K + 1 or stored_post.ndim != 3 or stored_post.shape[1:] != (G, n)
+            or stored_beta.shape != stored_post.shape or np.max(slot) >= len(stored_post) or not 0 <= stop <= K):
+        raise InputError("band_forward_backward: slot, stop or the output arrays do not fit the problem")
     n_pad = -(-n // _BLOCK) * _BLOCK
     pos = np.empty((K, n_pad), dtype=np.bool_)
     pos[:, :n] = positive
