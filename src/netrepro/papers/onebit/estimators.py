@@ -111,7 +111,7 @@ def grid_filter_smoother(r, eps: float, sigma_z2: float, sigma_eta: float, grid_
 
 
 def kalman_rts(y, eps, sigma_z2, sigma_eta):
-    """Scalar Kalman filter and RTS smoother means (unquantized reference), vectorised over runs.
+    """Scalar Kalman filter and RTS smoother means (unquantized reference), compiled loops over runs and steps.
 
     Parameters
     ----------
@@ -129,6 +129,19 @@ def kalman_rts(y, eps, sigma_z2, sigma_eta):
     mf, ms : ndarray (n_runs, K+1)
         Filtered and smoothed means, k = 0..K, started from the stationary prior.
     """
+    from .kernels import kalman_rts_recursions  # numba: imported by the steps that run the filter
+
+    alpha = 1.0 - eps
+    y = np.ascontiguousarray(y, dtype=float)
+    n, K = y.shape
+    mf, ms = np.empty((n, K + 1)), np.empty((n, K + 1))
+    kalman_rts_recursions(y, alpha, alpha**2, float(stationary_variance(eps, sigma_z2)), sigma_z2, sigma_eta**2,
+                          mf, ms, np.empty((5, K + 1)))
+    return mf, ms
+
+
+def _kalman_rts_numpy(y, eps, sigma_z2, sigma_eta):
+    """:func:`kalman_rts` as a numpy loop over steps (the reference of the compiled recursions)."""
     alpha = 1.0 - eps
     n, K = y.shape
     P = float(stationary_variance(eps, sigma_z2))
@@ -146,7 +159,6 @@ def kalman_rts(y, eps, sigma_z2, sigma_eta):
         C = Pf[k] * alpha / Pp[k + 1]
         ms[k] = mf[k] + C * (ms[k + 1] - mp[k + 1])
     return np.ascontiguousarray(mf.T), np.ascontiguousarray(ms.T)
-
 
 
 # ============================================================================ banded grid smoother (issue 17)
@@ -303,10 +315,8 @@ def _grid_smoother_banded_1bit(r, eps, sigma_z2, sigma_eta, ev, grid_half_width,
     slot[ev] = np.arange(len(ev))
     stored = np.empty((len(ev), len(x), n))
     betas = np.empty((len(ev), len(x), n))
-    i64 = lambda a: np.ascontiguousarray(a, dtype=np.int64)  # noqa: E731
-    band_forward_backward(i64(TT.indptr), i64(TT.indices), np.ascontiguousarray(TT.data), i64(T.indptr),
-                          i64(T.indices), np.ascontiguousarray(T.data), lik_pos, 1.0 - lik_pos,
-                          np.ascontiguousarray(r.T) > 0, prior, slot, int(ev[0]), stored, betas)
+    band_forward_backward(TT.indptr, TT.indices, TT.data, T.indptr, T.indices, T.data, lik_pos, 1.0 - lik_pos,
+                          r.T > 0, prior, slot, int(ev[0]), stored, betas)
     filt = np.empty((n, len(ev)))
     smooth = np.empty((n, len(ev)))
     for i, k in enumerate(ev):
