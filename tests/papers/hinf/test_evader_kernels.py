@@ -32,3 +32,20 @@ def test_pairwise_kernel_start_weights():
     b, lb = E.min_fused_trace_pairwise(M, 20, lam0)
     assert np.array_equal(a, b) and np.array_equal(la, lb)
     assert np.array_equal(lam0, np.random.default_rng(7).dirichlet(np.ones(4), size=M.shape[:-3]))  # not modified
+
+
+@pytest.mark.parametrize("n_agents", [2, 10])
+def test_pairwise_kernel_other_agent_counts(n_agents):
+    M = _instances(n_agents, 8)
+    a, la = E._min_fused_trace_pairwise_numpy(M, 30)
+    b, lb = E.min_fused_trace_pairwise(M, 30)
+    assert np.array_equal(a, b) and np.array_equal(la, lb)
+
+
+def test_pairwise_kernel_duplicate_agents():
+    # two agents at the same place: equal gradients (first-occurrence ties) and D = 0 (qa = qb = 0) steps
+    M = _instances(4, 9)
+    M[..., 1, :, :] = M[..., 0, :, :]
+    a, la = E._min_fused_trace_pairwise_numpy(M, 25)
+    b, lb = E.min_fused_trace_pairwise(M, 25)
+    assert np.array_equal(a, b) and np.array_equal(la, lb)
