@@ -143,3 +143,134 @@ def pairwise_kernel(Minv, lam, n_iter):
         d = A00 * A11 - A01 * A10
         trace[r] = A11 / d + A00 / d
     return trace
+
+
+@njit(cache=True, error_model="numpy")
+def faces_kernel(H, l, combos, rows, best_f, best_lam):
+    """The best stationary point over the faces ``combos`` of the simplex, for the instances ``rows``.
+
+    The compiled form of :func:`.evader._best_on_faces_numpy` (eqs (22)-(24); see
+    :func:`.evader.min_fused_trace_exact`): per instance and face, the closed-form stationary point of
+    ``f = tr A / det A`` of :func:`.evader._face_stationary`, kept if its weights are non-negative, and the
+    first face of smallest ``f``, which replaces the instance's best if strictly smaller. Same floating-point
+    operations in the same order as the numpy form (Python ``sum`` starts from ``0``; a sum over the face's
+    vertices is sequential), so the results are bit-identical.
+
+    Parameters
+    ----------
+    H : ndarray ``(M, N, N)``
+        ``det(sum lam_j S_j) = lam^T H lam`` per instance.
+    l : ndarray ``(M, N)``
+        ``tr S_j``.
+    combos : ndarray of int ``(C, k)``
+        The faces (``k <= 3`` vertices each).
+    rows : ndarray of int ``(m,)``
+        Instances to solve.
+    best_f : ndarray ``(M,)``
+        Best value so far; updated in place.
+    best_lam : ndarray ``(M, N)``
+        Its weights; updated in place (a row is replaced as a whole).
+
+    Returns
+    -------
+    None
+    """
+    C, k = combos.shape
+    n = l.shape[1]
+    lj = np.empty(3)
+    lam = np.empty(3)
+    blam = np.empty(3)
+    for r in rows:
+        bf = np.inf
+        bc = -1
+        for ci in range(C):
+            j0 = combos[ci, 0]
+            lj[0] = l[r, j0]
+            h00 = H[r, j0, j0]
+            if k == 1:
+                P0 = 0.0 + 1.0 * lj[0]
+                L = np.sqrt((0.0 + lj[0] * P0) / (0.0 + 1.0))
+                num0 = P0 + L * 1.0
+                lam[0] = num0 / num0
+            elif k == 2:
+                j1 = combos[ci, 1]
+                lj[1] = l[r, j1]
+                h01 = H[r, j0, j1]
+                h11 = H[r, j1, j1]
+                # adj(H) of the face: [[h11, -h01], [-h01, h00]]
+                a00, a01, a11 = h11, -h01, h00
+                P0 = (0.0 + a00 * lj[0]) + a01 * lj[1]
+                P1 = (0.0 + a01 * lj[0]) + a11 * lj[1]
+                R0 = (0.0 + a00) + a01
+                R1 = (0.0 + a01) + a11
+                L = np.sqrt(((0.0 + lj[0] * P0) + lj[1] * P1) / ((0.0 + R0) + R1))
+                num0 = P0 + L * R0
+                num1 = P1 + L * R1
+                s = num0 + num1
+                lam[0] = num0 / s
+                lam[1] = num1 / s
+            else:
+                j1 = combos[ci, 1]
+                j2 = combos[ci, 2]
+                lj[1] = l[r, j1]
+                lj[2] = l[r, j2]
+                h01 = H[r, j0, j1]
+                h02 = H[r, j0, j2]
+                h11 = H[r, j1, j1]
+                h12 = H[r, j1, j2]
+                h22 = H[r, j2, j2]
+                a00 = h11 * h22 - h12 * h12
+                a11 = h00 * h22 - h02 * h02
+                a22 = h00 * h11 - h01 * h01
+                a01 = h02 * h12 - h01 * h22
+                a02 = h01 * h12 - h02 * h11
+                a12 = h01 * h02 - h00 * h12
+                P0 = ((0.0 + a00 * lj[0]) + a01 * lj[1]) + a02 * lj[2]
+                P1 = ((0.0 + a01 * lj[0]) + a11 * lj[1]) + a12 * lj[2]
+                P2 = ((0.0 + a02 * lj[0]) + a12 * lj[1]) + a22 * lj[2]
+                R0 = ((0.0 + a00) + a01) + a02
+                R1 = ((0.0 + a01) + a11) + a12
+                R2 = ((0.0 + a02) + a12) + a22
+                L = np.sqrt((((0.0 + lj[0] * P0) + lj[1] * P1) + lj[2] * P2) / (((0.0 + R0) + R1) + R2))
+                num0 = P0 + L * R0
+                num1 = P1 + L * R1
+                num2 = P2 + L * R2
+                s = (num0 + num1) + num2
+                lam[0] = num0 / s
+                lam[1] = num1 / s
+                lam[2] = num2 / s
+            ok = True
+            for i in range(k):
+                if not (np.isfinite(lam[i]) and lam[i] >= -1e-12):
+                    ok = False
+            for i in range(k):
+                if ok:
+                    lam[i] = lam[i] if lam[i] > 0.0 else 0.0  # np.clip(lam, 0.0, None): -0.0 -> +0.0
+                else:
+                    lam[i] = 1.0 / k
+            s = lam[0]
+            for i in range(1, k):
+                s += lam[i]
+            for i in range(k):
+                lam[i] = lam[i] / s
+            tr = 0.0
+            for i in range(k):
+                tr += lam[i] * lj[i]
+            det = 0.0
+            for i in range(k):
+                for j in range(i, k):
+                    hij = H[r, combos[ci, i], combos[ci, j]]
+                    det += (1.0 if i == j else 2.0) * lam[i] * lam[j] * hij
+            f = tr / det if ok and det > 0 else np.inf
+            # argmin over the faces: first occurrence, a nan wins (np.argmin)
+            if bc == -1 or (not np.isnan(bf) and (np.isnan(f) or f < bf)):
+                bc = ci
+                bf = f
+                for i in range(k):
+                    blam[i] = lam[i]
+        if bf < best_f[r]:
+            best_f[r] = bf
+            for q in range(n):
+                best_lam[r, q] = 0.0
+            for i in range(k):
+                best_lam[r, combos[bc, i]] = blam[i]
