@@ -1,8 +1,12 @@
-"""Compiled (numba) kernel of the evader's pairwise Frank-Wolfe solver, eq (24) of the `hinf` paper.
+"""Compiled (numba) kernels of the evader's inner solvers, eq (24) of the `hinf` paper.
 
-Imported lazily by :func:`.evader.min_fused_trace_pairwise`, so that the steps that do not use it do not
-import numba. The kernel replays, per instance and in the same floating-point order, the numpy expressions
-of :func:`.evader._min_fused_trace_pairwise_numpy`, so that its results are bit-identical.
+``pairwise_kernel``: the pairwise Frank-Wolfe solver; ``faces_kernel``: the enumeration of the faces of the
+simplex of the exact solver. Imported lazily by :func:`.evader.min_fused_trace_pairwise` and
+:func:`.evader.min_fused_trace_exact`, so that the steps that do not use them do not import numba. Each kernel
+replays, per instance and in the same floating-point order, the numpy expressions of its reference
+(:func:`.evader._min_fused_trace_pairwise_numpy`, :func:`.evader._best_on_faces_numpy`), so that its results
+are bit-identical. Both are written on scalars (no helper functions, no scratch arrays): numba compiles them
+faster, a cost a process pays once when it loads a kernel cold.
 """
 
 from __future__ import annotations
@@ -12,7 +16,7 @@ from numba import njit
 
 from .filter_kernels import fma
 
-__all__ = ["pairwise_kernel"]
+__all__ = ["pairwise_kernel", "faces_kernel"]
 
 
 # --------------------------------------------------------------------------- compiled kernel (numba)
@@ -177,100 +181,97 @@ def faces_kernel(H, l, combos, rows, best_f, best_lam):
     """
     C, k = combos.shape
     n = l.shape[1]
-    lj = np.empty(3)
-    lam = np.empty(3)
-    blam = np.empty(3)
     for r in rows:
         bf = np.inf
         bc = -1
+        b0 = b1 = b2 = 0.0
         for ci in range(C):
             j0 = combos[ci, 0]
-            lj[0] = l[r, j0]
-            h00 = H[r, j0, j0]
+            j1 = combos[ci, 1] if k > 1 else j0
+            j2 = combos[ci, 2] if k > 2 else j0
+            l0, l1, l2 = l[r, j0], l[r, j1], l[r, j2]
+            h00, h01, h02 = H[r, j0, j0], H[r, j0, j1], H[r, j0, j2]
+            h11, h12, h22 = H[r, j1, j1], H[r, j1, j2], H[r, j2, j2]
+            lam1 = lam2 = 0.0
             if k == 1:
-                P0 = 0.0 + 1.0 * lj[0]
-                L = np.sqrt((0.0 + lj[0] * P0) / (0.0 + 1.0))
+                P0 = 0.0 + 1.0 * l0
+                L = np.sqrt((0.0 + l0 * P0) / (0.0 + 1.0))
                 num0 = P0 + L * 1.0
-                lam[0] = num0 / num0
+                lam0 = num0 / num0
             elif k == 2:
-                j1 = combos[ci, 1]
-                lj[1] = l[r, j1]
-                h01 = H[r, j0, j1]
-                h11 = H[r, j1, j1]
                 # adj(H) of the face: [[h11, -h01], [-h01, h00]]
                 a00, a01, a11 = h11, -h01, h00
-                P0 = (0.0 + a00 * lj[0]) + a01 * lj[1]
-                P1 = (0.0 + a01 * lj[0]) + a11 * lj[1]
+                P0 = (0.0 + a00 * l0) + a01 * l1
+                P1 = (0.0 + a01 * l0) + a11 * l1
                 R0 = (0.0 + a00) + a01
                 R1 = (0.0 + a01) + a11
-                L = np.sqrt(((0.0 + lj[0] * P0) + lj[1] * P1) / ((0.0 + R0) + R1))
+                L = np.sqrt(((0.0 + l0 * P0) + l1 * P1) / ((0.0 + R0) + R1))
                 num0 = P0 + L * R0
                 num1 = P1 + L * R1
                 s = num0 + num1
-                lam[0] = num0 / s
-                lam[1] = num1 / s
+                lam0 = num0 / s
+                lam1 = num1 / s
             else:
-                j1 = combos[ci, 1]
-                j2 = combos[ci, 2]
-                lj[1] = l[r, j1]
-                lj[2] = l[r, j2]
-                h01 = H[r, j0, j1]
-                h02 = H[r, j0, j2]
-                h11 = H[r, j1, j1]
-                h12 = H[r, j1, j2]
-                h22 = H[r, j2, j2]
                 a00 = h11 * h22 - h12 * h12
                 a11 = h00 * h22 - h02 * h02
                 a22 = h00 * h11 - h01 * h01
                 a01 = h02 * h12 - h01 * h22
                 a02 = h01 * h12 - h02 * h11
                 a12 = h01 * h02 - h00 * h12
-                P0 = ((0.0 + a00 * lj[0]) + a01 * lj[1]) + a02 * lj[2]
-                P1 = ((0.0 + a01 * lj[0]) + a11 * lj[1]) + a12 * lj[2]
-                P2 = ((0.0 + a02 * lj[0]) + a12 * lj[1]) + a22 * lj[2]
+                P0 = ((0.0 + a00 * l0) + a01 * l1) + a02 * l2
+                P1 = ((0.0 + a01 * l0) + a11 * l1) + a12 * l2
+                P2 = ((0.0 + a02 * l0) + a12 * l1) + a22 * l2
                 R0 = ((0.0 + a00) + a01) + a02
                 R1 = ((0.0 + a01) + a11) + a12
                 R2 = ((0.0 + a02) + a12) + a22
-                L = np.sqrt((((0.0 + lj[0] * P0) + lj[1] * P1) + lj[2] * P2) / (((0.0 + R0) + R1) + R2))
+                L = np.sqrt((((0.0 + l0 * P0) + l1 * P1) + l2 * P2) / (((0.0 + R0) + R1) + R2))
                 num0 = P0 + L * R0
                 num1 = P1 + L * R1
                 num2 = P2 + L * R2
                 s = (num0 + num1) + num2
-                lam[0] = num0 / s
-                lam[1] = num1 / s
-                lam[2] = num2 / s
-            ok = True
-            for i in range(k):
-                if not (np.isfinite(lam[i]) and lam[i] >= -1e-12):
-                    ok = False
-            for i in range(k):
-                if ok:
-                    lam[i] = lam[i] if lam[i] > 0.0 else 0.0  # np.clip(lam, 0.0, None): -0.0 -> +0.0
-                else:
-                    lam[i] = 1.0 / k
-            s = lam[0]
-            for i in range(1, k):
-                s += lam[i]
-            for i in range(k):
-                lam[i] = lam[i] / s
-            tr = 0.0
-            for i in range(k):
-                tr += lam[i] * lj[i]
-            det = 0.0
-            for i in range(k):
-                for j in range(i, k):
-                    hij = H[r, combos[ci, i], combos[ci, j]]
-                    det += (1.0 if i == j else 2.0) * lam[i] * lam[j] * hij
+                lam0 = num0 / s
+                lam1 = num1 / s
+                lam2 = num2 / s
+            ok = np.isfinite(lam0) and lam0 >= -1e-12
+            if k > 1:
+                ok = ok and np.isfinite(lam1) and lam1 >= -1e-12
+            if k > 2:
+                ok = ok and np.isfinite(lam2) and lam2 >= -1e-12
+            if ok:  # np.clip(lam, 0.0, None): -0.0 -> +0.0
+                lam0 = lam0 if lam0 > 0.0 else 0.0
+                lam1 = lam1 if lam1 > 0.0 else 0.0
+                lam2 = lam2 if lam2 > 0.0 else 0.0
+            else:
+                lam0 = lam1 = lam2 = 1.0 / k
+            s = lam0
+            if k > 1:
+                s += lam1
+            if k > 2:
+                s += lam2
+            lam0, lam1, lam2 = lam0 / s, lam1 / s, lam2 / s
+            tr = 0.0 + lam0 * l0
+            det = 0.0 + 1.0 * lam0 * lam0 * h00
+            if k > 1:
+                tr += lam1 * l1
+                det += 2.0 * lam0 * lam1 * h01
+            if k > 2:
+                tr += lam2 * l2
+                det += 2.0 * lam0 * lam2 * h02
+            if k > 1:
+                det += 1.0 * lam1 * lam1 * h11
+            if k > 2:
+                det += 2.0 * lam1 * lam2 * h12
+                det += 1.0 * lam2 * lam2 * h22
             f = tr / det if ok and det > 0 else np.inf
             # argmin over the faces: first occurrence, a nan wins (np.argmin)
             if bc == -1 or (not np.isnan(bf) and (np.isnan(f) or f < bf)):
-                bc = ci
-                bf = f
-                for i in range(k):
-                    blam[i] = lam[i]
+                bc, bf, b0, b1, b2 = ci, f, lam0, lam1, lam2
         if bf < best_f[r]:
             best_f[r] = bf
             for q in range(n):
                 best_lam[r, q] = 0.0
-            for i in range(k):
-                best_lam[r, combos[bc, i]] = blam[i]
+            best_lam[r, combos[bc, 0]] = b0
+            if k > 1:
+                best_lam[r, combos[bc, 1]] = b1
+            if k > 2:
+                best_lam[r, combos[bc, 2]] = b2
