@@ -212,6 +212,9 @@ def min_fused_trace_pairwise(Minv, n_iter: int = 60, lam0=None):
 EXACT_TOLERANCE = 1e-12
 """Relative Frank-Wolfe gap (of :func:`fused_trace_bounds`) that :func:`min_fused_trace_exact` guarantees."""
 
+EXACT_COMPILED_MIN_BATCH = 2048
+"""Fewest instances for which ``kernel="auto"`` of :func:`min_fused_trace_exact` runs its compiled kernel."""
+
 
 def _sym_coords(Minv):
     """``(a, b, d)`` of the symmetric 2x2 matrices ``[[a, b], [b, d]]``, shape ``(..., 3)``."""
@@ -373,7 +376,7 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
     kernel : {"auto", "compiled", "numpy"}
         ``"compiled"``: the faces of each size by :func:`.evader_kernels.faces_kernel`, the same arithmetic
         instance by instance (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see
-        :func:`.algebra.use_compiled`.
+        :func:`.algebra.use_compiled`, and at least :data:`EXACT_COMPILED_MIN_BATCH` instances.
 
     Returns
     -------
@@ -392,7 +395,9 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
     best_f = np.full(len(sf), np.inf)
     best_lam = np.zeros((len(sf), n))
     rows = np.arange(len(sf))  # instances still to be solved
-    compiled = use_compiled(kernel, Minv.size // 4)
+    # "auto": the kernel saves about 2 us per instance and costs about 0.5 s to compile in a cold process, so it
+    # runs on large batches only (an evader deciding for many runs at every step)
+    compiled = use_compiled(kernel, Minv.size // 4) and (kernel == "compiled" or len(sf) >= EXACT_COMPILED_MIN_BATCH)
     if compiled:
         from .evader_kernels import faces_kernel  # numba: used where it is already loaded (or asked for)
     for k in (1, 2, 3):
