@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .algebra import inv2
+from .algebra import inv2, use_compiled
 from .noise import NoiseModel, geometry, noise_information
 
 from itertools import combinations
@@ -212,6 +212,9 @@ def min_fused_trace_pairwise(Minv, n_iter: int = 60, lam0=None):
 EXACT_TOLERANCE = 1e-12
 """Relative Frank-Wolfe gap (of :func:`fused_trace_bounds`) that :func:`min_fused_trace_exact` guarantees."""
 
+EXACT_COMPILED_MIN_BATCH = 2048
+"""Fewest instances for which ``kernel="auto"`` of :func:`min_fused_trace_exact` runs its compiled kernel."""
+
 
 def _sym_coords(Minv):
     """``(a, b, d)`` of the symmetric 2x2 matrices ``[[a, b], [b, d]]``, shape ``(..., 3)``."""
@@ -319,7 +322,33 @@ def _newton_polish(s, l, lam, steps: int = 3):
     return lam
 
 
-def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
+def _best_on_faces_numpy(Hf, lf, combos, rows, best_f, best_lam):
+    """The best stationary point over the faces ``combos`` for the instances ``rows`` (in place, numpy form).
+
+    Per instance, the closed-form stationary point of each face (:func:`_face_stationary`), kept if its weights
+    are non-negative; the first face of smallest ``f`` replaces ``best_f``, ``best_lam`` (the whole row) if
+    strictly smaller. :func:`.evader_kernels.faces_kernel` is its compiled form (bit-identical).
+    """
+    n, k = lf.shape[1], combos.shape[1]
+    lam, h, lj = _face_stationary(Hf[rows], lf[rows], combos)  # lam (m, C, k)
+    ok = np.all(np.isfinite(lam), -1) & np.all(lam >= -1e-12, -1)
+    lam = np.where(ok[..., None], np.clip(lam, 0.0, None), 1.0 / k)
+    lam = lam / lam.sum(-1, keepdims=True)
+    tr = sum(lam[..., i] * lj[i] for i in range(k))
+    det = sum((1 if i == j else 2) * lam[..., i] * lam[..., j] * h[i, j] for i in range(k) for j in range(i, k))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.where(ok & (det > 0), tr / det, np.inf)
+    c = f.argmin(-1)
+    fc = f[np.arange(len(rows)), c]
+    better = fc < best_f[rows]
+    full = np.zeros((len(rows), n))
+    np.put_along_axis(full, combos[c], lam[np.arange(len(rows)), c], -1)
+    upd = rows[better]
+    best_f[upd] = fc[better]
+    best_lam[upd] = full[better]
+
+
+def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "auto"):
     """Exact ``min_lambda tr (sum_j lam_j M_j^{-1})^{-1}`` on the simplex, eqs (22)-(24), with a certificate.
 
     Same problem as :func:`min_fused_trace` (the smallest ellipse (24) over-bounding the intersection (22)
@@ -344,6 +373,10 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
         The agents' informations ``M_j^{-1}`` (symmetric positive definite).
     tol : float
         Relative Frank-Wolfe gap guaranteed (default :data:`EXACT_TOLERANCE`).
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: the faces of each size by :func:`.evader_kernels.faces_kernel`, the same arithmetic
+        instance by instance (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see
+        :func:`.algebra.use_compiled`, and at least :data:`EXACT_COMPILED_MIN_BATCH` instances.
 
     Returns
     -------
@@ -362,6 +395,11 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
     best_f = np.full(len(sf), np.inf)
     best_lam = np.zeros((len(sf), n))
     rows = np.arange(len(sf))  # instances still to be solved
+    # "auto": the kernel saves about 2 us per instance and costs about 0.5 s to compile in a cold process, so it
+    # runs on large batches only (an evader deciding for many runs at every step)
+    compiled = use_compiled(kernel, Minv.size // 4) and (kernel == "compiled" or len(sf) >= EXACT_COMPILED_MIN_BATCH)
+    if compiled:
+        from .evader_kernels import faces_kernel  # numba: used where it is already loaded (or asked for)
     for k in (1, 2, 3):
         if k > n or len(rows) == 0:
             break
@@ -371,22 +409,10 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE):
             if len(rows) == 0:
                 break
         combos = np.asarray(list(combinations(range(n), k)))
-        lam, h, lj = _face_stationary(Hf[rows], lf[rows], combos)  # lam (m, C, k)
-        ok = np.all(np.isfinite(lam), -1) & np.all(lam >= -1e-12, -1)
-        lam = np.where(ok[..., None], np.clip(lam, 0.0, None), 1.0 / k)
-        lam = lam / lam.sum(-1, keepdims=True)
-        tr = sum(lam[..., i] * lj[i] for i in range(k))
-        det = sum((1 if i == j else 2) * lam[..., i] * lam[..., j] * h[i, j] for i in range(k) for j in range(i, k))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(ok & (det > 0), tr / det, np.inf)
-        c = f.argmin(-1)
-        fc = f[np.arange(len(rows)), c]
-        better = fc < best_f[rows]
-        full = np.zeros((len(rows), n))
-        np.put_along_axis(full, combos[c], lam[np.arange(len(rows)), c], -1)
-        upd = rows[better]
-        best_f[upd] = fc[better]
-        best_lam[upd] = full[better]
+        if compiled:
+            faces_kernel(np.ascontiguousarray(Hf), np.ascontiguousarray(lf), combos, rows, best_f, best_lam)
+        else:
+            _best_on_faces_numpy(Hf, lf, combos, rows, best_f, best_lam)
     value, lower = fused_trace_bounds(Mf, best_lam)
     rough = value - lower > 0.01 * tol * np.abs(value)  # nearly degenerate faces: polish by Newton, keep if better
     if rough.any():
@@ -432,8 +458,9 @@ def fused_trace_bounds(Minv, lam):
 
 
 SOLVERS = {"mirror": min_fused_trace, "pairwise": min_fused_trace_pairwise,
-           "exact": lambda Minv, n_iter=None: min_fused_trace_exact(Minv)}
-"""Inner solvers of the evader by name, each called as ``solver(Minv, n_iter)`` (``exact`` ignores ``n_iter``)."""
+           "exact": lambda Minv, n_iter=None, kernel="auto": min_fused_trace_exact(Minv, kernel=kernel)}
+"""Inner solvers of the evader by name, each called as ``solver(Minv, n_iter)`` (``exact`` ignores ``n_iter`` and
+takes the ``kernel`` of :func:`min_fused_trace_exact`)."""
 
 
 def _inner(solver: str):

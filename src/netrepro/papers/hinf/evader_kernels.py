@@ -1,8 +1,12 @@
-"""Compiled (numba) kernel of the evader's pairwise Frank-Wolfe solver, eq (24) of the `hinf` paper.
+"""Compiled (numba) kernels of the evader's inner solvers, eq (24) of the `hinf` paper.
 
-Imported lazily by :func:`.evader.min_fused_trace_pairwise`, so that the steps that do not use it do not
-import numba. The kernel replays, per instance and in the same floating-point order, the numpy expressions
-of :func:`.evader._min_fused_trace_pairwise_numpy`, so that its results are bit-identical.
+``pairwise_kernel``: the pairwise Frank-Wolfe solver; ``faces_kernel``: the enumeration of the faces of the
+simplex of the exact solver. Imported lazily by :func:`.evader.min_fused_trace_pairwise` and
+:func:`.evader.min_fused_trace_exact`, so that the steps that do not use them do not import numba. Each kernel
+replays, per instance and in the same floating-point order, the numpy expressions of its reference
+(:func:`.evader._min_fused_trace_pairwise_numpy`, :func:`.evader._best_on_faces_numpy`), so that its results
+are bit-identical. Both are written on scalars (no helper functions, no scratch arrays): numba compiles them
+faster, a cost a process pays once when it loads a kernel cold.
 """
 
 from __future__ import annotations
@@ -12,60 +16,17 @@ from numba import njit
 
 from .filter_kernels import fma
 
-__all__ = ["pairwise_kernel"]
+__all__ = ["pairwise_kernel", "faces_kernel"]
 
 
-# --------------------------------------------------------------------------- compiled kernels (numba)
-# The kernels below replay, per instance and in the same floating-point order, the numpy expressions of the
-# solvers above, so that their results are bit-identical: ``einsum("...n,...nij->...ij")`` sums the weights
-# sequentially, ``Ai @ Ai`` (numpy's stacked 2x2 matmul through OpenBLAS) rounds ``fma(a_i1, b_1j, a_i0 b_0j)``
-# and ``einsum("...ij,...nji->...n")`` adds ``(t_00 + t_10) + (t_01 + t_11)``. No fastmath; ``fma`` is
-# :func:`.filter_kernels.fma`, the correctly rounded ``llvm.fma``.
-@njit(cache=True, error_model="numpy")
-def _fused_A(M, lam, A):
-    """``A = sum_n lam_n M_n`` (sequential, as ``einsum``) into ``A (2, 2)``."""
-    for i in range(2):
-        for j in range(2):
-            acc = 0.0
-            for n in range(M.shape[0]):
-                acc += lam[n] * M[n, i, j]
-            A[i, j] = acc
-
-
-@njit(cache=True, error_model="numpy")
-def _inv2_into(A, Ai):
-    """``inv2`` of :mod:`.algebra` for one matrix."""
-    d = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-    Ai[0, 0] = A[1, 1] / d
-    Ai[1, 1] = A[0, 0] / d
-    Ai[0, 1] = -A[0, 1] / d
-    Ai[1, 0] = -A[1, 0] / d
-
-
-@njit(cache=True, error_model="numpy")
-def _trace_grad(M, Ai, C, grad):
-    """``grad_n = -tr(Ai Ai M_n)`` as ``-einsum("ij,nji->n", Ai @ Ai, M)``; ``C`` receives ``Ai @ Ai``."""
-    for i in range(2):
-        for j in range(2):
-            C[i, j] = fma(Ai[i, 1], Ai[1, j], Ai[i, 0] * Ai[0, j])
-    for n in range(M.shape[0]):
-        grad[n] = -((C[0, 0] * M[n, 0, 0] + C[1, 0] * M[n, 0, 1]) + (C[0, 1] * M[n, 1, 0] + C[1, 1] * M[n, 1, 1]))
-
-
-@njit(cache=True, error_model="numpy")
-def _argmin(x):
-    """``np.argmin`` (first occurrence; a nan wins)."""
-    best = 0
-    if np.isnan(x[0]):
-        return 0
-    for i in range(1, x.shape[0]):
-        if np.isnan(x[i]):
-            return i
-        if x[i] < x[best]:
-            best = i
-    return best
-
-
+# --------------------------------------------------------------------------- compiled kernel (numba)
+# The kernel replays, per instance and in the same floating-point order, the numpy expressions of the solver,
+# so that its results are bit-identical: ``einsum("...n,...nij->...ij")`` sums the weights sequentially,
+# ``Ai @ Ai`` (numpy's stacked 2x2 matmul through OpenBLAS) rounds ``fma(a_i1, b_1j, a_i0 b_0j)`` and
+# ``einsum("...ij,...nji->...n")`` adds ``(t_00 + t_10) + (t_01 + t_11)``. No fastmath; ``fma`` is
+# :func:`.filter_kernels.fma`, the correctly rounded ``llvm.fma``. Written as one function on scalars (no
+# helper functions, no scratch 2x2 arrays): numba then compiles it in about a third less time, which a
+# process that loads it cold pays once.
 @njit(cache=True, error_model="numpy")
 def pairwise_kernel(Minv, lam, n_iter):
     """:func:`min_fused_trace_pairwise` on ``Minv (M, N, 2, 2)`` from ``lam (M, N)`` (updated in place).
@@ -86,34 +47,63 @@ def pairwise_kernel(Minv, lam, n_iter):
     """
     m, n = lam.shape
     trace = np.empty(m)
-    A = np.empty((2, 2))
-    Ai = np.empty((2, 2))
-    C = np.empty((2, 2))
     grad = np.empty(n)
-    masked = np.empty(n)
-    cands = np.empty(4)
-    fv = np.empty(4)
     for r in range(m):
-        M = Minv[r]
-        lr = lam[r]
         for _ in range(n_iter):
-            _fused_A(M, lr, A)
-            _inv2_into(A, Ai)
-            _trace_grad(M, Ai, C, grad)
-            s = _argmin(grad)
+            # A = sum_n lam_n M_n (sequential, as einsum)
+            A00 = 0.0
+            A01 = 0.0
+            A10 = 0.0
+            A11 = 0.0
             for q in range(n):
-                masked[q] = -grad[q] if lr[q] > 0 else np.inf  # argmax(x) == argmin(-x) incl. first occurrence
-            v = _argmin(masked)
-            tmax = lr[v]
-            D00 = M[s, 0, 0] - M[v, 0, 0]
-            D01 = M[s, 0, 1] - M[v, 0, 1]
-            D10 = M[s, 1, 0] - M[v, 1, 0]
-            D11 = M[s, 1, 1] - M[v, 1, 1]
-            a = A[0, 0] + A[1, 1]
-            c = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+                A00 += lam[r, q] * Minv[r, q, 0, 0]
+            for q in range(n):
+                A01 += lam[r, q] * Minv[r, q, 0, 1]
+            for q in range(n):
+                A10 += lam[r, q] * Minv[r, q, 1, 0]
+            for q in range(n):
+                A11 += lam[r, q] * Minv[r, q, 1, 1]
+            c = A00 * A11 - A01 * A10
+            i00 = A11 / c
+            i11 = A00 / c
+            i01 = -A01 / c
+            i10 = -A10 / c
+            C00 = fma(i01, i10, i00 * i00)
+            C01 = fma(i01, i11, i00 * i01)
+            C10 = fma(i11, i10, i10 * i00)
+            C11 = fma(i11, i11, i10 * i01)
+            for q in range(n):
+                grad[q] = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1])
+                            + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+            # s = argmin(grad), v = argmax over lam > 0 (np.argmin/argmax: first occurrence, a nan wins)
+            s = 0
+            if not np.isnan(grad[0]):
+                for q in range(1, n):
+                    if np.isnan(grad[q]):
+                        s = q
+                        break
+                    if grad[q] < grad[s]:
+                        s = q
+            v = 0
+            bv = -grad[0] if lam[r, 0] > 0 else np.inf
+            if not np.isnan(bv):
+                for q in range(1, n):
+                    x = -grad[q] if lam[r, q] > 0 else np.inf
+                    if np.isnan(x):
+                        v = q
+                        break
+                    if x < bv:
+                        v = q
+                        bv = x
+            tmax = lam[r, v]
+            D00 = Minv[r, s, 0, 0] - Minv[r, v, 0, 0]
+            D01 = Minv[r, s, 0, 1] - Minv[r, v, 0, 1]
+            D10 = Minv[r, s, 1, 0] - Minv[r, v, 1, 0]
+            D11 = Minv[r, s, 1, 1] - Minv[r, v, 1, 1]
+            a = A00 + A11
             b = D00 + D11
             e = D00 * D11 - D01 * D10
-            d = A[0, 0] * D11 + A[1, 1] * D00 - 2 * A[0, 1] * D01
+            d = A00 * D11 + A11 * D00 - 2 * A01 * D01
             qa, qb, qc = b * e, 2 * a * e, -(b * c - a * d)
             disc = np.sqrt(qb * qb - 4 * qa * qc)
             lin = -qc / qb
@@ -123,26 +113,165 @@ def pairwise_kernel(Minv, lam, n_iter):
             else:
                 r1 = lin
                 r2 = lin
-            cands[0] = 0.0
-            cands[1] = tmax
-            cands[2] = r1
-            cands[3] = r2
+            # candidates 0, tmax, r1, r2: clipped to [0, tmax] (0 if not finite); the first smallest positive f
+            t = 0.0
+            bf = 0.0
             for q in range(4):
-                x = cands[q]
-                if np.isfinite(x):
-                    cands[q] = min(max(x, 0.0), tmax)
-                else:
-                    cands[q] = 0.0
-                x = cands[q]
+                x = 0.0 if q == 0 else (tmax if q == 1 else (r1 if q == 2 else r2))
+                x = min(max(x, 0.0), tmax) if np.isfinite(x) else 0.0
                 f = (a + b * x) / (c + d * x + e * (x * x))
-                fv[q] = f if f > 0 else np.inf
-            t = cands[_argmin(fv)]
+                f = f if f > 0 else np.inf
+                if q == 0:
+                    t = x
+                    bf = f
+                elif not np.isnan(bf) and (np.isnan(f) or f < bf):
+                    t = x
+                    bf = f
             if s == v:
                 t = 0.0
-            lr[s] += t
-            lr[v] -= t
-            lr[v] = max(lr[v], 0.0)
-        _fused_A(M, lr, A)
-        _inv2_into(A, Ai)
-        trace[r] = Ai[0, 0] + Ai[1, 1]
+            lam[r, s] += t
+            lam[r, v] -= t
+            lam[r, v] = max(lam[r, v], 0.0)
+        A00 = 0.0
+        A01 = 0.0
+        A10 = 0.0
+        A11 = 0.0
+        for q in range(n):
+            A00 += lam[r, q] * Minv[r, q, 0, 0]
+        for q in range(n):
+            A11 += lam[r, q] * Minv[r, q, 1, 1]
+        for q in range(n):
+            A01 += lam[r, q] * Minv[r, q, 0, 1]
+        for q in range(n):
+            A10 += lam[r, q] * Minv[r, q, 1, 0]
+        d = A00 * A11 - A01 * A10
+        trace[r] = A11 / d + A00 / d
     return trace
+
+
+@njit(cache=True, error_model="numpy")
+def faces_kernel(H, l, combos, rows, best_f, best_lam):
+    """The best stationary point over the faces ``combos`` of the simplex, for the instances ``rows``.
+
+    The compiled form of :func:`.evader._best_on_faces_numpy` (eqs (22)-(24); see
+    :func:`.evader.min_fused_trace_exact`): per instance and face, the closed-form stationary point of
+    ``f = tr A / det A`` of :func:`.evader._face_stationary`, kept if its weights are non-negative, and the
+    first face of smallest ``f``, which replaces the instance's best if strictly smaller. Same floating-point
+    operations in the same order as the numpy form (Python ``sum`` starts from ``0``; a sum over the face's
+    vertices is sequential), so the results are bit-identical.
+
+    Parameters
+    ----------
+    H : ndarray ``(M, N, N)``
+        ``det(sum lam_j S_j) = lam^T H lam`` per instance.
+    l : ndarray ``(M, N)``
+        ``tr S_j``.
+    combos : ndarray of int ``(C, k)``
+        The faces (``k <= 3`` vertices each).
+    rows : ndarray of int ``(m,)``
+        Instances to solve.
+    best_f : ndarray ``(M,)``
+        Best value so far; updated in place.
+    best_lam : ndarray ``(M, N)``
+        Its weights; updated in place (a row is replaced as a whole).
+
+    Returns
+    -------
+    None
+    """
+    C, k = combos.shape
+    n = l.shape[1]
+    for r in rows:
+        bf = np.inf
+        bc = -1
+        b0 = b1 = b2 = 0.0
+        for ci in range(C):
+            j0 = combos[ci, 0]
+            j1 = combos[ci, 1] if k > 1 else j0
+            j2 = combos[ci, 2] if k > 2 else j0
+            l0, l1, l2 = l[r, j0], l[r, j1], l[r, j2]
+            h00, h01, h02 = H[r, j0, j0], H[r, j0, j1], H[r, j0, j2]
+            h11, h12, h22 = H[r, j1, j1], H[r, j1, j2], H[r, j2, j2]
+            lam1 = lam2 = 0.0
+            if k == 1:
+                P0 = 0.0 + 1.0 * l0
+                L = np.sqrt((0.0 + l0 * P0) / (0.0 + 1.0))
+                num0 = P0 + L * 1.0
+                lam0 = num0 / num0
+            elif k == 2:
+                # adj(H) of the face: [[h11, -h01], [-h01, h00]]
+                a00, a01, a11 = h11, -h01, h00
+                P0 = (0.0 + a00 * l0) + a01 * l1
+                P1 = (0.0 + a01 * l0) + a11 * l1
+                R0 = (0.0 + a00) + a01
+                R1 = (0.0 + a01) + a11
+                L = np.sqrt(((0.0 + l0 * P0) + l1 * P1) / ((0.0 + R0) + R1))
+                num0 = P0 + L * R0
+                num1 = P1 + L * R1
+                s = num0 + num1
+                lam0 = num0 / s
+                lam1 = num1 / s
+            else:
+                a00 = h11 * h22 - h12 * h12
+                a11 = h00 * h22 - h02 * h02
+                a22 = h00 * h11 - h01 * h01
+                a01 = h02 * h12 - h01 * h22
+                a02 = h01 * h12 - h02 * h11
+                a12 = h01 * h02 - h00 * h12
+                P0 = ((0.0 + a00 * l0) + a01 * l1) + a02 * l2
+                P1 = ((0.0 + a01 * l0) + a11 * l1) + a12 * l2
+                P2 = ((0.0 + a02 * l0) + a12 * l1) + a22 * l2
+                R0 = ((0.0 + a00) + a01) + a02
+                R1 = ((0.0 + a01) + a11) + a12
+                R2 = ((0.0 + a02) + a12) + a22
+                L = np.sqrt((((0.0 + l0 * P0) + l1 * P1) + l2 * P2) / (((0.0 + R0) + R1) + R2))
+                num0 = P0 + L * R0
+                num1 = P1 + L * R1
+                num2 = P2 + L * R2
+                s = (num0 + num1) + num2
+                lam0 = num0 / s
+                lam1 = num1 / s
+                lam2 = num2 / s
+            ok = np.isfinite(lam0) and lam0 >= -1e-12
+            if k > 1:
+                ok = ok and np.isfinite(lam1) and lam1 >= -1e-12
+            if k > 2:
+                ok = ok and np.isfinite(lam2) and lam2 >= -1e-12
+            if ok:  # np.clip(lam, 0.0, None): -0.0 -> +0.0
+                lam0 = lam0 if lam0 > 0.0 else 0.0
+                lam1 = lam1 if lam1 > 0.0 else 0.0
+                lam2 = lam2 if lam2 > 0.0 else 0.0
+            else:
+                lam0 = lam1 = lam2 = 1.0 / k
+            s = lam0
+            if k > 1:
+                s += lam1
+            if k > 2:
+                s += lam2
+            lam0, lam1, lam2 = lam0 / s, lam1 / s, lam2 / s
+            tr = 0.0 + lam0 * l0
+            det = 0.0 + 1.0 * lam0 * lam0 * h00
+            if k > 1:
+                tr += lam1 * l1
+                det += 2.0 * lam0 * lam1 * h01
+            if k > 2:
+                tr += lam2 * l2
+                det += 2.0 * lam0 * lam2 * h02
+            if k > 1:
+                det += 1.0 * lam1 * lam1 * h11
+            if k > 2:
+                det += 2.0 * lam1 * lam2 * h12
+                det += 1.0 * lam2 * lam2 * h22
+            f = tr / det if ok and det > 0 else np.inf
+            # argmin over the faces: first occurrence, a nan wins (np.argmin)
+            if bc == -1 or (not np.isnan(bf) and (np.isnan(f) or f < bf)):
+                bc, bf, b0, b1, b2 = ci, f, lam0, lam1, lam2
+        if bf < best_f[r]:
+            best_f[r] = bf
+            for q in range(n):
+                best_lam[r, q] = 0.0
+            best_lam[r, combos[bc, 0]] = b0
+            if k > 1:
+                best_lam[r, combos[bc, 1]] = b1
+            if k > 2:
+                best_lam[r, combos[bc, 2]] = b2

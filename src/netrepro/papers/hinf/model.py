@@ -280,8 +280,11 @@ def simulate(sc: dict) -> dict:
         ags[:, k] = P
     if sc["target"] == "evasive" or sc.get("fused_all", True):
         r, th = geometry(tgt[:, 0], ags[:, 0])
-        inner = SOLVERS[ev.get("solver", "mirror")]  # the evader's own inner solver of (24)
-        fused[:, 0] = inner(noise_information(r, th, model), int(ev.get("n_iter", 40)))[0]
+        solver = ev.get("solver", "mirror")
+        inner = SOLVERS[solver]  # the evader's own inner solver of (24)
+        # a single call: the exact solver's numpy form (compiling its kernel would cost more than it saves)
+        kw = {"kernel": "numpy"} if solver == "exact" else {}
+        fused[:, 0] = inner(noise_information(r, th, model), int(ev.get("n_iter", 40)), **kw)[0]
     return {"errors": errors, "target": tgt, "agents": ags, "connected": connected, "max_degree": max_degree,
             "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix, "connected_runs": conn_runs,
             "information": info_hist}
