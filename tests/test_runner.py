@@ -42,3 +42,21 @@ def test_failing_step_leaves_no_output(tmp_path, monkeypatch):
     with pytest.raises(KeyError):
         run_step("demo", "tests.test_runner:table_step", {}, {}, {"table": "c.csv"})
     assert not (tmp_path / "c.csv").exists()
+
+
+def two_tables_step(params, inputs, outputs):
+    return {"a": pd.DataFrame({"x": [1.0]}), "b": pd.DataFrame({"y": [2.0]})}
+
+
+def test_every_sidecar_of_a_step_records_its_inputs_checksums(tmp_path, monkeypatch):
+    """The inputs' checksums are computed once per step and written into the sidecar of every output."""
+    import hashlib
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "in.txt").write_text("some input\n")
+    run_step("demo", "tests.test_runner:two_tables_step", {}, {"data": "in.txt", "none": "missing.txt"},
+             {"a": "a.csv", "b": "b.csv"})
+    expected = {"data": {"path": "in.txt", "sha256": hashlib.sha256(b"some input\n").hexdigest()}}
+    metas = [read_sidecar(name) for name in ("a.csv", "b.csv")]
+    assert [m["inputs"] for m in metas] == [expected, expected]
+    assert metas[0]["packages"] == metas[1]["packages"] and "numpy" in metas[0]["packages"]

@@ -18,7 +18,7 @@ import platform
 import shlex
 import subprocess
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
@@ -28,6 +28,7 @@ from .errors import CorruptOutputError
 __all__ = [
     "params_hash",
     "git_state",
+    "step_environment",
     "package_versions",
     "find_seeds",
     "job_command",
@@ -137,6 +138,34 @@ class StepRecord:
     inputs: dict
     wall_time_s: float
     extra: dict
+    # inputs' checksums, git state and package versions: the same for every output of the step,
+    # so the runner computes them once (:func:`step_environment`); empty: computed per sidecar
+    environment: dict = field(default_factory=dict)
+
+
+def step_environment(inputs: dict) -> dict:
+    """The part of a sidecar shared by all outputs of a step: the checksum of every input file,
+    the git state of the checkout and the versions of the packages that shape the numbers.
+
+    Parameters
+    ----------
+    inputs : dict
+        ``{name: path}`` of the step's inputs (flattened); paths that are not files are left out.
+
+    Returns
+    -------
+    dict
+        ``{"inputs": {name: {"path", "sha256"}}, "git": ..., "packages": ...}``.
+    """
+    return {
+        "inputs": {
+            name: {"path": str(path), "sha256": sha256_file(path)}
+            for name, path in inputs.items()
+            if Path(path).is_file()
+        },
+        "git": git_state(),
+        "packages": package_versions(),
+    }
 
 
 def write_sidecar(output: str | Path, record: StepRecord) -> Path:
@@ -157,13 +186,7 @@ def write_sidecar(output: str | Path, record: StepRecord) -> Path:
         "params": record.params,
         "params_hash": params_hash(record.params),
         "seeds": find_seeds(record.params),
-        "inputs": {
-            name: {"path": str(path), "sha256": sha256_file(path)}
-            for name, path in record.inputs.items()
-            if Path(path).is_file()
-        },
-        "git": git_state(),
-        "packages": package_versions(),
+        **(record.environment or step_environment(record.inputs)),
         "machine": {"platform": platform.platform(), "processor": platform.machine()},
         "wall_time_s": round(record.wall_time_s, 3),
         "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),

@@ -36,7 +36,7 @@ import warnings
 from pathlib import Path
 
 from .io import write_table
-from .provenance import PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, verify_output, verify_tree, write_sidecar
+from .provenance import PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, step_environment, verify_output, verify_tree, write_sidecar
 
 __all__ = ["resolve", "run_step", "verify_main", "main"]
 
@@ -177,6 +177,7 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
         inputs={k: str(v) for k, v in _flatten(inputs).items()},
         wall_time_s=elapsed,
         extra=extra,
+        environment=step_environment({k: str(v) for k, v in _flatten(inputs).items()}),
     )
     for name, path in outputs.items():
         if not path.exists():
