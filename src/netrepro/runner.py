@@ -168,16 +168,17 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
         source_file = str(Path(source_file).resolve().relative_to(Path.cwd().resolve()))
     except ValueError:
         pass
+    flat_inputs = {k: str(v) for k, v in _flatten(inputs).items()}
     record = StepRecord(
         rule=rule,
         function=func_spec,
         source_file=source_file,
         source_line=inspect.getsourcelines(func)[1],
         params=params,
-        inputs={k: str(v) for k, v in _flatten(inputs).items()},
+        inputs=flat_inputs,
         wall_time_s=elapsed,
         extra=extra,
-        environment=step_environment({k: str(v) for k, v in _flatten(inputs).items()}),
+        environment=step_environment(flat_inputs),
     )
     for name, path in outputs.items():
         if not path.exists():
