@@ -45,10 +45,12 @@ import os, signal, sys
 sys.path.insert(0, {root!r})
 import netrepro.io, netrepro.runner
 where = {where!r}
-if where == "before-rename":
+if where == "before-rename":  # of the table (its sidecar's unfinished mark is renamed before)
     real = os.replace
     def boom(src, dst):
-        os.kill(os.getpid(), signal.SIGKILL)
+        if str(dst).endswith("t.csv"):
+            os.kill(os.getpid(), signal.SIGKILL)
+        real(src, dst)
     netrepro.io.os.replace = boom
 elif where == "before-sidecar":
     def boom(*a, **k):
@@ -74,31 +76,56 @@ def test_kill_before_rename_leaves_old_table_or_nothing_and_a_harmless_part_file
     assert not (tmp_path / "results/t.csv").exists()
     parts = list((tmp_path / "results").glob(".t.csv.*.part*"))
     assert parts, "expected the temporary file of the interrupted write"
-    statuses = {v.status for v in verify_tree(["results"])}
-    assert statuses == {"partial"}
+    # the temporary file, and the unfinished mark of a table that never reached its place
+    statuses = {str(v.path): v.status for v in verify_tree(["results"])}
+    assert set(statuses.values()) == {"partial", "missing"} and statuses["results/t.csv"] == "missing"
+    assert verify_main(["results"], quiet=True, stream=open(os.devnull, "w")) == 0
     # the rerun removes the leftover and writes a table that verifies
     run_step("demo", "tests.test_reliability_numerics:table_step", {"x": 5.0}, {}, {"table": "results/t.csv"})
     assert not list((tmp_path / "results").glob(".t.csv.*.part*"))
     verify_output("results/t.csv")
 
 
-def test_kill_between_table_and_sidecar_is_never_taken_for_complete(tmp_path, monkeypatch):
+def test_kill_between_table_and_sidecar_leaves_it_marked_unfinished(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     # a complete earlier run: table and sidecar
     run_step("demo", "tests.test_reliability_numerics:table_step", {"x": 1.0}, {}, {"table": "results/t.csv"})
-    old_side = sidecar_path("results/t.csv").read_text()
+    old_side = json.loads(sidecar_path("results/t.csv").read_text())
     run_killed(tmp_path, "before-sidecar")
-    # the new table is in place, but the old sidecar is gone: it does not describe the new file
+    # the new table is in place; its sidecar is the mark written before the step ran, not the old one
     assert pd.read_csv("results/t.csv")["x"].tolist() == [5.0, 2.0]
-    assert not sidecar_path("results/t.csv").exists() and old_side
-    verdicts = verify_tree(["results"])
-    assert [v.status for v in verdicts] == ["no-sidecar"]
-    assert verify_main(["results"], quiet=True, stream=open(os.devnull, "w")) == 1
-    # a step reading it refuses, naming the file
-    with pytest.raises(CorruptOutputError, match="results/t.csv: no provenance sidecar"):
+    side = json.loads(sidecar_path("results/t.csv").read_text())
+    assert side["unfinished"] is True and side["rule"] == "demo" and "output_sha256" not in side
+    assert "output_sha256" in old_side
+    # verify names it as the leftover of an interrupted job: harmless for the tree, fatal for a reader
+    assert [v.status for v in verify_tree(["results"])] == ["unfinished"]
+    assert verify_main(["results"], quiet=True) == 0
+    assert "UNFINISHED: results/t.csv: its job (rule demo) has not finished" in capsys.readouterr().out
+    assert verify_main(["results/t.csv"], inputs_only=True, quiet=True) == 1
+    with pytest.raises(CorruptOutputError, match=r"results/t.csv: its job \(rule demo\) has not finished"):
         run_step("down", "tests.test_reliability_numerics:table_step", {}, {"src": "results/t.csv"},
                  {"table": "results/u.csv"})
     assert not Path("results/u.csv").exists()
+    # the rerun replaces the mark with a full sidecar
+    run_step("demo", "tests.test_reliability_numerics:table_step", {"x": 5.0}, {}, {"table": "results/t.csv"})
+    assert verify_output("results/t.csv")["output_sha256"]
+
+
+def test_a_running_step_marks_its_outputs_unfinished(tmp_path, monkeypatch):
+    # what a concurrent `verify` or a killed job sees while the step is still computing
+    monkeypatch.chdir(tmp_path)
+    _SEEN.clear()
+    run_step("demo", "tests.test_reliability_numerics:peeking_step", {}, {}, {"table": "results/t.csv"})
+    assert json.loads(_SEEN["sidecar"])["unfinished"] is True
+    verify_output("results/t.csv")
+
+
+def peeking_step(params, inputs, outputs):
+    _SEEN["sidecar"] = sidecar_path(outputs["table"]).read_text()
+    return {"table": pd.DataFrame({"x": [1.0]})}
+
+
+_SEEN: dict = {}
 
 
 def test_failing_step_keeps_no_stale_sidecar(tmp_path, monkeypatch):

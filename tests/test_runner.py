@@ -60,3 +60,42 @@ def test_every_sidecar_of_a_step_records_its_inputs_checksums(tmp_path, monkeypa
     metas = [read_sidecar(name) for name in ("a.csv", "b.csv")]
     assert [m["inputs"] for m in metas] == [expected, expected]
     assert metas[0]["packages"] == metas[1]["packages"] and "numpy" in metas[0]["packages"]
+
+
+def _command_line(args, cwd, code=None):
+    """Run ``python -m netrepro ARGS`` (or ``python -c CODE``) as the rules do, with this checkout's src/ and tests."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    repo = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(repo / "src"), str(repo)]))
+    env.pop("PYTHONUNBUFFERED", None)  # as under Snakemake's shell: the streams are buffered
+    cmd = [sys.executable, "-c", code] if code else [sys.executable, "-m", "netrepro", *args]
+    return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
+
+
+def test_command_line_exit_keeps_outputs_logs_and_exit_code(tmp_path):
+    # The command line ends without the interpreter's teardown: the table, its sidecar and the
+    # log file must still be complete, and a failing step must still exit with 1.
+    import json
+
+    io = json.dumps({"outputs": {"table": "t.csv"}, "rule": "demo"})
+    ok = _command_line(["run", "--func", "tests.test_runner:table_step", "--params", '{"x": 1.5}',
+                        "--io", io, "--log", "run.log"], tmp_path)
+    assert ok.returncode == 0, ok.stderr
+    assert pd.read_csv(tmp_path / "t.csv")["x"].tolist() == [1.5, 2.0]
+    verify_output(tmp_path / "t.csv")
+    assert "rule demo: tests.test_runner:table_step done" in (tmp_path / "run.log").read_text()
+    bad = _command_line(["run", "--func", "tests.test_runner:table_step", "--params", "{}",
+                         "--io", io, "--log", "bad.log"], tmp_path)
+    assert bad.returncode == 1
+    assert "rule demo failed" in (tmp_path / "bad.log").read_text()
+
+
+def test_exit_process_flushes_buffered_output_and_keeps_the_code(tmp_path):
+    # stdout is a pipe here, hence block-buffered: without the flush the text would be lost.
+    code = "import sys; from netrepro.runner import exit_process; sys.stdout.write('unflushed'); exit_process(3)"
+    proc = _command_line([], tmp_path, code=code)
+    assert proc.returncode == 3 and proc.stdout == "unflushed"

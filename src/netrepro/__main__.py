@@ -1,9 +1,7 @@
 """``python -m netrepro``: the pipeline runner's command line (:func:`netrepro.runner.main`)."""
 
-import sys
-
-from .runner import main
+from .runner import exit_process, main
 
 __all__: list[str] = []
 
-sys.exit(main())
+exit_process(main())

@@ -38,6 +38,10 @@ class CorruptOutputError(NetreproError, RuntimeError):
     """A result file does not match the checksum recorded in its sidecar."""
 
 
+class UnfinishedOutputError(CorruptOutputError):
+    """A result file whose sidecar says its job has not finished (running, or interrupted)."""
+
+
 class LMIError(NetreproError, RuntimeError):
     """An LMI problem could not be set up or solved as asked."""
 

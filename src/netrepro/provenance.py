@@ -23,7 +23,7 @@ from importlib import metadata
 from pathlib import Path
 
 from .io import sha256_file, write_json
-from .errors import CorruptOutputError
+from .errors import CorruptOutputError, UnfinishedOutputError
 
 __all__ = [
     "params_hash",
@@ -39,7 +39,9 @@ __all__ = [
     "verify_tree",
     "Verdict",
     "CorruptOutputError",
+    "UnfinishedOutputError",
     "PARTIAL_MARK",
+    "write_unfinished_sidecar",
 ]
 
 # Marker in the names of the temporary files of :func:`netrepro.io.atomic_path`.
@@ -200,6 +202,19 @@ def read_sidecar(output: str | Path) -> dict:
     return json.loads(sidecar_path(output).read_text())
 
 
+def write_unfinished_sidecar(output: str | Path, rule: str) -> Path:
+    """Mark ``output`` as being written by ``rule``'s job: a sidecar without a checksum.
+
+    The runner writes it before the step runs and replaces it (atomically) with the full sidecar
+    once the output is complete, so a job killed at any moment leaves its output either absent,
+    marked unfinished, or complete with its checksum; never a result that looks written outside
+    the pipeline, and never one that verifies.
+    """
+    meta = {"output": str(output), "unfinished": True, "rule": rule,
+            "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}
+    return write_json(meta, sidecar_path(output))
+
+
 def verify_output(output: str | Path) -> dict:
     """Check ``output`` against its sidecar checksum; return the sidecar.
 
@@ -207,7 +222,9 @@ def verify_output(output: str | Path) -> dict:
     ------
     CorruptOutputError
         If the file or its sidecar is missing, the sidecar is unreadable, or
-        the checksum differs (truncated or edited file).
+        the checksum differs (truncated or edited file);
+        :class:`~netrepro.errors.UnfinishedOutputError` if the sidecar marks
+        the file as still being written (:func:`write_unfinished_sidecar`).
     """
     output = Path(output)
     side = sidecar_path(output)
@@ -217,6 +234,10 @@ def verify_output(output: str | Path) -> dict:
         raise CorruptOutputError(f"{output}: no provenance sidecar {side.name}; rebuild it with snakemake")
     try:
         meta = json.loads(side.read_text())
+        if isinstance(meta, dict) and meta.get("unfinished"):
+            raise UnfinishedOutputError(
+                f"{output}: its job (rule {meta.get('rule', '?')}) has not finished: the sidecar {side.name} "
+                "marks it unfinished (the job is running, or was interrupted). Rerun snakemake to rebuild it.")
         recorded = meta["output_sha256"]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise CorruptOutputError(
@@ -237,7 +258,7 @@ class Verdict:
     """The state of one file checked by :func:`verify_tree`."""
 
     path: Path
-    status: str  # "ok", "corrupt", "missing", "no-sidecar", "partial"
+    status: str  # "ok", "corrupt", "missing", "no-sidecar", "partial", "unfinished"
     message: str
 
     @property
@@ -264,8 +285,9 @@ def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
     Returns
     -------
     list of :class:`Verdict`
-        One per result file, sidecar without its file (``missing``), or
-        leftover temporary file of an interrupted write (``partial``).
+        One per result file, sidecar without its file (``missing``),
+        leftover temporary file of an interrupted write (``partial``), or
+        output of a job that is running or was interrupted (``unfinished``).
     """
     verdicts = []
     files = []
@@ -302,6 +324,8 @@ def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
             continue
         try:
             verify_output(path)
+        except UnfinishedOutputError as exc:
+            verdicts.append(Verdict(path, "unfinished", f"{exc} No step reads it."))
         except CorruptOutputError as exc:
             verdicts.append(Verdict(path, "corrupt", str(exc)))
         else:

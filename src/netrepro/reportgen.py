@@ -988,4 +988,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from .runner import exit_process
+
+    exit_process(main())
