@@ -206,7 +206,8 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
         if path.is_file():
             write_sidecar(path, record)
         else:  # a directory output has no sidecar of its own
-            sidecar_path(path).unlink()
+            with contextlib.suppress(FileNotFoundError):
+                sidecar_path(path).unlink()
     log.info("rule %s: %s done in %.2f s", rule, func_spec, elapsed)
 
 
