@@ -52,7 +52,7 @@ def test_quick_mode_writes_every_benchmark(tmp_path):
     assert list(table.columns) == bench.COLUMNS
     names = set(table["benchmark"])
     for expected in ("blas_peak", "riccati_iid_n1", "riccati_ge_n3", "channel_ge", "lmi_sweep_two_sensor_n1",
-                     "lmi_bisection", "fisher_1bit", "exact_mean"):
+                     "lmi_bisection", "fisher_1bit", "exact_mean", "job_exit"):
         assert expected in names
     assert not any(name.startswith("pipeline") for name in names)
     agree = table[table["metric"] == "max_rel_diff"]

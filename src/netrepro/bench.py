@@ -54,6 +54,11 @@ Benchmarks
     The ``onebit`` grid filter/smoother on 1-bit data (alpha = 1 - 1e-3, 0 dB): the banded sparse
     transition against the dense one (same estimates to rounding), and the compiled banded kernel the
     pipeline runs against its numpy/scipy form (same estimates bit for bit).
+``job_exit``
+    One job process as the rules start it: interpreter, the imports of an LMI or figure step
+    (numpy, scipy, pandas, numba, cvxpy, matplotlib) and exit, ending through
+    :func:`netrepro.runner.exit_process` (no interpreter teardown, what the pipeline's command
+    lines do) against the normal exit; the ratio is the time ratio per job.
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
     rebuilt after a parameter change, peak memory, and the three slowest jobs (job wall time
@@ -92,6 +97,7 @@ __all__ = [
     "bench_lmi",
     "bench_fisher",
     "bench_exact_mean",
+    "bench_job_exit",
     "bench_pipeline",
     "blas_peak",
     "run_all",
@@ -607,6 +613,28 @@ def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: in
     return rows, source
 
 
+# ============================================================================ job process exit
+JOB_IMPORTS = "numpy, scipy.linalg, pandas, numba, cvxpy, matplotlib.pyplot"
+
+
+def bench_job_exit(repeats: int) -> list[dict]:
+    """Wall time of one job process (start, a step's imports, exit) ending through
+    :func:`netrepro.runner.exit_process` against the interpreter's normal exit (its teardown frees
+    every imported module: what each of a cold build's ~100 jobs paid before)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(ROOT / "src"), os.environ.get("PYTHONPATH"))
+                                                      if p))
+    codes = {"ours": f"import {JOB_IMPORTS}\nfrom netrepro.runner import exit_process\nexit_process(0)",
+             "reference": f"import {JOB_IMPORTS}\nimport netrepro.runner"}
+
+    def job(which):
+        return lambda: subprocess.run([sys.executable, "-c", codes[which]], env=env, check=True)
+
+    t_ours = median_time(job("ours"), repeats)
+    t_ref = median_time(job("reference"), repeats)
+    return [BenchRow("job_exit", "time_s_per_job", t_ours, t_ref, _div(t_ref, t_ours),
+                     f"s (start, import {JOB_IMPORTS}, exit)")]
+
+
 def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]:
     """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded vs dense transition, and the
     compiled banded kernel (what the pipeline runs) against its numpy/scipy form (the tested reference)."""
@@ -867,6 +895,9 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
     if want("grid"):
         _progress("grid: onebit grid filter/smoother, banded vs dense transition, compiled vs numpy banded")
         rows += bench_grid_transition(*sizes["grid"], reps)
+    if want("job_exit"):
+        _progress("job_exit: one job process ending without the interpreter's teardown vs the normal exit")
+        rows += bench_job_exit(reps)
     if pipeline and not quick and want("pipeline"):
         _progress("pipeline: cold snakemake -j2 report in a scratch copy, no-op rerun, one figure after a change")
         pipe_rows, info["pipeline"] = bench_pipeline(scratch=scratch, keep=keep_scratch)
@@ -881,7 +912,8 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
     parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")
     parser.add_argument("--only", default=None,
-                        help="comma-separated subset of riccati,channels,lmi,fisher,exact_mean,grid,pipeline")
+                        help="comma-separated subset of riccati,channels,lmi,fisher,exact_mean,gainsched,markov,"
+                             "grid,job_exit,pipeline")
     parser.add_argument("--scratch", default=None, help="folder for the pipeline's scratch copy (default: tmp)")
     parser.add_argument("--keep-scratch", action="store_true", help="keep the pipeline's scratch copy")
     args = parser.parse_args(argv)
