@@ -1,3 +1,8 @@
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -64,11 +69,6 @@ def test_every_sidecar_of_a_step_records_its_inputs_checksums(tmp_path, monkeypa
 
 def _command_line(args, cwd, code=None):
     """Run ``python -m netrepro ARGS`` (or ``python -c CODE``) as the rules do, with this checkout's src/ and tests."""
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
-
     repo = Path(__file__).resolve().parents[1]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(repo / "src"), str(repo)]))
     env.pop("PYTHONUNBUFFERED", None)  # as under Snakemake's shell: the streams are buffered
@@ -79,8 +79,6 @@ def _command_line(args, cwd, code=None):
 def test_command_line_exit_keeps_outputs_logs_and_exit_code(tmp_path):
     # The command line ends without the interpreter's teardown: the table, its sidecar and the
     # log file must still be complete, and a failing step must still exit with 1.
-    import json
-
     io = json.dumps({"outputs": {"table": "t.csv"}, "rule": "demo"})
     ok = _command_line(["run", "--func", "tests.test_runner:table_step", "--params", '{"x": 1.5}',
                         "--io", io, "--log", "run.log"], tmp_path)

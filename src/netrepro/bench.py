@@ -614,6 +614,11 @@ def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: in
 
 
 # ============================================================================ job process exit
+def _env_with_src(src: Path) -> dict:
+    """This process's environment with ``src`` first on ``PYTHONPATH`` (its package is the one a child runs)."""
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(src), os.environ.get("PYTHONPATH")) if p))
+
+
 JOB_IMPORTS = "numpy, scipy.linalg, pandas, numba, cvxpy, matplotlib.pyplot"
 
 
@@ -621,8 +626,7 @@ def bench_job_exit(repeats: int) -> list[dict]:
     """Wall time of one job process (start, a step's imports, exit) ending through
     :func:`netrepro.runner.exit_process` against the interpreter's normal exit (its teardown frees
     every imported module: what each of a cold build's ~100 jobs paid before)."""
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (str(ROOT / "src"), os.environ.get("PYTHONPATH"))
-                                                      if p))
+    env = _env_with_src(ROOT / "src")
     codes = {"ours": f"import {JOB_IMPORTS}\nfrom netrepro.runner import exit_process\nexit_process(0)",
              "reference": f"import {JOB_IMPORTS}\nimport netrepro.runner"}
 
@@ -796,8 +800,7 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
     for d in ("report", "figures"):
         (work / d).mkdir(exist_ok=True)
     log = base / "snakemake.log"
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(work / "src") + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    env = _env_with_src(work / "src")
     common = [f"-j{jobs}", "--configfile", config]  # targets go first: --configfile takes several values
     info = {"scratch": str(work), "log": str(log), "config": config}
     rows = []

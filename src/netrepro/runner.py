@@ -92,11 +92,14 @@ def _check_inputs(inputs: dict) -> None:
                 "(written outside the pipeline, or by an interrupted job). Delete it and rerun snakemake.")
 
 
+def _described(outputs: dict) -> dict:
+    """The outputs that get a sidecar: all but sidecar files a rule names as outputs of its own."""
+    return {name: path for name, path in outputs.items() if not path.name.endswith(".meta.json")}
+
+
 def _clear_stale(outputs: dict, rule: str) -> None:
     """Mark ``outputs`` unfinished (replacing old sidecars) and remove temporary files of interrupted writes."""
-    for path in outputs.values():
-        if path.name.endswith(".meta.json"):
-            continue
+    for path in _described(outputs).values():
         path.parent.mkdir(parents=True, exist_ok=True)
         for part in path.parent.glob(f".{path.name}.*{PARTIAL_MARK}*"):
             with contextlib.suppress(FileNotFoundError):
@@ -145,10 +148,9 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     except BaseException:
         # a failed step leaves no sidecar (Snakemake deletes its outputs); a killed one cannot get
         # here, and its outputs stay marked unfinished
-        for path in outputs.values():
-            if not path.name.endswith(".meta.json"):
-                with contextlib.suppress(FileNotFoundError):
-                    sidecar_path(path).unlink()
+        for path in _described(outputs).values():
+            with contextlib.suppress(FileNotFoundError):
+                sidecar_path(path).unlink()
         raise
 
 
@@ -201,8 +203,7 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
     for name, path in outputs.items():
         if not path.exists():
             raise FileNotFoundError(f"{func_spec} did not write output {name!r} ({path})")
-        if path.name.endswith(".meta.json"):
-            continue
+    for path in _described(outputs).values():
         if path.is_file():
             write_sidecar(path, record)
         else:  # a directory output has no sidecar of its own
