@@ -142,6 +142,8 @@ class ClaimEntry:
         For statistical verdicts: the test, its sample size and significance level.
     nominal : str
         The setting of the nominal value, as named in a condition.
+    at : dict
+        The paper's settings of the claim (e.g. ``{"p": 0.04, "q": 0.65}``), read by the evidence step.
     """
 
     claim_id: str
@@ -159,6 +161,7 @@ class ClaimEntry:
     group: str = ""
     test: str = ""
     nominal: str = ""
+    at: dict = field(default_factory=dict)
 
     @property
     def location_text(self) -> str:
@@ -268,7 +271,8 @@ def _entry(path: Path, index: int, raw) -> ClaimEntry:
         relative=bool(tol.get("relative", False)), tolerance_reason=str(tol.get("reason", "")).strip(),
         ours=dict(raw.get("ours", {})), depends_on=tuple(raw.get("depends_on", ())),
         erratum_id=str(raw.get("erratum_id", "")), note=str(raw.get("note", "")).strip(),
-        group=str(raw.get("group", "")), test=str(raw.get("test", "")).strip(), nominal=str(raw.get("nominal", "")))
+        group=str(raw.get("group", "")), test=str(raw.get("test", "")).strip(), nominal=str(raw.get("nominal", "")),
+        at=dict(raw.get("at") or {}))
 
 
 def _unique(path: Path, ids) -> None:
