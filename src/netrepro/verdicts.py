@@ -1,80 +1,63 @@
-"""Claims as data, and the one verdict function every paper uses (issue 15).
+"""The one verdict function every paper uses, and the claims, errata, reconstructions and findings tables.
 
-Per paper, four data files beside its code hold the paper's side of the reproduction, each
-validated against a JSON schema in ``workflow/schemas/paper/`` before any job starts:
+The paper's side (claims, errata, reconstructions, findings) is loaded and validated by
+:mod:`netrepro.paperdata` (issue 15, split out in issue 29). Our side is computed by the paper's
+evidence step into ``results/evidence/<slug>.csv`` (columns ``quantity, variant, value, note``;
+built with :func:`evidence_frame`): one ``nominal`` row per quantity at the configured settings,
+and one row per variant across the declared range of the reconstructions a claim or finding
+depends on. By convention, quantity ``<erratum id>.residual_printed`` / ``.residual_corrected``
+give an erratum's residuals (the note of the first is its demonstration), and
+``reconstruction.<key>`` gives a reconstruction's value (its note is the sensitivity). Nothing in
+Python holds a paper value, a statement or a tolerance.
 
-``claims.yaml``
-    id, location in the paper, group (of the replication summary), the quoted statement, kind
-    (``numeric | boolean | not_checkable | not_identifiable | context``), the paper's value,
-    the tolerance and its reason (fixed before and independently of our value), the quantity of
-    ours it is compared with, what it depends on (reconstruction keys) and, for a statement
-    the text gets wrong, the erratum that explains it::
+Only declared ranges decide a verdict (issue 27): a variant row decides a verdict and ``robust``
+only if its label reads ``<key>=<value>`` or ``<key>: <anything>`` with ``<key>`` one of the
+entry's ``depends_on`` (:func:`split_variants`). Any other label is a re-reading: the note lists
+it with its outcome; it decides nothing.
 
-        - id: C2
-          location: {section: "3.1", figure: "1"}
-          group: Fig 1
-          statement: "s_k converges to approximately 0.4"
-          kind: numeric
-          paper_value: 0.4
-          tolerance: {value: 0.05, reason: "'approximately', one significant digit: half a unit of it"}
-          ours: {quantity: s_limit}           # or {table: results/..., column: x, where: {k: 60}}
-          depends_on: [horizon]
+:func:`judge` decides a verdict from an entry (a claim or a finding), our nominal value and our
+values across the declared variants: a verdict that changes inside that range is
+``conditional``, with the condition stated, and ``robust`` is ``no``. :func:`verdicts_step`
+writes the four tables of one paper.
 
-``errata.yaml``
-    id, location, kind (``equation | prose | notation | typesetting``), printed, corrected, impact.
-``reconstructions.yaml``
-    key, reason, range (over which dependent claims are re-judged), optional value/sensitivity.
-``findings.yaml``
-    id, statement, the table (and figure) that shows it, the evidence quantity.
-
-Our side is computed by the paper's evidence step into ``results/evidence/<slug>.csv``
-(columns ``quantity, variant, value, note``): one ``nominal`` row per quantity at the
-configured settings, and one row per variant across the range of the reconstructions the
-claim depends on. By convention, quantity ``<erratum id>.residual_printed`` /
-``.residual_corrected`` give an erratum's residuals (the note of the first is its
-demonstration), and ``reconstruction.<key>`` gives a reconstruction's value (its note is the
-sensitivity). Nothing in Python holds a paper value, a statement or a tolerance.
-
-:func:`judge` decides a verdict from an entry, our nominal value and our values across the
-variants: a verdict that changes inside that range is ``conditional``, with the condition
-stated, and ``robust`` is ``no``. :func:`verdicts_step` writes the claims, errata,
-reconstructions and findings tables of one paper.
+``DATA_FILES``, ``load_paper_data``, ``paper_dir`` and ``referenced_tables`` are re-exported from
+:mod:`netrepro.paperdata` for the workflow (``workflow/rules/common.smk``) and the papers' tests.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-import yaml
 
 from .errors import ConfigError, InputError
-from .io import load_yaml
+from .paperdata import ClaimEntry, FindingEntry, PaperData, load_paper_data
+# re-exported: the workflow (common.smk) imports these from here
+from .paperdata import DATA_FILES as DATA_FILES  # noqa: F401
+from .paperdata import paper_dir as paper_dir  # noqa: F401
+from .paperdata import referenced_tables as referenced_tables  # noqa: F401
 
 __all__ = [
     "VERDICTS",
     "TESTABLE_VERDICTS",
-    "KINDS",
-    "ERRATUM_KINDS",
+    "FINDING_VERDICTS",
     "SCORED_ERRATUM_KINDS",
     "CLAIM_COLUMNS",
     "ERRATA_COLUMNS",
     "RECONSTRUCTION_COLUMNS",
     "FINDING_COLUMNS",
     "EVIDENCE_COLUMNS",
-    "ClaimEntry",
+    "NOMINAL",
     "Judgement",
-    "PaperData",
-    "load_claims",
-    "load_paper_data",
-    "paper_dir",
-    "referenced_tables",
     "read_evidence",
     "evidence_frame",
     "erratum_evidence",
     "lookup",
+    "variant_key",
+    "split_variants",
     "agrees",
     "judge",
     "claims_table",
@@ -87,8 +70,8 @@ __all__ = [
 VERDICTS = ("reproduced", "conditional", "differs", "erratum", "not_checkable", "not_identifiable", "context")
 # the verdicts that score a reproduction; the other three are kept for transparency only
 TESTABLE_VERDICTS = ("reproduced", "conditional", "differs", "erratum")
-KINDS = ("numeric", "boolean", "not_checkable", "not_identifiable", "context")
-ERRATUM_KINDS = ("equation", "prose", "notation", "typesetting")
+# the verdicts on our own findings (a failing finding must be rewritten)
+FINDING_VERDICTS = ("holds", "conditional", "fails")
 # only errors of substance count as errata in the scorecard; notation and typesetting are listed
 SCORED_ERRATUM_KINDS = ("equation", "prose")
 CLAIM_COLUMNS = ["paper", "claim_id", "statement", "paper_value", "reproduced_value", "tolerance", "verdict",
@@ -97,269 +80,38 @@ CLAIM_COLUMNS = ["paper", "claim_id", "statement", "paper_value", "reproduced_va
 ERRATA_COLUMNS = ["paper", "erratum_id", "location", "printed", "corrected", "demonstration", "residual_printed",
                   "residual_corrected", "kind", "impact"]
 RECONSTRUCTION_COLUMNS = ["paper", "key", "value", "reason", "sensitivity", "range"]
-FINDING_COLUMNS = ["paper", "finding_id", "statement", "evidence", "table", "figure"]
+FINDING_COLUMNS = ["paper", "finding_id", "statement", "evidence", "table", "figure", "verdict", "robust", "condition",
+                   "rule", "evidence_quantities", "depends_on", "prior_work", "known", "cause_variant"]
 EVIDENCE_COLUMNS = ["quantity", "variant", "value", "note"]
 NOMINAL = "nominal"
 _UNTESTABLE_KIND_VERDICT = {"not_checkable": "not_checkable", "not_identifiable": "not_identifiable",
                             "context": "context"}
 _EPS = 2.0 ** -52
-_SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "paper"
-_PAPERS_DIR = Path(__file__).resolve().parent / "papers"
-DATA_FILES = ("claims", "errata", "reconstructions", "findings")
-
-
-@dataclass(frozen=True)
-class ClaimEntry:
-    """One claim of a paper, as its data file states it.
-
-    Attributes
-    ----------
-    claim_id : str
-        Identifier, unique within the paper.
-    location : dict
-        Where the paper states it (``section``, ``equation``, ``figure``, ``page``, ...).
-    statement : str
-        The paper's statement, quoted.
-    kind : str
-        One of :data:`KINDS`.
-    paper_value : float, bool or None
-        The paper's value (None for untestable kinds).
-    tolerance : float
-        Absolute, or relative to ``|paper_value|`` when ``relative``.
-    relative : bool
-        Whether ``tolerance`` is relative.
-    tolerance_reason : str
-        Why this tolerance (or decision rule), fixed before and independently of our value.
-    ours : dict
-        Where our value comes from: ``{quantity}`` (the evidence table) or ``{table, column, where}``.
-    depends_on : tuple of str
-        Reconstruction keys the value depends on.
-    erratum_id : str
-        The erratum that explains a disagreement, if any.
-    group : str
-        The claim group of the replication summary.
-    test : str
-        For statistical verdicts: the test, its sample size and significance level.
-    nominal : str
-        The setting of the nominal value, as named in a condition.
-    at : dict
-        The paper's settings of the claim (e.g. ``{"p": 0.04, "q": 0.65}``), read by the evidence step.
-    """
-
-    claim_id: str
-    location: dict
-    statement: str
-    kind: str
-    paper_value: object = None
-    tolerance: float = 0.0
-    relative: bool = False
-    tolerance_reason: str = ""
-    ours: dict = field(default_factory=dict)
-    depends_on: tuple = ()
-    erratum_id: str = ""
-    note: str = ""
-    group: str = ""
-    test: str = ""
-    nominal: str = ""
-    at: dict = field(default_factory=dict)
-
-    @property
-    def location_text(self) -> str:
-        return ", ".join(f"{k} {v}" for k, v in self.location.items())
+# a declared-range variant label: "<key>=<value>" or "<key>: <anything>" (spaces around '=' allowed)
+_VARIANT_LABEL = re.compile(r"^\s*([A-Za-z0-9_.-]+)\s*(?:=|:)")
 
 
 @dataclass(frozen=True)
 class Judgement:
-    """The verdict on one claim.
+    """The verdict on one claim or finding.
 
     Attributes
     ----------
     verdict : str
-        One of :data:`VERDICTS`.
+        One of :data:`VERDICTS` (claims) or :data:`FINDING_VERDICTS` (findings).
     robust : str
-        ``yes`` when the verdict holds across every variant, ``no`` when it changes, ``""`` when
-        the claim depends on nothing that could be varied.
+        ``yes`` when the verdict holds across every declared variant, ``no`` when it changes,
+        ``""`` when the entry has no declared variant.
     condition : str
-        For ``conditional``: where the claim holds and where it does not.
+        For ``conditional``: where it holds and where it does not.
+    readings : tuple of str
+        Labels of the variants that are re-readings (outside every declared range): listed, not judged.
     """
 
     verdict: str
     robust: str
     condition: str
-
-
-@dataclass(frozen=True)
-class PaperData:
-    """The four data files of one paper, validated and cross-checked."""
-
-    slug: str
-    claims: list
-    errata: list
-    reconstructions: list
-    findings: list
-
-
-def paper_dir(slug: str) -> Path:
-    return _PAPERS_DIR / slug
-
-
-def _read_yaml_list(path: Path) -> list:
-    try:
-        data = load_yaml(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML: {exc}") from None
-    return [] if data is None else data
-
-
-def _schema_errors(path: Path, kind: str, data) -> None:
-    """Raise a ConfigError naming file, entry and field for the first schema violations."""
-    import jsonschema
-
-    schema = load_yaml((_SCHEMA_DIR / f"{kind}.schema.yaml").read_text())
-    validator = jsonschema.Draft202012Validator(schema)
-    errors = sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
-    if not errors:
-        return
-    lines = []
-    for err in errors[:5]:
-        parts = list(err.absolute_path)
-        if not parts:
-            lines.append(f"{path}: {err.message} (expected a list of entries)")
-            continue
-        index, fields = parts[0], [str(p) for p in parts[1:]]
-        entry = data[index] if isinstance(data, list) and isinstance(index, int) else None
-        ident = entry.get("id", entry.get("key", "?")) if isinstance(entry, dict) else "?"
-        if err.validator == "required":
-            missing = err.message.split("'")[1] if err.message.count("'") >= 2 else "?"
-            fields, message = fields + [missing], "is required"
-        elif err.validator == "additionalProperties":
-            extra = sorted(set(err.instance) - set(err.schema.get("properties", {})))
-            fields, message = fields + [",".join(extra)], "is not a known field (a typo?)"
-        else:
-            message = err.message
-        lines.append(f"{path}: entry {index} (id {ident!r}): field {'.'.join(fields) or '<entry>'!r} {message}")
-    raise ConfigError("\n  ".join(lines))
-
-
-def _problem(path: Path, where: str, field_name: str, what: str) -> ConfigError:
-    return ConfigError(f"{path}: {where}: field {field_name!r} {what}")
-
-
-def _entry(path: Path, index: int, raw) -> ClaimEntry:
-    where = f"entry {index} (id {raw.get('id', '?')!r})"
-    kind = raw["kind"]
-    tol = raw.get("tolerance")
-    if kind in ("numeric", "boolean"):
-        if "paper_value" not in raw:
-            raise _problem(path, where, "paper_value", f"is required for kind {kind!r}")
-        ours = raw.get("ours")
-        if not isinstance(ours, dict) or not (ours.get("quantity") or (ours.get("table") and ours.get("column"))):
-            raise _problem(path, where, "ours", "must name an evidence quantity, or a table and column")
-        if not isinstance(tol, dict) or not str(tol.get("reason", "")).strip():
-            raise _problem(path, where, "tolerance.reason", "is required: why this tolerance, fixed in advance")
-    if kind == "numeric":
-        if not isinstance(tol.get("value"), (int, float)):
-            raise _problem(path, where, "tolerance.value", "is required for kind 'numeric'")
-        if not isinstance(raw["paper_value"], (int, float)) or isinstance(raw["paper_value"], bool):
-            raise _problem(path, where, "paper_value", "must be a number for kind 'numeric'")
-    if kind == "boolean" and not isinstance(raw["paper_value"], bool):
-        raise _problem(path, where, "paper_value", "must be true or false for kind 'boolean'")
-    tol = tol if isinstance(tol, dict) else {}
-    return ClaimEntry(
-        claim_id=str(raw["id"]), location=dict(raw["location"]), statement=str(raw["statement"]).strip(), kind=kind,
-        paper_value=raw.get("paper_value"), tolerance=float(tol.get("value", 0.0)),
-        relative=bool(tol.get("relative", False)), tolerance_reason=str(tol.get("reason", "")).strip(),
-        ours=dict(raw.get("ours", {})), depends_on=tuple(raw.get("depends_on", ())),
-        erratum_id=str(raw.get("erratum_id", "")), note=str(raw.get("note", "")).strip(),
-        group=str(raw.get("group", "")), test=str(raw.get("test", "")).strip(), nominal=str(raw.get("nominal", "")),
-        at=dict(raw.get("at") or {}))
-
-
-def _unique(path: Path, ids) -> None:
-    seen = set()
-    for ident in ids:
-        if ident in seen:
-            raise ConfigError(f"{path}: duplicate id {ident!r}")
-        seen.add(ident)
-
-
-def load_claims(path: str | Path) -> list[ClaimEntry]:
-    """Read and validate a paper's ``claims.yaml``.
-
-    Parameters
-    ----------
-    path : str or Path
-        The data file.
-
-    Returns
-    -------
-    list of ClaimEntry
-        In file order.
-
-    Raises
-    ------
-    ConfigError
-        Naming the file, the entry (index and id) and the field, for a malformed file.
-    """
-    path = Path(path)
-    data = _read_yaml_list(path)
-    _schema_errors(path, "claims", data)
-    entries = [_entry(path, i, raw) for i, raw in enumerate(data)]
-    _unique(path, [e.claim_id for e in entries])
-    return entries
-
-
-def _load_list(path: Path, kind: str) -> list[dict]:
-    if not path.is_file():
-        return []
-    data = _read_yaml_list(path)
-    _schema_errors(path, kind, data)
-    _unique(path, [d.get("id", d.get("key")) for d in data])
-    return data
-
-
-def load_paper_data(slug: str, root: str | Path | None = None) -> PaperData:
-    """Read, validate and cross-check the data files of one paper.
-
-    Parameters
-    ----------
-    slug : str
-        The paper.
-    root : str or Path, optional
-        The directory holding the files (default: the paper's package).
-
-    Raises
-    ------
-    ConfigError
-        For a malformed file, a ``depends_on`` that names no reconstruction, or an
-        ``erratum_id`` that names no erratum.
-    """
-    root = Path(root) if root is not None else paper_dir(slug)
-    claims_path = root / "claims.yaml"
-    claims = load_claims(claims_path)
-    errata = _load_list(root / "errata.yaml", "errata")
-    reconstructions = _load_list(root / "reconstructions.yaml", "reconstructions")
-    findings = _load_list(root / "findings.yaml", "findings")
-    keys = {r["key"] for r in reconstructions}
-    errata_ids = {e["id"] for e in errata}
-    for i, entry in enumerate(claims):
-        where = f"entry {i} (id {entry.claim_id!r})"
-        for dep in entry.depends_on:
-            if dep not in keys:
-                raise _problem(claims_path, where, "depends_on",
-                               f"names {dep!r}, which is not a key of {root / 'reconstructions.yaml'}")
-        if entry.erratum_id and entry.erratum_id not in errata_ids:
-            raise _problem(claims_path, where, "erratum_id", f"names {entry.erratum_id!r}, which is not in errata.yaml")
-    return PaperData(slug, claims, errata, reconstructions, findings)
-
-
-def referenced_tables(slug: str, root: str | Path | None = None) -> list[str]:
-    """The result tables (other than the evidence table) that the paper's claims read."""
-    return _tables_read(load_paper_data(slug, root))
-
-
-def _tables_read(data: PaperData) -> list[str]:
-    return sorted({e.ours["table"] for e in data.claims if e.ours.get("table")})
+    readings: tuple = ()
 
 
 def evidence_frame(rows) -> pd.DataFrame:
@@ -465,68 +217,118 @@ def lookup(ours: dict, tables: dict):
     return rows.iloc[0][column]
 
 
-def agrees(entry: ClaimEntry, value) -> bool:
-    """Whether ``value`` agrees with the paper's value within the entry's pre-set tolerance.
+def variant_key(label: str) -> str | None:
+    """The key of a declared-range variant label, or None for a label of another form.
 
     Parameters
     ----------
-    entry : ClaimEntry
-        A ``numeric`` or ``boolean`` claim.
+    label : str
+        A variant label of the evidence table (or of a claim's ``ours.variants``).
+
+    Returns
+    -------
+    str or None
+        ``<key>`` of ``<key>=<value>`` or ``<key>: <anything>``; None if the label has neither form
+        (e.g. ``"last k only (k=60)"``, ``"agent 0, H=200"``).
+    """
+    match = _VARIANT_LABEL.match(str(label))
+    return match.group(1) if match else None
+
+
+def split_variants(depends_on, variants: dict | None) -> tuple[dict, dict]:
+    """Split variant values into those that decide a verdict and the re-readings.
+
+    Parameters
+    ----------
+    depends_on : sequence of str
+        The entry's reconstruction keys (whose declared ranges re-judge it).
+    variants : dict or None
+        ``{label: value}``.
+
+    Returns
+    -------
+    declared : dict
+        ``{label: value}`` whose label's key (:func:`variant_key`) is in ``depends_on``: they decide.
+    readings : dict
+        The others: re-readings, listed in the note, deciding nothing.
+    """
+    keys = set(depends_on)
+    declared, readings = {}, {}
+    for label, value in (variants or {}).items():
+        (declared if variant_key(label) in keys else readings)[label] = value
+    return declared, readings
+
+
+def agrees(entry, value) -> bool:
+    """Whether ``value`` agrees with the entry's expected value within its pre-set tolerance.
+
+    Parameters
+    ----------
+    entry : ClaimEntry or FindingEntry
+        A ``numeric`` or ``boolean`` claim (held against the paper's value) or finding (held
+        against what it asserts).
     value : float or bool
         Our value.
 
     Returns
     -------
     bool
-        For booleans, equality; for numbers, ``|ours - paper| <= tolerance`` (times ``|paper|`` if
-        relative), with NaN or infinite values never agreeing.
+        For booleans, equality; for numbers, ``|ours - expected| <= tolerance`` (times
+        ``|expected|`` if relative), with NaN or infinite values never agreeing.
     """
     if entry.kind == "boolean":
-        return bool(value) == bool(entry.paper_value)
-    ours, paper = float(value), float(entry.paper_value)
-    scale = abs(paper) if entry.relative else 1.0
-    # paper values and tolerances are decimals that binary floats hold only to an ulp: the edge
-    # |ours - paper| == tolerance must not depend on which way the subtraction rounds
-    slack = 8 * _EPS * max(abs(ours), abs(paper), entry.tolerance * scale)
-    return math.isfinite(ours) and abs(ours - paper) <= entry.tolerance * scale + slack
+        return bool(value) == bool(entry.expected)
+    ours, expected = float(value), float(entry.expected)
+    scale = abs(expected) if entry.relative else 1.0
+    # expected values and tolerances are decimals that binary floats hold only to an ulp: the edge
+    # |ours - expected| == tolerance must not depend on which way the subtraction rounds
+    slack = 8 * _EPS * max(abs(ours), abs(expected), entry.tolerance * scale)
+    return math.isfinite(ours) and abs(ours - expected) <= entry.tolerance * scale + slack
 
 
-def judge(entry: ClaimEntry, value=None, variants: dict | None = None) -> Judgement:
-    """The verdict on a claim: one function for every paper.
+def judge(entry, value=None, variants: dict | None = None) -> Judgement:
+    """The verdict on a claim or a finding: one function for every paper.
 
     Parameters
     ----------
-    entry : ClaimEntry
-        The paper's side of the claim.
+    entry : ClaimEntry or FindingEntry
+        The paper's side of a claim, or our finding.
     value : float or bool, optional
         Our value at the configured (nominal) settings; unused for untestable kinds.
     variants : dict, optional
-        ``{label: value}``: our value across the range of the reconstructions and settings the
-        claim depends on (e.g. ``{"horizon=200": 0.8, "horizon=800": 1.2}``).
+        ``{label: value}``: our value across variants. Only the labels ``<key>=...`` or
+        ``<key>: ...`` with ``<key>`` in ``entry.depends_on`` decide (:func:`split_variants`,
+        e.g. ``{"horizon=200": 0.8, "horizon=800": 1.2}``); the others are re-readings, returned
+        in ``readings`` and judged nowhere.
 
     Returns
     -------
     Judgement
-        ``not_checkable`` / ``not_identifiable`` / ``context`` for those kinds; otherwise
-        ``reproduced`` when ours agrees at the nominal settings and at every variant;
+        Claims: ``not_checkable`` / ``not_identifiable`` / ``context`` for those kinds; otherwise
+        ``reproduced`` when ours agrees at the nominal settings and at every declared variant;
         ``conditional`` when it agrees at some but not all (the condition lists where it holds);
         ``erratum`` when it disagrees everywhere and the entry names an erratum; else ``differs``.
+        Findings: ``holds``, ``conditional`` (with its condition) or ``fails``, likewise.
     """
-    if entry.kind in _UNTESTABLE_KIND_VERDICT:
+    finding = isinstance(entry, FindingEntry)
+    if not finding and entry.kind in _UNTESTABLE_KIND_VERDICT:
         return Judgement(_UNTESTABLE_KIND_VERDICT[entry.kind], "", "")
+    declared, readings = split_variants(entry.depends_on, variants)
     nominal = agrees(entry, value)
-    outcomes = {label: agrees(entry, v) for label, v in (variants or {}).items()}
+    outcomes = {label: agrees(entry, v) for label, v in declared.items()}
     robust = "" if not outcomes else ("yes" if all(o == nominal for o in outcomes.values()) else "no")
     if nominal and robust != "no":
-        return Judgement("reproduced", robust, "")
+        return Judgement("holds" if finding else "reproduced", robust, "", tuple(readings))
     nominal_label = entry.nominal or "nominal settings"
     holds = ([nominal_label] if nominal else []) + [label for label, ok in outcomes.items() if ok]
     fails = ([] if nominal else [nominal_label]) + [label for label, ok in outcomes.items() if not ok]
     if holds:
-        return Judgement("conditional", robust, _condition_text(holds, fails))
+        return Judgement("conditional", robust, _condition_text(holds, fails), tuple(readings))
+    if finding:
+        return Judgement("fails", robust, "", tuple(readings))
     if entry.erratum_id:
-        return Judgement("erratum", robust, "")
-    return Judgement("differs", robust, "")
+        return Judgement("erratum", robust, "", tuple(readings))
+    return Judgement("differs", robust, "", tuple(readings))
 
 
 _LISTED = 6  # settings named in a condition on each side; the note lists every setting with its value
@@ -552,23 +354,51 @@ def _fmt_tolerance(entry: ClaimEntry) -> str:
     return f"{entry.tolerance:g} (relative)" if entry.relative else f"{entry.tolerance:g}"
 
 
+def _evidence_rows(kind: str, slug: str, ident: str, evidence: dict, name: str) -> dict:
+    if name not in evidence:
+        raise InputError(f"{kind} {slug}/{ident}: quantity {name!r} is not in results/evidence/{slug}.csv "
+                         "(the paper's evidence step must produce it)")
+    rows = evidence[name]
+    if NOMINAL not in rows:
+        raise InputError(f"{kind} {slug}/{ident}: quantity {name!r} has no {NOMINAL!r} row")
+    return rows
+
+
 def _our_value(entry: ClaimEntry, tables: dict, evidence: dict, slug: str):
     """(nominal value, note, {variant label: value}) of a testable claim."""
     ours = entry.ours
     if ours.get("quantity"):
-        name = ours["quantity"]
-        if name not in evidence:
-            raise InputError(f"claim {slug}/{entry.claim_id}: quantity {name!r} is not in results/evidence/{slug}.csv "
-                             "(the paper's evidence step must produce it)")
-        rows = evidence[name]
-        if NOMINAL not in rows:
-            raise InputError(f"claim {slug}/{entry.claim_id}: quantity {name!r} has no {NOMINAL!r} row")
+        rows = _evidence_rows("claim", slug, entry.claim_id, evidence, ours["quantity"])
         value, note = rows[NOMINAL]
         return value, note, {label: v for label, (v, _) in rows.items() if label != NOMINAL}
     value = lookup(ours, tables)
     variants = {label: lookup(dict(ours, where={**(ours.get("where") or {}), **override}), tables)
                 for label, override in (ours.get("variants") or {}).items()}
     return value, "", variants
+
+
+def _require_declared(kind: str, slug: str, ident: str, depends_on: tuple, variants: dict) -> None:
+    """An entry that depends on declared ranges must be re-judged across at least one of them."""
+    declared, readings = split_variants(depends_on, variants)
+    if depends_on and not declared:
+        also = f" (its variants {list(readings)} are re-readings: no label '<key>=...' with a key of depends_on)" \
+            if readings else ""
+        raise InputError(f"{kind} {slug}/{ident} depends on {list(depends_on)} but has no variants across their "
+                         f"declared range{also}: re-judge it with variant rows labelled '<key>=<value>' "
+                         "(evidence rows or ours.variants)")
+
+
+def _variants_note(entry, variants: dict, outcome_words: tuple) -> str:
+    """The note's account of the variants: the declared range, then the re-readings with their outcome."""
+    declared, readings = split_variants(entry.depends_on, variants)
+    parts = []
+    if declared:
+        parts.append("across the range: " + "; ".join(f"{label}: {_fmt_cell(v)}" for label, v in declared.items()))
+    if readings:
+        yes, no = outcome_words
+        parts.append("re-readings (outside any declared range; they decide nothing): " + "; ".join(
+            f"{label}: {_fmt_cell(v)} ({yes if agrees(entry, v) else no})" for label, v in readings.items()))
+    return "; ".join(parts)
 
 
 def _plain(value):
@@ -588,10 +418,15 @@ def claims_table(data: PaperData, tables: dict, evidence: dict) -> pd.DataFrame:
     evidence : dict
         From :func:`read_evidence`.
 
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`CLAIM_COLUMNS`, one row per claim in file order.
+
     Raises
     ------
     InputError
-        When a claim that depends on a reconstruction has no variants to be re-judged on, or
+        When a claim that depends on a reconstruction has no variant across its declared range, or
         names a quantity the evidence step did not produce.
     """
     rows = []
@@ -599,15 +434,12 @@ def claims_table(data: PaperData, tables: dict, evidence: dict) -> pd.DataFrame:
         value, ev_note, variants = (None, "", {})
         if entry.kind in ("numeric", "boolean"):
             value, ev_note, variants = _our_value(entry, tables, evidence, data.slug)
-            if entry.depends_on and not variants:
-                raise InputError(f"claim {data.slug}/{entry.claim_id} depends on {list(entry.depends_on)} but has no "
-                                 "variants: re-judge it across their range (evidence rows or ours.variants)")
+            _require_declared("claim", data.slug, entry.claim_id, entry.depends_on, variants)
         elif entry.ours.get("quantity") in evidence:
             ev_note = evidence[entry.ours["quantity"]].get(NOMINAL, (None, ""))[1]
         result = judge(entry, value, variants)
         if variants:
-            shown = "; ".join(f"{label}: {_fmt_cell(v)}" for label, v in variants.items())
-            ev_note = "; ".join(x for x in (ev_note, f"across the range: {shown}") if x)
+            ev_note = "; ".join(x for x in (ev_note, _variants_note(entry, variants, ("agrees", "disagrees"))) if x)
         rows.append({
             "paper": data.slug, "claim_id": entry.claim_id, "statement": entry.statement,
             "paper_value": entry.paper_value if entry.paper_value is not None else "",
@@ -630,7 +462,20 @@ def _fmt_cell(value) -> str:
 
 
 def errata_table(data: PaperData, evidence: dict) -> pd.DataFrame:
-    """Table ``results/errata/<slug>.csv``; residuals from the evidence quantities ``<id>.residual_*``."""
+    """Table ``results/errata/<slug>.csv``; residuals from the evidence quantities ``<id>.residual_*``.
+
+    Parameters
+    ----------
+    data : PaperData
+        The paper's data files.
+    evidence : dict
+        From :func:`read_evidence`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`ERRATA_COLUMNS`.
+    """
     rows = []
     for e in data.errata:
         printed = evidence.get(f"{e['id']}.residual_printed", {}).get(NOMINAL, ("", ""))
@@ -644,7 +489,20 @@ def errata_table(data: PaperData, evidence: dict) -> pd.DataFrame:
 
 
 def reconstructions_table(data: PaperData, evidence: dict) -> pd.DataFrame:
-    """Table ``results/reconstructions/<slug>.csv``; value and sensitivity from ``reconstruction.<key>``."""
+    """Table ``results/reconstructions/<slug>.csv``; value and sensitivity from ``reconstruction.<key>``.
+
+    Parameters
+    ----------
+    data : PaperData
+        The paper's data files.
+    evidence : dict
+        From :func:`read_evidence`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`RECONSTRUCTION_COLUMNS`.
+    """
     rows = []
     for r in data.reconstructions:
         value, sensitivity = evidence.get(f"reconstruction.{r['key']}", {}).get(NOMINAL, (None, ""))
@@ -656,27 +514,84 @@ def reconstructions_table(data: PaperData, evidence: dict) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=RECONSTRUCTION_COLUMNS)
 
 
+def _fmt_rule(entry: FindingEntry) -> str:
+    if entry.kind == "boolean":
+        return f"{str(entry.asserted).lower()}, exact: {entry.rule_reason}"
+    within = f"{entry.tolerance:g}" + (" (relative)" if entry.relative else "")
+    return f"{entry.asserted:g} within {within}: {entry.rule_reason}"
+
+
 def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
-    """Table ``results/findings/<slug>.csv``: our discoveries, with their evidence."""
+    """Table ``results/findings/<slug>.csv``: our findings, judged by :func:`judge` like claims.
+
+    Parameters
+    ----------
+    data : PaperData
+        The paper's data files.
+    evidence : dict
+        From :func:`read_evidence`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`FINDING_COLUMNS`: the verdict (``holds``, ``conditional``, ``fails``),
+        ``robust`` and the condition; the evidence text holds the judged quantity's value and note,
+        the declared variants, the re-readings and the other evidence quantities' values.
+
+    Raises
+    ------
+    InputError
+        Naming the finding and the quantity, when a quantity it rests on (``quantity``,
+        ``evidence_quantities``) or its cause variant is not in the evidence table, or when it
+        depends on a reconstruction and has no variant across its declared range.
+    """
     rows = []
     for f in data.findings:
-        text = str(f.get("evidence", "")).strip()
-        if f.get("quantity"):
-            if f["quantity"] not in evidence:
-                raise InputError(f"finding {data.slug}/{f['id']}: quantity {f['quantity']!r} is not in the evidence table")
-            value, note = evidence[f["quantity"]][NOMINAL]
-            text = "; ".join(x for x in (text, f"{_fmt_cell(value)}" if value != "" else "", note) if x)
-        rows.append({"paper": data.slug, "finding_id": f["id"], "statement": f["statement"].strip(), "evidence": text,
-                     "table": f["table"], "figure": f.get("figure", "")})
-    return pd.DataFrame(rows, columns=FINDING_COLUMNS)
+        rows_q = _evidence_rows("finding", data.slug, f.finding_id, evidence, f.quantity)
+        for name in f.evidence_quantities:
+            if name not in evidence:
+                raise InputError(f"finding {data.slug}/{f.finding_id}: evidence quantity {name!r} is not in "
+                                 f"results/evidence/{data.slug}.csv (the paper's evidence step must produce it)")
+        cause = f.cause.get("variant", "")
+        if cause and cause not in evidence and cause not in rows_q:
+            raise InputError(f"finding {data.slug}/{f.finding_id}: cause variant {cause!r} is neither an evidence "
+                             f"quantity nor a variant of {f.quantity!r}")
+        value, note = rows_q[NOMINAL]
+        variants = {label: v for label, (v, _) in rows_q.items() if label != NOMINAL}
+        _require_declared("finding", data.slug, f.finding_id, f.depends_on, variants)
+        result = judge(f, value, variants)
+        others = "; ".join(f"{q}: {_fmt_cell(evidence[q].get(NOMINAL, ('', ''))[0])}"
+                           for q in f.evidence_quantities[1:])
+        text = "; ".join(x for x in (f.evidence, _fmt_cell(value) if value != "" else "", note,
+                                     _variants_note(f, variants, ("holds", "fails")),
+                                     f"also rests on {others}" if others else "") if x)
+        rows.append({"paper": data.slug, "finding_id": f.finding_id, "statement": f.statement, "evidence": text,
+                     "table": f.table, "figure": f.figure, "verdict": result.verdict, "robust": result.robust,
+                     "condition": result.condition, "rule": _fmt_rule(f),
+                     "evidence_quantities": ", ".join(f.evidence_quantities), "depends_on": ", ".join(f.depends_on),
+                     "prior_work": f.prior_work, "known": "yes" if f.known else "no", "cause_variant": cause})
+    frame = pd.DataFrame(rows, columns=FINDING_COLUMNS)
+    assert set(frame["verdict"]) <= set(FINDING_VERDICTS)
+    return frame
 
 
 def verdicts_step(params, inputs, outputs):
     """Step of rule ``<slug>_claims``: the claims, errata, reconstructions and findings tables.
 
-    ``params``: ``{"slug": ...}``; ``inputs``: ``evidence`` (the paper's evidence table),
-    ``tables`` (the result tables its claims read) and the data files; outputs ``table``
-    (claims), ``errata``, ``reconstructions``, ``findings``.
+    Parameters
+    ----------
+    params : dict
+        ``{"slug": ...}``.
+    inputs : dict
+        ``evidence`` (the paper's evidence table), ``tables`` (the result tables its claims read)
+        and the data files (``claims_file``, ...).
+    outputs : dict
+        ``table`` (claims), ``errata``, ``reconstructions``, ``findings``.
+
+    Returns
+    -------
+    dict
+        ``{output name: DataFrame}``.
     """
     slug = params["slug"]
     data = load_paper_data(slug, Path(inputs["claims_file"]).parent)
@@ -684,7 +599,7 @@ def verdicts_step(params, inputs, outputs):
     paths = inputs.get("tables", [])
     paths = [paths] if isinstance(paths, (str, Path)) else list(paths)
     tables = {str(p): pd.read_csv(p) for p in paths}
-    missing = set(_tables_read(data)) - set(tables)
+    missing = set(data.tables_read()) - set(tables)
     if missing:
         raise InputError(f"claims of {slug} read tables that are not inputs of the rule: {sorted(missing)}")
     return {"table": claims_table(data, tables, evidence), "errata": errata_table(data, evidence),
