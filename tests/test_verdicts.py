@@ -230,11 +230,14 @@ def test_a_flip_across_the_reconstruction_range_is_conditional(tmp_path):
 
 
 def test_a_claim_that_depends_on_a_reconstruction_needs_variants_of_its_range(tmp_path):
-    data = load_paper_data("p", write_paper(tmp_path))
+    data = load_paper_data("p", write_paper(tmp_path, claims=[("erratum_id: E1", "erratum_id: E1\n  depends_on: [horizon]")]))
     rows = [r for r in EVIDENCE if r.get("variant") in (None, "limit k->inf")]
-    with pytest.raises(InputError, match=r"claim p/C1 depends on \['horizon'\] but has no variants across their "
-                                         r"declared range \(its variants \['limit k->inf'\] are re-readings"):
+    with pytest.raises(InputError) as info:
         claims_table(data, TABLES, evidence(rows))
+    lines = str(info.value).splitlines()  # every such claim in one error
+    assert lines[0] == ("claim p/C1 depends on ['horizon'] but has no variants across their declared range "
+                        "(its variants ['limit k->inf'] are re-readings: no label '<key>=...' with a key of depends_on)")
+    assert lines[1].strip() == "claim p/C3 depends on ['horizon'] but has no variants across their declared range"
     with pytest.raises(InputError, match="quantity 'gain' is not in"):
         claims_table(data, TABLES, evidence([r for r in EVIDENCE if r["quantity"] != "gain"]))
 

@@ -377,15 +377,22 @@ def _our_value(entry: ClaimEntry, tables: dict, evidence: dict, slug: str):
     return value, "", variants
 
 
-def _require_declared(kind: str, slug: str, ident: str, depends_on: tuple, variants: dict) -> None:
-    """An entry that depends on declared ranges must be re-judged across at least one of them."""
+def _undeclared(kind: str, slug: str, ident: str, depends_on: tuple, variants: dict) -> str:
+    """The problem of an entry that depends on declared ranges but is re-judged across none ("" if none)."""
     declared, readings = split_variants(depends_on, variants)
-    if depends_on and not declared:
-        also = f" (its variants {list(readings)} are re-readings: no label '<key>=...' with a key of depends_on)" \
-            if readings else ""
-        raise InputError(f"{kind} {slug}/{ident} depends on {list(depends_on)} but has no variants across their "
-                         f"declared range{also}: re-judge it with variant rows labelled '<key>=<value>' "
-                         "(evidence rows or ours.variants)")
+    if not depends_on or declared:
+        return ""
+    also = f" (its variants {list(readings)} are re-readings: no label '<key>=...' with a key of depends_on)" \
+        if readings else ""
+    return f"{kind} {slug}/{ident} depends on {list(depends_on)} but has no variants across their declared range{also}"
+
+
+def _raise_undeclared(problems: list) -> None:
+    """One error naming every entry that is not re-judged across its declared range."""
+    problems = [p for p in problems if p]
+    if problems:
+        raise InputError("\n  ".join(problems) + "\n  Re-judge each across the declared range of its depends_on: "
+                         "variant rows labelled '<key>=<value>' or '<key>: ...' (evidence rows or ours.variants)")
 
 
 def _variants_note(entry, variants: dict, outcome_words: tuple) -> str:
@@ -429,12 +436,12 @@ def claims_table(data: PaperData, tables: dict, evidence: dict) -> pd.DataFrame:
         When a claim that depends on a reconstruction has no variant across its declared range, or
         names a quantity the evidence step did not produce.
     """
-    rows = []
+    rows, problems = [], []
     for entry in data.claims:
         value, ev_note, variants = (None, "", {})
         if entry.kind in ("numeric", "boolean"):
             value, ev_note, variants = _our_value(entry, tables, evidence, data.slug)
-            _require_declared("claim", data.slug, entry.claim_id, entry.depends_on, variants)
+            problems.append(_undeclared("claim", data.slug, entry.claim_id, entry.depends_on, variants))
         elif entry.ours.get("quantity") in evidence:
             ev_note = evidence[entry.ours["quantity"]].get(NOMINAL, (None, ""))[1]
         result = judge(entry, value, variants)
@@ -450,6 +457,7 @@ def claims_table(data: PaperData, tables: dict, evidence: dict) -> pd.DataFrame:
             "erratum_id": entry.erratum_id if result.verdict == "erratum" else "", "group": entry.group,
             "test": entry.test,
         })
+    _raise_undeclared(problems)
     frame = pd.DataFrame(rows, columns=CLAIM_COLUMNS)
     assert set(frame["verdict"]) <= set(VERDICTS)
     return frame
@@ -517,8 +525,8 @@ def reconstructions_table(data: PaperData, evidence: dict) -> pd.DataFrame:
 def _fmt_rule(entry: FindingEntry) -> str:
     if entry.kind == "boolean":
         return f"{str(entry.asserted).lower()}, exact: {entry.rule_reason}"
-    within = f"{entry.tolerance:g}" + (" (relative)" if entry.relative else "")
-    return f"{entry.asserted:g} within {within}: {entry.rule_reason}"
+    within = f"{entry.tolerance:.15g}" + (" (relative)" if entry.relative else "")
+    return f"{entry.asserted:.15g} within {within}: {entry.rule_reason}"
 
 
 def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
@@ -545,7 +553,7 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
         ``evidence_quantities``) or its cause variant is not in the evidence table, or when it
         depends on a reconstruction and has no variant across its declared range.
     """
-    rows = []
+    rows, problems = [], []
     for f in data.findings:
         rows_q = _evidence_rows("finding", data.slug, f.finding_id, evidence, f.quantity)
         for name in f.evidence_quantities:
@@ -558,7 +566,7 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
                              f"quantity nor a variant of {f.quantity!r}")
         value, note = rows_q[NOMINAL]
         variants = {label: v for label, (v, _) in rows_q.items() if label != NOMINAL}
-        _require_declared("finding", data.slug, f.finding_id, f.depends_on, variants)
+        problems.append(_undeclared("finding", data.slug, f.finding_id, f.depends_on, variants))
         result = judge(f, value, variants)
         others = "; ".join(f"{q}: {_fmt_cell(evidence[q].get(NOMINAL, ('', ''))[0])}"
                            for q in f.evidence_quantities[1:])
@@ -570,6 +578,7 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
                      "condition": result.condition, "rule": _fmt_rule(f),
                      "evidence_quantities": ", ".join(f.evidence_quantities), "depends_on": ", ".join(f.depends_on),
                      "prior_work": f.prior_work, "known": "yes" if f.known else "no", "cause_variant": cause})
+    _raise_undeclared(problems)
     frame = pd.DataFrame(rows, columns=FINDING_COLUMNS)
     assert set(frame["verdict"]) <= set(FINDING_VERDICTS)
     return frame
