@@ -102,7 +102,10 @@ def finding(kind="numeric", asserted=3.0, tol=0.5, depends_on=("horizon",)):
 
 
 def test_findings_are_judged_by_the_same_function():
-    assert judge(finding(), 3.4, {"horizon=100": 2.6}) == judge(finding(), 3.4, {"horizon=100": 2.6})
+    # the same decision as for a claim with that value and tolerance, in the findings' vocabulary
+    claim, variants = numeric(tol=0.5, paper=3.0), {"horizon=100": 3.6, "horizon=400": 2.9}
+    assert (judge(claim, 3.4, variants).condition, judge(claim, 3.4, variants).verdict) == (
+        judge(finding(), 3.4, variants).condition, "conditional")
     holds = judge(finding(), 3.4, {"horizon=100": 2.6, "another reading": 9.0})
     assert (holds.verdict, holds.robust, holds.readings) == ("holds", "yes", ("another reading",))
     cond = judge(finding(), 3.4, {"horizon=100": 3.6})
