@@ -221,6 +221,9 @@ def _evidence_quantities(slug: str, pkg: Path, root: Path):
     prefixes = []
     for node in ast.walk(tree):
         if isinstance(node, ast.JoinedStr):
+            fixed = "".join(v.value for v in node.values if isinstance(v, ast.Constant))
+            if len(fixed) < 3:  # f"{name}" could be anything: it proves no quantity
+                continue
             parts = [re.escape(v.value) if isinstance(v, ast.Constant) else ".+" for v in node.values]
             prefixes.append(re.compile("^" + "".join(parts) + "$"))
     return literals, prefixes, "evidence.py"

@@ -48,11 +48,9 @@ def _validate(path: Path, data) -> dict:
     return data
 
 
-@lru_cache(maxsize=None)
-def _load(path: str) -> dict:
+@lru_cache(maxsize=16)
+def _load(path: str, stamp: tuple) -> dict:
     file = Path(path)
-    if not file.is_file():
-        raise ConfigError(f"paper registry {file} not found")
     return _validate(file, yaml.safe_load(file.read_text()))
 
 
@@ -64,7 +62,11 @@ def load_registry(path: str | Path = REGISTRY_FILE) -> dict:
     ConfigError
         When the file is missing, a slug is not a valid identifier, or an entry lacks a field.
     """
-    return _load(str(Path(path).resolve()))
+    file = Path(path).resolve()
+    if not file.is_file():
+        raise ConfigError(f"paper registry {file} not found")
+    stat = file.stat()  # an edited file is read again
+    return dict(_load(str(file), (stat.st_mtime_ns, stat.st_size)))
 
 
 def paper_slugs(path: str | Path = REGISTRY_FILE) -> list[str]:
