@@ -47,6 +47,7 @@ verify: $(STAMP)
 lint: $(STAMP_TEST)
 	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/snakemake --lint
+	$(BIN)/python -m netrepro check-paper
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
 lock: $(STAMP)

@@ -7,7 +7,9 @@ import docutils.core
 import pytest
 
 from netrepro.figurespec import load_figure_specs
-from netrepro.papers import PAPERS
+from netrepro.registry import load_registry
+
+PAPERS = load_registry()
 
 ROOT = Path(__file__).resolve().parents[1]
 CAPTIONS = sorted((ROOT / "workflow" / "report").glob("*/*.rst"))

@@ -15,7 +15,9 @@ import pytest
 
 from netrepro.crate import PROFILES, data_id
 from netrepro.io import sha256_file
-from netrepro.papers import PAPERS
+from netrepro.registry import load_registry
+
+PAPERS = load_registry()
 from netrepro.readme import END, START
 from netrepro.verdicts import TESTABLE_VERDICTS, VERDICTS
 

@@ -21,6 +21,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from netrepro.config import ConfigError, DependencyError, check_dependencies, validate_config
+from netrepro.registry import paper_slugs
 
 ROOT = Path(__file__).resolve().parents[1]
 SLOW_OK = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -218,7 +219,7 @@ def test_property_any_out_of_schema_value_is_refused_and_named(case):
 def test_property_unknown_keys_are_refused_and_named(name, where, value):
     cfg = base()
     node = {"top": cfg, "scalar": cfg["intermittent"]["scalar"], "two_sensor": cfg["intermittent"]["two_sensor"]}[where]
-    if name in node or (where == "top" and name in ("intermittent", "markov", "onebit", "gainsched", "hinf")):
+    if name in node or (where == "top" and name in paper_slugs()):
         return
     node[name] = value
     msg = message_of(cfg)
@@ -228,7 +229,7 @@ def test_property_unknown_keys_are_refused_and_named(name, where, value):
 @SLOW_OK
 @given(st.lists(st.text(min_size=1, max_size=10), min_size=1, max_size=4))
 def test_property_papers_must_be_known_slugs(papers):
-    known = {"intermittent", "markov", "onebit", "gainsched", "hinf"}
+    known = set(paper_slugs())
     cfg = base()
     cfg["papers"] = papers
     if set(papers) <= known and len(set(papers)) == len(papers):

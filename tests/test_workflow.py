@@ -16,6 +16,7 @@ import pytest
 import yaml
 
 from netrepro.verdicts import VERDICTS
+from netrepro.registry import paper_slugs
 
 from .conftest import run_snakemake
 
@@ -55,7 +56,7 @@ def test_report_and_interface_tables(built):
                                            "tolerance", "verdict", "note"]
         assert set(frame["verdict"]) <= set(VERDICTS)
         assert {"location", "condition", "depends_on", "robust"} <= set(frame.columns), claims.name
-    for slug in ("intermittent", "markov", "onebit", "gainsched", "hinf"):
+    for slug in paper_slugs():
         if (built / "results/claims" / f"{slug}.csv").is_file():
             assert (built / "results/findings" / f"{slug}.csv").is_file(), slug
     for table in (built / "results").rglob("*.csv"):

@@ -6,6 +6,9 @@ figures (the paper's and ours), its claims by verdict (every category; testable 
 apart), its errata of substance, findings and reconstructions, read from ``results/claims/``,
 ``results/errata/``, ``results/findings/``, ``results/reconstructions/`` and ``figures/``.
 ``--check`` exits 1 when the README is not what the tables give (for CI or a test).
+
+The figure-targets table between ``<!-- figures:start -->`` and ``<!-- figures:end -->`` is written
+from the paper registry and each paper's ``figures.yaml`` (:func:`figure_table`): it needs no build.
 """
 
 from __future__ import annotations
@@ -16,14 +19,18 @@ from pathlib import Path
 
 import pandas as pd
 
-from .papers import PAPERS
+from .figurespec import load_figure_specs
+from .registry import load_registry
 from .summary import scorecard
 from .verdicts import VERDICTS
 
-__all__ = ["START", "END", "results_table", "rewrite", "main"]
+__all__ = ["START", "END", "FIG_START", "FIG_END", "results_table", "figure_table", "rewrite", "rewrite_figures",
+           "main"]
 
 START = "<!-- results:start (written by `make readme`: python -m netrepro.readme README.md) -->"
 END = "<!-- results:end -->"
+FIG_START = "<!-- figures:start (written by `make readme` from src/netrepro/papers.yaml and each figures.yaml) -->"
+FIG_END = "<!-- figures:end -->"
 
 
 def _rows(path: Path) -> pd.DataFrame | None:
@@ -41,7 +48,8 @@ def results_table(root: str | Path = ".", papers=None) -> str:
     The counts are :func:`netrepro.summary.scorecard`'s, so README and report agree.
     """
     root = Path(root)
-    papers = list(papers or PAPERS)
+    registry = load_registry()
+    papers = list(papers or registry)
     table = {kind: {slug: _rows(root / "results" / kind / f"{slug}.csv") for slug in papers}
              for kind in ("claims", "errata", "findings", "reconstructions")}
     built = {slug: frame for slug, frame in table["claims"].items() if frame is not None}
@@ -55,7 +63,7 @@ def results_table(root: str | Path = ".", papers=None) -> str:
         ours = sum(f.stem.startswith("figS") for f in figs)
         recon = table["reconstructions"][slug]
         n_figs, n_ours, n_recon = n_figs + len(figs) - ours, n_ours + ours, n_recon + (0 if recon is None else len(recon))
-        name = f"`{slug}` {PAPERS.get(slug, {}).get('title', '')}".strip()
+        name = f"`{slug}` {registry.get(slug, {}).get('title', '')}".strip()
         if slug not in score.index:
             cells = [name, f"{len(figs) - ours} + {ours}", "not built", *[""] * (len(head) - 3)]
         else:
@@ -81,6 +89,26 @@ def rewrite(readme: str, table: str) -> str:
     return f"{head}{START}\n{table}\n{END}{tail}"
 
 
+def figure_table(papers=None) -> str:
+    """The Markdown table of figure targets: per registered paper its figure rules and folder."""
+    registry = load_registry()
+    lines = ["| paper | figure rules | files |", "|---|---|---|"]
+    for slug in papers or registry:
+        number = str(registry[slug]["source"]).split("_", 1)[0]
+        rules = ", ".join(f"`{spec.rule}`" for spec in load_figure_specs(slug))
+        lines.append(f"| `{slug}` ({number}) | {rules} | `figures/{slug}/` |")
+    return "\n".join(lines)
+
+
+def rewrite_figures(readme: str, table: str) -> str:
+    """``readme`` with the figure-targets table replaced by ``table`` (unchanged without its markers)."""
+    if FIG_START not in readme or FIG_END not in readme:
+        return readme
+    head, rest = readme.split(FIG_START, 1)
+    _, tail = rest.split(FIG_END, 1)
+    return f"{head}{FIG_START}\n{table}\n{FIG_END}{tail}"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m netrepro.readme", description=__doc__.split("\n")[0])
     parser.add_argument("readme", nargs="?", default="README.md")
@@ -89,10 +117,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     path = Path(args.readme)
     text = path.read_text()
-    new = rewrite(text, results_table(args.root))
+    new = rewrite_figures(rewrite(text, results_table(args.root)), figure_table())
     if args.check:
         if new != text:
-            print(f"{path}: results table out of date; run `make readme`", file=sys.stderr)
+            print(f"{path}: results or figure table out of date; run `make readme`", file=sys.stderr)
             return 1
         return 0
     path.write_text(new)

@@ -1,7 +1,7 @@
 """The original papers, for citing: the report's "Cite the originals" section and CITATION.cff.
 
-The data are in ``references.yaml`` beside this module (titles and authors from the source
-texts). :func:`citation_cff` builds the whole ``CITATION.cff`` (this software, with the papers
+The data are the ``citation`` entries of the paper registry (``papers.yaml``,
+:mod:`netrepro.registry`; titles and authors from the source texts). :func:`citation_cff` builds the whole ``CITATION.cff`` (this software, with the papers
 as ``references``); ``python -m netrepro.references CITATION.cff`` rewrites it, and
 ``tests/test_release_files.py`` checks that the committed file is this output and that it
 validates against the Citation File Format 1.2.0 schema.
@@ -12,15 +12,14 @@ from __future__ import annotations
 import argparse
 import html
 import sys
-from functools import lru_cache
 from pathlib import Path
 
 import yaml
 
+from .registry import REGISTRY_FILE, load_registry
+
 __all__ = ["load_references", "format_reference", "references_html", "cff_reference", "citation_cff",
            "SOFTWARE", "main"]
-
-REFERENCES_FILE = Path(__file__).with_name("references.yaml")
 
 # This software as CITATION.cff describes it (title, licence, version: keep in step with pyproject.toml).
 SOFTWARE = {
@@ -36,14 +35,12 @@ SOFTWARE = {
 }
 
 
-@lru_cache(maxsize=None)
-def _load(path: str) -> dict:
-    return yaml.safe_load(Path(path).read_text())
+def load_references(path: str | Path = REGISTRY_FILE) -> dict:
+    """Slug -> reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``underlying``).
 
-
-def load_references(path: str | Path = REFERENCES_FILE) -> dict:
-    """Slug -> reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``underlying``)."""
-    return _load(str(path))
+    The ``citation`` of every paper of the registry ``path``.
+    """
+    return {slug: entry["citation"] for slug, entry in load_registry(path).items()}
 
 
 def _author(person: dict) -> str:
@@ -115,10 +112,10 @@ def citation_cff() -> dict:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m netrepro.references",
-                                     description="write CITATION.cff from references.yaml")
+                                     description="write CITATION.cff from the paper registry (papers.yaml)")
     parser.add_argument("out", nargs="?", default="CITATION.cff")
     args = parser.parse_args(argv)
-    text = ("# Written by `python -m netrepro.references` from src/netrepro/references.yaml: edit that, not this.\n"
+    text = ("# Written by `python -m netrepro.references` from src/netrepro/papers.yaml: edit that, not this.\n"
             + yaml.safe_dump(citation_cff(), sort_keys=False, allow_unicode=True, width=100))
     Path(args.out).write_text(text)
     print(args.out)

@@ -28,7 +28,7 @@ import pandas as pd
 
 from .errors import ConfigError
 from .io import atomic_path
-from .papers import PAPERS
+from .registry import load_registry
 from .provenance import git_state, package_versions, params_hash, sidecar_path
 from .crate import iso, write_crate
 from .references import references_html
@@ -702,7 +702,7 @@ def _tables_list(paths, ctx) -> str:
 
 
 def _paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict) -> str:
-    meta = PAPERS.get(slug, {})
+    meta = load_registry().get(slug, {})
     root = ctx["root"]
     captions = figure_captions(root, slug)
     figures = sorted((Path(f) for f in spec.get("figures", [])), key=_figure_sort_key)
@@ -787,7 +787,7 @@ def _scorecard_html(score: pd.DataFrame, papers: dict, ctx: dict) -> str:
         bar = "".join(f'<span class="{v}" style="width:{160 * int(row[v]) / n:.1f}px" title="{int(row[v])} {v}"></span>'
                       for v in TESTABLE_VERDICTS if int(row[v]))
         if spec is not None:
-            name = f'<a href="#{slug}">{_esc(PAPERS.get(slug, {}).get("title", slug))}</a> <code>{_esc(slug)}</code>'
+            name = f'<a href="#{slug}">{_esc(load_registry().get(slug, {}).get("title", slug))}</a> <code>{_esc(slug)}</code>'
             recon = _read_csv(spec.get("reconstructions", "")) if spec.get("reconstructions") else None
             figs = spec.get("figures", [])
             extra = (f'<td class="num">{"" if recon is None else len(recon)}</td>'

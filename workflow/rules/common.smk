@@ -12,6 +12,7 @@ try:
     from netrepro.config import check_dependencies, validate_config
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
+    from netrepro.registry import paper_slugs
     from netrepro.reportgen import rule_for, workflow_producers
     from netrepro.verdicts import DATA_FILES, load_paper_data, paper_dir, referenced_tables
 except ImportError as exc:

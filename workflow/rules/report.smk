@@ -16,6 +16,8 @@ rule report:
     input:
         unpack(report_inputs),
         code=code("netrepro.reportgen:build_index"),
+        # titles and citations: a title fix reruns the report, and nothing of any paper
+        registry="src/netrepro/papers.yaml",
     output:
         html="report/index.html",
         files=directory("report/files"),

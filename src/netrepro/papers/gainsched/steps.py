@@ -150,7 +150,7 @@ def design_step(params, inputs, outputs):
         for var, val in sol.values.items():
             for (r, c), x in np.ndenumerate(np.atleast_2d(val)):
                 lmi_rows.append({"problem": name, "variable": var, "row": r, "col": c, "value": float(x)})
-        verdict, slack = decide_point(prob, sol, sys)
+        verdict, slack = _decide_point(prob, sol, sys)
         if not sol.values:
             rows.append({"design": name, "method": "Theorem 3", "status": sol.status, "margin": sol.margin,
                          "objective": sol.objective, "solver_feasible": False, "solve_time_s": sol.solve_time_s,
@@ -209,7 +209,7 @@ def design_step(params, inputs, outputs):
             "provenance": {"solver_status": {k: v.status for k, v in solutions.items()}}}
 
 
-def decide_point(prob, sol, sys):
+def _decide_point(prob, sol, sys):
     """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve), by the shared engine."""
     from .feasibility import necessary_condition
 

@@ -76,7 +76,7 @@ from .stability import classify_growth, decide_estimator, refine_long_horizon
 
 __all__ = [
     "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
-    "sample_paths_step", "expectations_step", "load_moments",
+    "sample_paths_step", "expectations_step", "load_moments", "tight_variants_step",
 ]
 
 

@@ -1,0 +1,386 @@
+"""The paper contract as a command: ``python -m netrepro check-paper SLUG`` (issue 30).
+
+``docs/adding-a-paper.md`` describes the shape every paper has. :func:`check_paper` checks it by
+reading the files (nothing is imported or run), and names the file and line of each violation:
+
+* ``roles``: the package roles, data files, rules file, captions, schema section, registry entry,
+  tests and committed reference tables are present;
+* ``figures-imports``: ``figures.py`` imports neither the model nor the steps;
+* ``math-io``: math modules do no file IO and import no pandas;
+* ``public-api``: every public top-level function is in ``__all__``, and every function of a math
+  module in ``__all__`` has numpydoc sections (``Parameters`` when it takes arguments, ``Returns``
+  or ``Yields`` when it returns a value);
+* ``claim-quantity``: every claim and finding names an evidence quantity that the evidence step
+  produces (the built ``results/evidence/<slug>.csv`` when present, else a string in ``evidence.py``);
+* ``figure-spec``: every figure of ``figures.yaml`` has its plotting function and a caption;
+* ``rule-name``: every rule of ``workflow/rules/<slug>.smk`` starts with the slug;
+* ``config-key``: every configuration key the rules pick for their steps is in the paper's schema.
+"""
+
+from __future__ import annotations
+
+import ast
+import csv
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from .registry import load_registry, schema_mismatches
+
+__all__ = ["Violation", "ROLES", "DATA_FILES", "NOT_MATH", "check_paper", "math_modules", "main"]
+
+ROLES = ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py")
+DATA_FILES = ("claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml", "figures.yaml")
+NOT_MATH = {"__init__", "steps", "evidence", "figures", "checks"}
+# method names that only file IO uses; `load`/`save` only on numpy (an LLVM builder's load is no IO)
+_IO_METHODS = {"read_csv", "to_csv", "read_text", "write_text", "read_bytes", "write_bytes", "savez",
+               "savez_compressed", "loadtxt", "savetxt", "genfromtxt", "read_parquet", "to_parquet", "safe_load",
+               "safe_dump", "tofile", "fromfile"}
+_NUMPY_IO = {"load", "save"}
+_IO_MODULES = {"pandas", "json", "yaml", "pickle", "csv", "shutil"}
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One breach of the contract: where it is and what is wrong."""
+
+    path: str
+    line: int
+    check: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}: [{self.check}] {self.message}"
+
+
+def _rel(path: Path, root: Path) -> str:
+    try:
+        return str(path.relative_to(root))
+    except ValueError:
+        return str(path)
+
+
+def math_modules(package: Path) -> list[Path]:
+    """The paper's math modules: every module of its package but the non-math roles."""
+    return sorted(p for p in package.glob("*.py") if p.stem not in NOT_MATH)
+
+
+def _check_roles(slug: str, root: Path) -> list[Violation]:
+    pkg = root / "src/netrepro/papers" / slug
+    out = [Violation(_rel(pkg / name, root), 0, "roles", f"missing: the paper's {name}")
+           for name in (*ROLES, *DATA_FILES) if not (pkg / name).is_file()]
+    required = {
+        root / "workflow/rules" / f"{slug}.smk": "the paper's rules file",
+        root / "workflow/schemas" / f"{slug}.schema.yaml": "the paper's configuration schema",
+        root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.reportgen make-notebook)",
+        root / "tests/papers" / slug: "the paper's tests (tests/papers/<slug>/)",
+        root / "tests/reference" / slug: "the committed reference tables (tests/reference/<slug>/; copy them from "
+                                          "results/<slug>/ after a checked build)",
+    }
+    out += [Violation(_rel(path, root), 0, "roles", f"missing: {what}") for path, what in required.items()
+            if not path.exists()]
+    registry = root / "src/netrepro/papers.yaml"
+    if slug not in load_registry(registry):
+        out.append(Violation(_rel(registry, root), 0, "roles", f"paper {slug!r} is not registered"))
+    schema_file = root / "workflow/schemas/config.schema.yaml"
+    schema = yaml.safe_load(schema_file.read_text())
+    out += [Violation(_rel(schema_file, root), 0, "roles", msg)
+            for msg in schema_mismatches(schema, load_registry(registry)) if repr(slug) in msg]
+    for section in ("config/config.yaml", "config/test.yaml"):
+        cfg = yaml.safe_load((root / section).read_text()) or {}
+        if slug not in cfg:
+            out.append(Violation(section, 0, "roles", f"no configuration section {slug!r}"))
+    return out
+
+
+def _imports(tree: ast.AST):
+    """(module name, line) of every import, relative imports resolved to their last part."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield alias.name, node.lineno
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level and not base:
+                for alias in node.names:
+                    yield alias.name, node.lineno
+            else:
+                yield base, node.lineno
+
+
+def _check_figures_imports(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    path = pkg / "figures.py"
+    if not path.is_file():
+        return []
+    forbidden = {"model", "steps"}
+    out = []
+    for name, line in _imports(ast.parse(path.read_text())):
+        last = name.split(".")[-1]
+        if last in forbidden and (name in forbidden or name.startswith(f"netrepro.papers.{slug}.")):
+            out.append(Violation(_rel(path, root), line, "figures-imports",
+                                 f"figures.py imports {name!r}: figures read tables, never the model or the steps"))
+    return out
+
+
+def _check_math_io(pkg: Path, root: Path) -> list[Violation]:
+    out = []
+    for path in math_modules(pkg):
+        tree = ast.parse(path.read_text())
+        for name, line in _imports(tree):
+            if name.split(".")[0] in _IO_MODULES:
+                out.append(Violation(_rel(path, root), line, "math-io",
+                                     f"math module imports {name!r}: no pandas and no file IO in the equations"))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call):
+                func = node.func
+                owner = getattr(func.value, "id", "") if isinstance(func, ast.Attribute) else ""
+                name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+                if (name == "open" and not owner) or name in _IO_METHODS or (
+                        name in _NUMPY_IO and owner in ("np", "numpy")):
+                    out.append(Violation(_rel(path, root), node.lineno, "math-io",
+                                         f"math module calls {name}(): file IO belongs in steps.py"))
+    return out
+
+
+def _module_all(tree: ast.Module) -> list[str] | None:
+    for node in tree.body:
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) else []
+        if any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets) and node.value is not None:
+            try:
+                return list(ast.literal_eval(node.value))
+            except ValueError:
+                return None
+    return None
+
+
+def _sections(doc: str) -> set[str]:
+    lines = [line.strip() for line in (doc or "").splitlines()]
+    return {line for line, nxt in zip(lines, lines[1:]) if line and nxt and set(nxt) == {"-"} and len(nxt) == len(line)}
+
+
+def _returns_value(func: ast.FunctionDef) -> bool:
+    for node in ast.walk(func):
+        if isinstance(node, (ast.Yield, ast.YieldFrom)):
+            return True
+        if isinstance(node, ast.Return) and node.value is not None and not (
+                isinstance(node.value, ast.Constant) and node.value.value is None):
+            return True
+    return False
+
+
+def _check_public_api(pkg: Path, root: Path) -> list[Violation]:
+    out = []
+    math = {p.stem for p in math_modules(pkg)}
+    for path in sorted(pkg.glob("*.py")):
+        tree = ast.parse(path.read_text())
+        names = _module_all(tree)
+        if names is None:
+            if path.stem != "__init__":
+                out.append(Violation(_rel(path, root), 1, "public-api", "module has no literal __all__"))
+            continue
+        for node in tree.body:
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) or node.name.startswith("_"):
+                continue
+            if node.name not in names:
+                out.append(Violation(_rel(path, root), node.lineno, "public-api",
+                                     f"public function {node.name!r} is not in __all__ (add it, or prefix it with _)"))
+                continue
+            if path.stem not in math:
+                continue
+            doc = ast.get_docstring(node) or ""
+            sections = _sections(doc)
+            args = [a.arg for a in (*node.args.posonlyargs, *node.args.args, *node.args.kwonlyargs)
+                    if a.arg not in ("self", "cls")] + [a.arg for a in (node.args.vararg, node.args.kwarg) if a]
+            if args and "Parameters" not in sections:
+                out.append(Violation(_rel(path, root), node.lineno, "public-api",
+                                     f"{node.name}() has no numpydoc 'Parameters' section"))
+            if _returns_value(node) and not sections & {"Returns", "Yields"}:
+                out.append(Violation(_rel(path, root), node.lineno, "public-api",
+                                     f"{node.name}() has no numpydoc 'Returns' section"))
+    return out
+
+
+def _line_of(text: str, needle: str) -> int:
+    pos = text.find(needle)
+    return text.count("\n", 0, pos) + 1 if pos >= 0 else 0
+
+
+def _evidence_quantities(slug: str, pkg: Path, root: Path):
+    """(set of quantities, how they were found, a matcher for quantities built by f-strings)."""
+    built = root / "results/evidence" / f"{slug}.csv"
+    if built.is_file():
+        with built.open(newline="") as handle:
+            return {row["quantity"] for row in csv.DictReader(handle)}, [], "results/evidence"
+    path = pkg / "evidence.py"
+    if not path.is_file():
+        return set(), [], "evidence.py"
+    tree = ast.parse(path.read_text())
+    literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+    prefixes = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.JoinedStr):
+            fixed = "".join(v.value for v in node.values if isinstance(v, ast.Constant))
+            if len(fixed) < 3:  # f"{name}" could be anything: it proves no quantity
+                continue
+            parts = [re.escape(v.value) if isinstance(v, ast.Constant) else ".+" for v in node.values]
+            prefixes.append(re.compile("^" + "".join(parts) + "$"))
+    return literals, prefixes, "evidence.py"
+
+
+def _check_quantities(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    known, patterns, where = _evidence_quantities(slug, pkg, root)
+    out = []
+    for data in ("claims.yaml", "findings.yaml"):
+        path = pkg / data
+        if not path.is_file():
+            continue
+        text = path.read_text()
+        for entry in yaml.safe_load(text) or []:
+            names = []
+            ours = entry.get("ours") or {}
+            if ours.get("quantity"):
+                names.append(ours["quantity"])
+            if data == "findings.yaml":
+                names += [entry["quantity"]] if entry.get("quantity") else []
+                names += list(entry.get("evidence_quantities") or [])
+            for name in names:
+                if name in known or any(p.match(name) for p in patterns):
+                    continue
+                out.append(Violation(_rel(path, root), _line_of(text, f"id: {entry.get('id')}"), "claim-quantity",
+                                     f"{entry.get('id')}: quantity {name!r} is not produced by the evidence step "
+                                     f"(looked in {where})"))
+    return out
+
+
+def _check_figures(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    spec_path, fig_path = pkg / "figures.yaml", pkg / "figures.py"
+    if not spec_path.is_file():
+        return []
+    text = spec_path.read_text()
+    specs = yaml.safe_load(text) or {}
+    functions = set()
+    if fig_path.is_file():
+        functions = {n.name for n in ast.parse(fig_path.read_text()).body if isinstance(n, ast.FunctionDef)}
+    out = []
+    for figure_id, spec in specs.items():
+        line = _line_of(text, f"{figure_id}:")
+        plot = (spec or {}).get("plot")
+        if plot not in functions:
+            out.append(Violation(_rel(spec_path, root), line, "figure-spec",
+                                 f"{figure_id}: plotting function {plot!r} is not defined in figures.py"))
+        caption = root / "workflow/report" / slug / f"{figure_id}.rst"
+        if not caption.is_file():
+            out.append(Violation(_rel(spec_path, root), line, "figure-spec",
+                                 f"{figure_id}: no caption {_rel(caption, root)}"))
+    return out
+
+
+_RULE = re.compile(r"^rule\s+(\w+)\s*:", re.M)
+
+
+def _check_rule_names(slug: str, root: Path) -> list[Violation]:
+    path = root / "workflow/rules" / f"{slug}.smk"
+    if not path.is_file():
+        return []
+    text = path.read_text()
+    return [Violation(_rel(path, root), text.count("\n", 0, m.start()) + 1, "rule-name",
+                      f"rule {m.group(1)!r} does not start with '{slug}_'")
+            for m in _RULE.finditer(text) if not m.group(1).startswith(f"{slug}_")]
+
+
+def _calls(text: str, name: str):
+    """(offset, source) of every call ``name(...)`` in ``text``, by balanced parentheses."""
+    for m in re.finditer(rf"\b{name}\(", text):
+        depth, i = 0, m.end() - 1
+        while i < len(text):
+            depth += {"(": 1, ")": -1}.get(text[i], 0)
+            if depth == 0:
+                yield m.start(), text[m.start():i + 1]
+                break
+            i += 1
+
+
+def _tuple_constants(text: str) -> dict:
+    out = {}
+    for m in re.finditer(r"^([A-Z_][A-Z0-9_]*)\s*=\s*(\([^()]*\)|\[[^\[\]]*\])", text, re.M):
+        try:
+            value = ast.literal_eval(m.group(2))
+        except (ValueError, SyntaxError):
+            continue
+        if isinstance(value, (tuple, list)) and all(isinstance(v, str) for v in value):
+            out[m.group(1)] = list(value)
+    return out
+
+
+def _check_config_keys(slug: str, root: Path) -> list[Violation]:
+    path = root / "workflow/rules" / f"{slug}.smk"
+    schema_path = root / "workflow/schemas" / f"{slug}.schema.yaml"
+    if not (path.is_file() and schema_path.is_file()):
+        return []
+    text = path.read_text()
+    schema = yaml.safe_load(schema_path.read_text())
+    constants = _tuple_constants(text)
+    out = []
+    for offset, source in _calls(text, "pick"):
+        try:
+            call = ast.parse(source, mode="eval").body
+        except SyntaxError:
+            continue
+        section = [n.value for n in ast.walk(call.args[0]) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
+        node = schema
+        for key in section:
+            node = (node.get("properties") or {}).get(key, {})
+        props = node.get("properties") or {}
+        keys = []
+        for arg in call.args[1:]:
+            if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+                keys.append(arg.value)
+            elif isinstance(arg, ast.Starred) and isinstance(arg.value, ast.Name):
+                keys += constants.get(arg.value.id, [])
+        where = ".".join([slug, *section])
+        for key in keys:
+            if key not in props:
+                out.append(Violation(_rel(path, root), text.count("\n", 0, offset) + 1, "config-key",
+                                     f"the rule passes {where}.{key} to its step, but "
+                                     f"{_rel(schema_path, root)} does not define it"))
+    return out
+
+
+def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
+    """Every breach of the paper contract by paper ``slug`` in the checkout ``root``.
+
+    Parameters
+    ----------
+    slug : str
+        The paper's slug.
+    root : str or Path
+        The repository's root.
+
+    Returns
+    -------
+    list of Violation
+        Empty when the paper follows the contract.
+    """
+    root = Path(root).resolve()
+    pkg = root / "src/netrepro/papers" / slug
+    if not pkg.is_dir():
+        return [Violation(_rel(pkg, root), 0, "roles", f"paper {slug!r} has no package")]
+    return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
+            *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_figures(slug, pkg, root),
+            *_check_rule_names(slug, root), *_check_config_keys(slug, root)]
+
+
+def main(slugs, root: str | Path = ".") -> int:
+    """Print every violation of the papers ``slugs`` (all registered ones when empty); 1 if any."""
+    root = Path(root)
+    slugs = list(slugs) or list(load_registry(root / "src/netrepro/papers.yaml"))
+    found = 0
+    for slug in slugs:
+        violations = check_paper(slug, root)
+        found += len(violations)
+        for v in violations:
+            print(v)
+        print(f"check-paper {slug}: {'ok' if not violations else f'{len(violations)} violation(s)'}")
+    return 1 if found else 0

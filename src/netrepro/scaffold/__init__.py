@@ -1,0 +1,155 @@
+"""``python -m netrepro new-paper SLUG --title ... --source FILE``: a working skeleton of a paper.
+
+The skeleton follows the paper contract (``docs/adding-a-paper.md``, checked by
+``python -m netrepro check-paper``): the package with every role and one example each (an
+equation, a step, the evidence, a figure, a claim, an erratum, a reconstruction, a finding), its
+rules file, configuration section and schema, caption, notebook, tests (one per role) and the
+registry entry. Right after it, ``make report`` builds the new paper's figure, judges its claim
+and shows its section in the report. The templates are in ``templates/`` beside this module.
+
+Every check runs before anything is written: an existing slug, a slug that is not a valid
+identifier, or a missing source file stops the command with a message and no file changed.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from string import Template
+
+import yaml
+
+from ..errors import InputError
+from ..registry import load_registry, registry_entry_text, valid_slug
+
+__all__ = ["Plan", "plan_new_paper", "write_plan", "new_paper"]
+
+TEMPLATES = Path(__file__).with_name("templates")
+PACKAGE_FILES = ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
+                 "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml")
+TEST_FILES = ("__init__.py", "test_model.py", "test_steps.py", "test_evidence.py", "test_figures.py",
+              "test_checks.py")
+
+
+@dataclass
+class Plan:
+    """What ``new-paper`` will do: files to create (path -> text) and files to rewrite (path -> new text)."""
+
+    slug: str
+    create: dict
+    rewrite: dict
+
+    def paths(self) -> list[str]:
+        return sorted([*self.create, *self.rewrite])
+
+
+def _render(name: str, values: dict) -> str:
+    return Template((TEMPLATES / name).read_text()).substitute(values)
+
+
+def _add_to_papers_list(path: Path, text: str, slug: str) -> str:
+    match = re.search(r"^papers:\s*\[([^\]]*)\]", text, re.M)
+    if not match:
+        raise InputError(f"{path}: no line 'papers: [...]' to add {slug!r} to")
+    items = [s.strip() for s in match.group(1).split(",") if s.strip()]
+    return text[:match.start()] + f"papers: [{', '.join([*items, slug])}]" + text[match.end():]
+
+
+def _add_to_schema(path: Path, text: str, slug: str) -> str:
+    match = re.search(r"(\n\s+items:\n\s+enum: \[)([^\]]*)\]", text)
+    if not match:
+        raise InputError(f"{path}: no 'items: enum: [...]' list of papers to add {slug!r} to")
+    items = [s.strip() for s in match.group(2).split(",") if s.strip()]
+    text = text[:match.start(2)] + ", ".join([*items, slug]) + text[match.end(2):]
+    refs = list(re.finditer(r'^  \w+: \{\$ref: "\w+\.schema\.yaml"\}\n', text, re.M))
+    if not refs:
+        raise InputError(f"{path}: no paper sections ({{$ref: <slug>.schema.yaml}}) to add {slug!r} after")
+    end = refs[-1].end()
+    return text[:end] + f'  {slug}: {{$ref: "{slug}.schema.yaml"}}\n' + text[end:]
+
+
+def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".", authors: str = "") -> Plan:
+    """Check the request and compute every file ``new-paper`` writes, writing nothing.
+
+    Parameters
+    ----------
+    slug : str
+        The new paper's slug: a lower-case Python identifier not yet registered.
+    title : str
+        The paper's title.
+    source : str or Path
+        The paper's source text; it must exist.
+    root : str or Path
+        The repository's root.
+    authors : str
+        The authors, one line (the registry says TODO when empty).
+
+    Returns
+    -------
+    Plan
+        The files to create and to rewrite.
+
+    Raises
+    ------
+    InputError
+        When the slug is invalid or taken, the title empty, the source file missing, or a file
+        the skeleton would create already exists.
+    """
+    root = Path(root)
+    if not valid_slug(slug):
+        raise InputError(f"new-paper: slug {slug!r} is not a valid lower-case Python identifier "
+                         "(letters, digits and underscores, not starting with a digit or underscore, not a keyword)")
+    registry_path = root / "src/netrepro/papers.yaml"
+    if slug in load_registry(registry_path):
+        raise InputError(f"new-paper: paper {slug!r} already exists in {registry_path}")
+    if not str(title).strip():
+        raise InputError("new-paper: --title must not be empty")
+    source = Path(source)
+    if not source.is_file():
+        raise InputError(f"new-paper: source file {source} does not exist")
+    values = {"slug": slug, "title": title.strip(), "source": source.name, "CFG": f"{slug.upper()}_CFG"}
+    create = {f"src/netrepro/papers/{slug}/{name}": _render(f"package/{name}.tmpl", values) for name in PACKAGE_FILES}
+    create |= {f"tests/papers/{slug}/{name}": _render(f"tests/{name}.tmpl", values) for name in TEST_FILES}
+    create[f"workflow/rules/{slug}.smk"] = _render("rules.smk.tmpl", values)
+    create[f"workflow/schemas/{slug}.schema.yaml"] = _render("schema.yaml.tmpl", values)
+    create[f"workflow/report/{slug}/fig1.rst"] = _render("caption.rst.tmpl", values)
+    create[f"workflow/notebooks/{slug}.ipynb"] = ""  # written by the report's notebook template
+    taken = [p for p in create if (root / p).exists()]
+    if taken:
+        raise InputError(f"new-paper: {taken[0]} already exists (paper {slug!r} is partly there); nothing written")
+    section = _render("config.yaml.tmpl", values)
+    rewrite = {}
+    for cfg in ("config/config.yaml", "config/test.yaml"):
+        text = (root / cfg).read_text()
+        if slug in (yaml.safe_load(text) or {}):
+            raise InputError(f"new-paper: {cfg} already has a section {slug!r}; nothing written")
+        rewrite[cfg] = _add_to_papers_list(root / cfg, text, slug).rstrip("\n") + "\n" + section
+    schema = "workflow/schemas/config.schema.yaml"
+    rewrite[schema] = _add_to_schema(root / schema, (root / schema).read_text(), slug)
+    registry_text = registry_path.read_text()
+    rewrite["src/netrepro/papers.yaml"] = (registry_text.rstrip("\n") + "\n"
+                                           + registry_entry_text(slug, title.strip(), source.name, authors))
+    return Plan(slug, create, rewrite)
+
+
+def write_plan(plan: Plan, root: str | Path = ".") -> list[str]:
+    """Write the files of ``plan`` under ``root``; return their paths."""
+    from ..reportgen import make_notebook  # the report's notebook template, imported only when writing
+
+    root = Path(root)
+    for rel, text in plan.create.items():
+        path = root / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if rel.endswith(".ipynb"):
+            make_notebook(plan.slug, path)
+        else:
+            path.write_text(text)
+    for rel, text in plan.rewrite.items():
+        (root / rel).write_text(text)
+    return plan.paths()
+
+
+def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".", authors: str = "") -> list[str]:
+    """Create the skeleton of paper ``slug`` (see :func:`plan_new_paper`); return the paths written."""
+    return write_plan(plan_new_paper(slug, title, source, root, authors), root)

@@ -1,0 +1,56 @@
+"""``new-paper`` refuses a bad request with a message naming the problem, and writes nothing."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from netrepro.errors import InputError
+from netrepro.scaffold import plan_new_paper
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("slug,title,missing,message", [
+    ("markov", "T", False, "paper 'markov' already exists"),
+    ("2nd_paper", "T", False, "'2nd_paper' is not a valid lower-case Python identifier"),
+    ("Kalman", "T", False, "'Kalman' is not a valid"),
+    ("new_one", "T", True, "source file .*missing.txt does not exist"),
+    ("new_one", " ", False, "--title must not be empty"),
+])
+def test_a_bad_request_is_refused_naming_the_problem(tmp_path, slug, title, missing, message):
+    source = tmp_path / ("missing.txt" if missing else "paper.txt")
+    if not missing:
+        source.write_text("text")
+    with pytest.raises(InputError, match=message):
+        plan_new_paper(slug, title, source, ROOT)
+
+
+def test_the_command_refuses_and_writes_nothing(tmp_path):
+    source = tmp_path / "paper.txt"
+    source.write_text("text")
+    watched = [ROOT / "src/netrepro/papers.yaml", ROOT / "config/config.yaml", ROOT / "config/test.yaml",
+               ROOT / "workflow/schemas/config.schema.yaml"]
+    before = {p: p.read_bytes() for p in watched}
+    proc = subprocess.run([sys.executable, "-m", "netrepro", "new-paper", "hinf", "--title", "T", "--source",
+                           str(source), "--root", str(ROOT)], capture_output=True, text=True, check=False)
+    assert proc.returncode == 2
+    assert "paper 'hinf' already exists" in proc.stderr
+    assert {p: p.read_bytes() for p in watched} == before
+
+
+def test_the_plan_creates_every_role_and_registers_the_paper(tmp_path):
+    source = tmp_path / "paper.txt"
+    source.write_text("text")
+    plan = plan_new_paper("kalman_iid", "A title", source, ROOT)
+    pkg = "src/netrepro/papers/kalman_iid/"
+    for name in ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
+                 "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml"):
+        assert pkg + name in plan.create, name
+    for role in ("model", "steps", "evidence", "figures", "checks"):
+        assert f"tests/papers/kalman_iid/test_{role}.py" in plan.create, role
+    assert "workflow/rules/kalman_iid.smk" in plan.create
+    assert "kalman_iid:" in plan.rewrite["src/netrepro/papers.yaml"]
+    assert 'kalman_iid: {$ref: "kalman_iid.schema.yaml"}' in plan.rewrite["workflow/schemas/config.schema.yaml"]
+    assert "papers: [intermittent, markov, onebit, gainsched, hinf, kalman_iid]" in plan.rewrite["config/test.yaml"]

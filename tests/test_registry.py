@@ -1,0 +1,60 @@
+"""The paper registry (issue 30): one file feeds every list of papers."""
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from netrepro.errors import ConfigError
+from netrepro.registry import load_registry, paper_slugs, schema_mismatches, valid_slug
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_the_schema_lists_exactly_the_registered_papers():
+    schema = yaml.safe_load((ROOT / "workflow/schemas/config.schema.yaml").read_text())
+    assert schema_mismatches(schema, paper_slugs()) == []
+
+
+def test_schema_mismatches_names_each_difference():
+    schema = {"properties": {"papers": {"items": {"enum": ["a", "stale"]}}, "a": {"$ref": "a.schema.yaml"}}}
+    problems = schema_mismatches(schema, ["a", "b"])
+    assert any("'b' is registered but not in the schema's papers enum" in p for p in problems)
+    assert any("'b' has no section" in p for p in problems)
+    assert any("'stale', which is not registered" in p for p in problems)
+    assert not any("'a'" in p for p in problems)
+
+
+def test_every_registered_paper_has_its_package_rules_and_source():
+    shared = ROOT.parent / "shared" / "papers"
+    for slug, entry in load_registry().items():
+        assert (ROOT / "src/netrepro/papers" / slug / "__init__.py").is_file(), slug
+        assert (ROOT / "workflow/rules" / f"{slug}.smk").is_file(), slug
+        if shared.is_dir():  # the texts are beside the checkout here, not in a clone
+            assert (shared / entry["source"]).is_file(), entry["source"]
+
+
+def test_the_package_init_files_hold_no_data():
+    import netrepro.papers as papers
+
+    assert not hasattr(papers, "PAPERS")
+    assert not [n for n in vars(papers) if not n.startswith("_")]
+
+
+@pytest.mark.parametrize("slug,ok", [("markov", True), ("kalman_iid", True), ("1paper", False), ("Paper", False),
+                                     ("class", False), ("_x", False), ("a-b", False)])
+def test_valid_slug(slug, ok):
+    assert valid_slug(slug) is ok
+
+
+@pytest.mark.parametrize("text,message", [
+    ("[]", "must map each paper"),
+    ("Bad-Slug: {source: a, title: b, authors: c, citation: {type: article, title: b, authors: [x]}}", "Python identifier"),
+    ("p: {source: a, title: b, citation: {type: article, title: b, authors: [x]}}", "lacks ['authors']"),
+    ("p: {source: a, title: b, authors: c, citation: {type: article}}", "citation lacks ['title', 'authors']"),
+])
+def test_a_broken_registry_is_refused_naming_the_problem(tmp_path, text, message):
+    path = tmp_path / "papers.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        load_registry(path)
