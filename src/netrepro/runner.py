@@ -284,6 +284,10 @@ def _new_paper_main(args) -> int:
 
 
 def main(argv=None) -> int:
+    if argv is None and sys.argv[1:2] == ["diff"] or argv and argv[:1] == ["diff"]:
+        from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
+
+        return diff_main((sys.argv[2:] if argv is None else argv[1:]))
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run one pipeline step")
