@@ -85,7 +85,8 @@ class GilbertElliottLMI:
         (11):\\ \\Psi = \\begin{bmatrix} X & \\cdots & \\sqrt{w_i}\\,((A^i)'Y + C^{(i)\\prime}F_i) & \\cdots \\\\
                  \\vdots & & \\ddots \\\\ \\sqrt{w_i}\\,(YA^i + F_i'C^{(i)}) & & Y \\end{bmatrix} \\succ 0
 
-    with ``w_i = p (1-p)^{i-1}``. Derivation (tested on the LMI's own blocks in ``tests/papers/markov/test_lmis.py``): the Schur
+    with ``w_i = p (1-p)^{i-1}``. Derivation (tested on the LMI's own blocks in
+    ``tests/papers/markov/test_lmis.py``): the Schur
     complement of (10) is ``Y - (1-q)A'YA - qA'XA >= 0``, hence ``Y >= Phi_X``; the Schur
     complement of (11) is ``X - sum_i w_i M_i' Y M_i`` with ``M_i = A^i + K^{(i)} C^{(i)}``,
     ``K^{(i)} = Y^{-1} F_i'``; so ``X > L_K(X)`` (Theorem 2 (iii)).
