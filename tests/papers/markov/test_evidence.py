@@ -192,3 +192,23 @@ def test_ceiling_finding_on_the_tiny_tables(markov_tables):
     assert ev["exII.unstable_above_ceiling"]["nominal"][0] is True
     assert ev["exII.p_c_ceiling"]["nominal"][0] == pytest.approx(model.parity_ceiling(1.2)["p_max"], rel=1e-12)
     assert "0.5609" not in (PKG / "findings.yaml").read_text()
+
+
+def test_configured_points_are_the_claims_settings():
+    """The LMI check points and the figure settings of config/config.yaml are the `at:` of the claims they serve
+    (a paper setting lives in the claim; the configuration must not drift from it)."""
+    import yaml
+
+    cfg = yaml.safe_load((PKG.parents[3] / "config" / "config.yaml").read_text())["markov"]
+    at = evidence.claim_settings(PKG / "claims.yaml", PKG / "findings.yaml")
+    points = {p["name"]: (p["example"], p["p"], p["q"]) for p in cfg["checks"]["points"]}
+    served = {"exI_thm2_p1": "exI_lmi_p1", "exI_fig3_p05": "exI_fig3_stable", "exI_thm2_p099": "exI_fig4_stable",
+              "exII_thm2_p1": "exII_lmi_p1_infeasible", "exII_thm5_p0465": "exII_p0465_certified",
+              "exII_fig5_p045": "exII_fig5_stable"}
+    for check, claim in served.items():
+        assert points[check][1:] == (at[claim]["at"]["p"], at[claim]["at"]["q"]), (check, claim)
+    figs = {c["figure"]: (c["p"], c["q"]) for c in cfg["paths"]["cases"]}
+    for fig, claim in (("fig3", "exI_fig3_stable"), ("fig4", "exI_fig4_stable"), ("fig5", "exII_fig5_stable"),
+                       ("fig6", "exII_fig6_diverges")):
+        assert figs[fig] == (at[claim]["at"]["p"], at[claim]["at"]["q"]), (fig, claim)
+    assert {t["q"] for t in cfg["checks"]["tight"] if t["example"] == "II"} == {at["exII_thm5_q05"]["at"]["q"]}
