@@ -155,6 +155,8 @@ rule markov_evidence:
         map=rules.markov_stability_map.output.table,
         sensitivity=rules.markov_stability_map.output.sensitivity,
         moments=rules.markov_exact_moments.output.table,
+        claims="src/netrepro/papers/markov/claims.yaml",
+        findings="src/netrepro/papers/markov/findings.yaml",
     output:
         table="results/evidence/markov.csv",
     log:

@@ -11,6 +11,7 @@ from netrepro.papers.markov import checks, evidence, steps
 __all__ = ["tiny_config", "run_all", "NAMES"]
 
 ROOT = Path(__file__).resolve().parents[3]
+PKG = ROOT / "src" / "netrepro" / "papers" / "markov"
 NAMES = ("curves", "bench", "checks", "tight", "iid", "moments", "map", "sensitivity", "paths", "check", "evidence",
          "expectations")
 
@@ -47,5 +48,7 @@ def run_all(cfg: dict, tmp: Path) -> dict:
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
     _run(steps.expectations_step, cfg, {"moments": t["moments"]}, {"table": t["expectations"]})
     _run(evidence.evidence_step, cfg, {"checks": t["checks"], "tight": t["tight"], "curves": t["curves"], "iid": t["iid"],
-                                       "map": t["map"], "sensitivity": t["sensitivity"], "moments": t["moments"]}, {"table": t["evidence"]})
+                                       "map": t["map"], "sensitivity": t["sensitivity"], "moments": t["moments"],
+                                       "claims": PKG / "claims.yaml", "findings": PKG / "findings.yaml"},
+         {"table": t["evidence"]})
     return t

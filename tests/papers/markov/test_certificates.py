@@ -32,7 +32,7 @@ def test_two_reception_bound_dominates_exact_means(p, q):
 
 def test_two_reception_bound_infinite_below_necessary_condition_and_rejects_n_ne_2m():
     assert np.isinf(ce.two_reception_bound(EX1, np.eye(2), 0.5, Q_NEC1 - 0.01))
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="needs n = 2 m"):
         ce.two_reception_bound(EX2, np.eye(3), 0.5, 0.5)
 
 
@@ -99,7 +99,7 @@ def test_decide_certified_never_contradicts_and_raises_on_a_contradiction():
     v1, _ = ce.decide_certified(facts1, P, 1e-9, 0.0)
     assert (v1 == np.where(Qg > Q_NEC1, "bounded", "unbounded")).all()
     bad = dict(facts, upper=np.zeros(P.shape))  # claims every point bounded, contradicting the lower bounds
-    with pytest.raises(ModelError):
+    with pytest.raises(ModelError, match="certified both bounded and unbounded"):
         ce.decide_certified(bad, P, 1e-9, 0.0)
 
 
@@ -107,3 +107,15 @@ def test_critical_distance():
     q, p = ce.true_critical_curve("nondegenerate", 1.3)
     d = ce.critical_distance(np.array([0.5, Q_NEC1]), np.array([0.5, 0.3]), q, p)
     assert d == pytest.approx([0.5 - Q_NEC1, 0.0], abs=1e-4)
+
+
+def test_iid_instability_end_is_where_the_lower_bounds_start_to_grow():
+    """On p + q = 1: Example II's parity bound grows exactly below 1 - |lambda|^-4 (parity_growth evaluated on
+    both sides), Example I's loss-run bound exactly up to 1 - |lambda|^-2 (|lambda|^2 (1 - lambda) >= 1)."""
+    end2, why2 = ce.iid_instability_end(A2, C2, np.eye(3))
+    assert end2 == pytest.approx(1 - 1.2 ** -4, abs=1e-15) and "parity" in why2
+    for lam_, sign in ((end2 - 1e-6, 1), (end2 + 1e-6, -1)):
+        assert np.sign(ce.parity_growth(1.2, 1 - lam_, lam_)) == sign
+    end1, why1 = ce.iid_instability_end(A1, C1, np.eye(2))
+    assert end1 == pytest.approx(1 - 1.3 ** -2, abs=1e-15) and "loss-run" in why1
+    assert 1.3 ** 2 * (1 - (end1 - 1e-6)) > 1 > 1.3 ** 2 * (1 - (end1 + 1e-6))

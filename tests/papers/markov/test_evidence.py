@@ -1,17 +1,21 @@
-"""Evidence of `markov` (evidence.py) against independent computations, and its data files."""
+"""The enumeration (enumeration.py), map and closed-form helpers behind the evidence of `markov`, against
+independent computations; the evidence step and its data files."""
 
 from __future__ import annotations
 
+import ast
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from netrepro.papers.markov import evidence, exact, model
+from netrepro.papers.markov import enumeration, evidence, exact, model, stability
 from netrepro.verdicts import claims_table, errata_table, findings_table, load_paper_data, read_evidence
 
 from .systems import EX1, EX2
+from .tables import PKG
 
 
 def _psi(P, g, system):
@@ -21,10 +25,10 @@ def _psi(P, g, system):
 @pytest.mark.parametrize("system", [EX1, EX2])
 def test_enumeration_matches_exact_tree(system):
     """Brute force over all 2^(k-1) paths (gamma_1 = 1) equals the transition-count tree of exact.py."""
-    paths = evidence.enumerate_norms(system, np.eye(system.n), 8)
+    paths = enumeration.enumerate_norms(system, np.eye(system.n), 8)
     em = exact.exact_moments(system, np.eye(system.n), 7)
     for p, q in ((0.3, 0.6), (0.9, 0.95)):
-        assert np.allclose(evidence.mean_norm_enumerated(paths, p, q, "gamma1"), em.mean(p, q), rtol=1e-10)
+        assert np.allclose(enumeration.mean_norm_enumerated(paths, p, q, "gamma1"), em.mean(p, q), rtol=1e-10)
 
 
 def test_stationary_start_by_hand():
@@ -36,31 +40,31 @@ def test_stationary_start_by_hand():
     trans = {(1, 1): 1 - p, (1, 0): p, (0, 1): q, (0, 0): 1 - q}
     want = sum(law[a] * trans[(a, b)] * np.linalg.norm(_psi(_psi(S0, a, EX1), b, EX1), 2)
                for a, b in itertools.product([0, 1], repeat=2))
-    got = evidence.mean_norm_enumerated(evidence.enumerate_norms(EX1, S0, 3), p, q, "stationary")
+    got = enumeration.mean_norm_enumerated(enumeration.enumerate_norms(EX1, S0, 3), p, q, "stationary")
     assert got[2] == pytest.approx(want, rel=1e-12)
     assert got[0] == pytest.approx(1.0)
 
 
 def test_monotonicity_violation_on_a_hand_table():
     means = np.array([[1.0, 2.0], [1.5, 1.8], [2.0, 2.1]])
-    v = evidence.monotonicity_violation(means, [0.1, 0.2, 0.3])
+    v = enumeration.monotonicity_violation(means, [0.1, 0.2, 0.3])
     assert v["violation"] == pytest.approx(0.2 / 1.8)
     assert (v["p1"], v["p2"], v["k"]) == (0.2, 0.1, 2)
-    assert evidence.monotonicity_violation(means, [0.1, 0.2, 0.3], rtol=0.2)["violation"] == 0.0
-    assert evidence.monotonicity_violation(np.sort(means, axis=0), [0.1, 0.2, 0.3])["violation"] == 0.0
+    assert enumeration.monotonicity_violation(means, [0.1, 0.2, 0.3], rtol=0.2)["violation"] == 0.0
+    assert enumeration.monotonicity_violation(np.sort(means, axis=0), [0.1, 0.2, 0.3])["violation"] == 0.0
 
 
 def test_prop1_closed_form_value():
     """Section 5.1: |lambda| = 1.3, q = 0.65 gives 0.22 (by hand: 0.4085 / 1.856465)."""
-    assert float(evidence.prop1_closed_form(1.3, 0.65)) == pytest.approx(0.4085 / 1.856465, rel=1e-12)
+    assert float(model.prop1_closed_form(1.3, 0.65)) == pytest.approx(0.4085 / 1.856465, rel=1e-12)
 
 
 def test_single_transition():
     rows = [("I", p, 0.5, "bounded" if p < 0.4 else "unbounded") for p in (0.1, 0.3, 0.5, 0.7)]
-    ok, _ = evidence.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    ok, _ = stability.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
     assert ok
     rows[3] = ("I", 0.7, 0.5, "bounded")
-    bad, note = evidence.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    bad, note = stability.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
     assert not bad and "1 of 1" in note
 
 
@@ -151,5 +155,60 @@ def test_path_weights_from_codes_equal_the_direct_form():
         step = np.where(a == 1, np.where(b == 1, 1 - p, p), np.where(b == 1, q, 1 - q))
         for gamma1 in (0, 1):
             ref = np.where(G[:, 0] == gamma1, 1.0, 0.0) * np.prod(step, axis=1)
-            assert np.array_equal(evidence.path_weights(G, p, q, gamma1), ref)
-            assert np.array_equal(evidence.path_weights(G, p, q, gamma1, evidence.transition_codes(G)), ref)
+            assert np.array_equal(enumeration.path_weights(G, p, q, gamma1), ref)
+            assert np.array_equal(enumeration.path_weights(G, p, q, gamma1, enumeration.transition_codes(G)), ref)
+
+
+def test_evidence_imports_no_private_name_and_defines_no_mathematics():
+    """evidence.py assembles: it imports no private name and defines only its step, the settings reader and
+    private row builders (issue 29)."""
+    tree = ast.parse(Path(evidence.__file__).read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            assert not [a.name for a in node.names if a.name.startswith("_")], node.module
+    public = {n.name for n in tree.body if isinstance(n, ast.FunctionDef) and not n.name.startswith("_")}
+    assert public == {"evidence_step", "claim_settings"}
+
+
+def test_claim_settings_reach_the_evidence_from_the_yaml(markov_cfg, markov_tables, tmp_path):
+    """The loss rate of claim exI_loss_rate_004 is computed at the claim's own `at:` (p, q): edit the YAML, the
+    value follows (p / (p + q), eq. 3, written out here)."""
+    text = (PKG / "claims.yaml").read_text()
+    assert "at: {p: 0.04, q: 0.65}" in text
+    claims = tmp_path / "claims.yaml"
+    claims.write_text(text.replace("at: {p: 0.04, q: 0.65}", "at: {p: 0.1, q: 0.4}"))
+    at = evidence.claim_settings(claims, PKG / "findings.yaml")
+    assert at["exI_loss_rate_004"]["at"] == {"p": 0.1, "q": 0.4}
+    assert at["prop1_is_thm1_K0"]["at"] == {"q": 0.65}
+    inputs = {k: markov_tables[k] for k in ("checks", "tight", "curves", "iid", "map", "sensitivity", "moments")}
+    out = evidence.evidence_step(markov_cfg, dict(inputs, claims=claims, findings=PKG / "findings.yaml"), {})["table"]
+    row = out[(out.quantity == "exI.loss_rate_p004") & (out.variant == "nominal")]
+    assert float(row.value.iloc[0]) == pytest.approx(0.1 / (0.1 + 0.4), rel=1e-12)
+
+
+def test_ceiling_finding_on_the_tiny_tables(markov_tables):
+    """The Example II ceiling rows exist, hold, and carry the computed values (not typed in the YAML)."""
+    ev = read_evidence(markov_tables["evidence"])
+    assert ev["exII.unstable_above_ceiling"]["nominal"][0] is True
+    assert ev["exII.p_c_ceiling"]["nominal"][0] == pytest.approx(model.parity_ceiling(1.2)["p_max"], rel=1e-12)
+    assert "0.5609" not in (PKG / "findings.yaml").read_text()
+
+
+def test_configured_points_are_the_claims_settings():
+    """The LMI check points and the figure settings of config/config.yaml are the `at:` of the claims they serve
+    (a paper setting lives in the claim; the configuration must not drift from it)."""
+    import yaml
+
+    cfg = yaml.safe_load((PKG.parents[3] / "config" / "config.yaml").read_text())["markov"]
+    at = evidence.claim_settings(PKG / "claims.yaml", PKG / "findings.yaml")
+    points = {p["name"]: (p["example"], p["p"], p["q"]) for p in cfg["checks"]["points"]}
+    served = {"exI_thm2_p1": "exI_lmi_p1", "exI_fig3_p05": "exI_fig3_stable", "exI_thm2_p099": "exI_fig4_stable",
+              "exII_thm2_p1": "exII_lmi_p1_infeasible", "exII_thm5_p0465": "exII_p0465_certified",
+              "exII_fig5_p045": "exII_fig5_stable"}
+    for check, claim in served.items():
+        assert points[check][1:] == (at[claim]["at"]["p"], at[claim]["at"]["q"]), (check, claim)
+    figs = {c["figure"]: (c["p"], c["q"]) for c in cfg["paths"]["cases"]}
+    for fig, claim in (("fig3", "exI_fig3_stable"), ("fig4", "exI_fig4_stable"), ("fig5", "exII_fig5_stable"),
+                       ("fig6", "exII_fig6_diverges")):
+        assert figs[fig] == (at[claim]["at"]["p"], at[claim]["at"]["q"]), (fig, claim)
+    assert {t["q"] for t in cfg["checks"]["tight"] if t["example"] == "II"} == {at["exII_thm5_q05"]["at"]["q"]}

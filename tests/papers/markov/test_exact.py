@@ -67,7 +67,7 @@ def test_block_split_rejected_when_coupled():
     assert exact.find_split(EX2, np.array([[1.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 1.0]])) is not None
     assert exact.find_split(EX2, np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.0], [0.5, 0.0, 1.0]])) is None
     assert exact.find_split(EX1, np.eye(2)) is None
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="does not split Q"):
         exact.example2_split().blocks(coupled, np.eye(3))
 
 

@@ -47,7 +47,7 @@ def test_asymptote_exact_on_geometric_sequence():
     assert np.allclose(lo, hi, rtol=1e-12)
     inside, err, mono = xp.asymptote_backtest(seq, R, 12)
     assert inside and err < 1e-12
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="at least 6 exact values"):
         xp.asymptote_extrapolation(seq[:4], 10, R)
 
 
@@ -79,13 +79,17 @@ def test_conditional_validation_rejects():
     # deterministic value (zero half-width) that disagrees: rejected
     zmax, ok = xp.conditional_validation(np.array([1.0, 2.1, 3.0]), np.array([0.0, 0.0, 0.196]), exact_vals, 4.0, 1.96, 1e-9)
     assert not ok and np.isinf(zmax)
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="need at least the 3 exact ones"):
         xp.conditional_validation(np.array([1.0]), np.array([0.0]), exact_vals, 4.0, 1.96, 1e-9)
 
 
 def test_expectations_table(markov_tables, markov_cfg):
     t = pd.read_csv(markov_tables["expectations"])
-    assert list(t.columns) == ["example", "p", "q", "k", "mean_norm", "lo", "hi", "method"]
+    assert list(t.columns) == ["example", "p", "q", "k", "mean_norm", "lo", "hi", "method", "limit", "limit_lo",
+                               "limit_hi"]
+    asym = t.method == "asymptote"
+    assert t.limit[~asym].isna().all() and (t.limit_lo[asym] <= t.limit[asym]).all()
+    assert (t.limit[asym] <= t.limit_hi[asym]).all()
     k_max = markov_cfg["paths"]["horizon"] + 1
     K = {"I": markov_cfg["exact"]["depth"] + 1, "II": markov_cfg["expectations"]["split_depth"] + 1}
     assert len(t) == len(markov_cfg["paths"]["cases"]) * k_max
@@ -115,3 +119,18 @@ def test_asymptote_above_certified_lower_bound(markov_tables):
     st = parity_structure(EX2.A, EX2.C, EX2.Q)
     for r in a.itertuples():
         assert r.lo >= parity_lower_bound(st, r.p, r.q, int(r.k))
+
+
+def test_asymptote_limit_is_the_limit_of_the_extrapolation():
+    """Two parity classes with exact ratio R = 0.9 and limit 5 (written out), and the extrapolation carried far."""
+    R = 0.9
+    k = np.arange(1, 41)
+    seq = 5.0 - 3.0 * R ** (k / 2) + 0.5 * (-1) ** k * R ** (k / 2)
+    limit, lo, hi = xp.asymptote_limit(seq[:20], R)
+    assert limit == pytest.approx(5.0, rel=1e-12) and lo == pytest.approx(5.0, rel=1e-12)
+    assert hi == pytest.approx(5.0, rel=1e-12)
+    far, far_lo, far_hi = xp.asymptote_extrapolation(seq[:20], 2000, R)
+    assert far[-1] == pytest.approx(limit, rel=1e-10) and far_lo[-1] >= lo - 1e-9 and far_hi[-1] <= hi + 1e-9
+    assert xp.asymptote_limit(seq[:20] * 0 + np.arange(20) ** 2, 1.1)[0] == np.inf
+    with pytest.raises(InputError, match="at least 6 exact values"):
+        xp.asymptote_limit(seq[:4], R)

@@ -10,11 +10,46 @@ from netrepro.papers.markov import lmis, model
 from .systems import A1, C1, A2, C2, A3, C3
 
 
-def test_lmi_block_form_is_schur_of_L():
-    """Schur complement of Psi (11) is X - sum_i w_i M_i' Y M_i with K^{(i)} = Y^{-1} F_i' (for l_o = 2 and 3)."""
-    rng = np.random.default_rng(2)
-    assert lmis.schur_residual(A1, C1, 0.5, 0.65, rng) < 1e-9
-    assert lmis.schur_residual(A3, C3, 0.5, 0.65, rng) < 1e-8
+def _own_blocks(A, C, p, q, rng):
+    """The two matrix blocks of the compiled LMI (10) and (11), evaluated at random X, Y > 0 and F_i (t = 0)."""
+    lmi = lmis.GilbertElliottLMI(A, C)
+    n, m = A.shape[0], C.shape[0]
+    G = rng.standard_normal((n, n))
+    X, Y = 50.0 * np.eye(n), G @ G.T + np.eye(n)
+    F = [rng.standard_normal((m * i, n)) for i in range(1, lmi.l_o)]
+    lmi.X.value, lmi.Y.value, lmi.t.value = X, Y, 0.0
+    for var, val in zip(lmi.F, F):
+        var.value = val
+    lmi._set(p, q)
+    (_, c10), (_, c11) = lmi.blocks
+    return lmi.l_o, X, Y, F, np.asarray(c10.args[0].value), np.asarray(c11.args[0].value)
+
+
+@pytest.mark.parametrize("A, C", [(A1, C1), (A3, C3)], ids=["l_o=2", "l_o=3"])
+def test_lmi_own_blocks_are_the_schur_forms_of_theorem2(A, C):
+    """The LMI as compiled (its constraint expressions, evaluated): the Schur complement of Psi (11) over its Y blocks
+    is X - sum_i w_i M_i' Y M_i with M_i = A^i + K^{(i)} C^{(i)}, K^{(i)} = Y^{-1} F_i', C^{(i)} = [C; CA; ...; CA^{i-1}]
+    (built here, not by the module), and the Schur complement of (10) over diag(Y, X) is Y - (1-q) A'YA - q A'XA."""
+    p, q = 0.5, 0.65
+    l_o, X, Y, F, b10, psi = _own_blocks(A, C, p, q, np.random.default_rng(2))
+    n = A.shape[0]
+    r = l_o - 1
+    assert psi.shape == (n * (r + 1), n * (r + 1)) and b10.shape == (3 * n, 3 * n)
+    B, D = psi[n:, :n], psi[n:, n:]
+    assert np.allclose(D, np.kron(np.eye(r), Y), atol=1e-12)  # the Y blocks on the diagonal, zeros elsewhere
+    schur = psi[:n, :n] - B.T @ np.linalg.solve(D, B)
+    direct = X.copy()
+    for i in range(1, l_o):
+        Ci = np.vstack([C @ np.linalg.matrix_power(A, j) for j in range(i)])
+        M = np.linalg.matrix_power(A, i) + np.linalg.solve(Y, F[i - 1].T) @ Ci
+        direct -= p * (1 - p) ** (i - 1) * M.T @ Y @ M
+    assert np.max(np.abs(schur - direct)) < 1e-8 * np.max(np.abs(direct))
+    lower = np.zeros((2 * n, 2 * n))
+    lower[:n, :n], lower[n:, n:] = Y, X
+    s10 = b10[:n, :n] - b10[:n, n:] @ np.linalg.solve(lower, b10[n:, :n])
+    assert np.allclose(s10, Y - (1 - q) * A.T @ Y @ A - q * A.T @ X @ A, atol=1e-9)
+    # the module's helper (erratum E1's residual) agrees with the blocks
+    assert lmis.schur_residual(A, C, p, q, np.random.default_rng(2)) < 1e-8
 
 
 def test_lmi_feasible_is_certified_and_matches_rebuild():

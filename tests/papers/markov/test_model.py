@@ -14,7 +14,7 @@ def test_observability_index():
     assert model.observability_index(A2, C2) == 2
     assert model.observability_index(A3, C3) == 3
     assert model.stacked_output(A3, C3, 2).shape == (2, 3)
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="not observable"):
         model.observability_index(np.eye(2) * 1.2, np.array([[1.0, 0.0]]))
 
 
@@ -93,3 +93,35 @@ def test_stationary_loss_rates():
     assert model.gilbert_elliott_stationary_loss(0.04, 0.65) == pytest.approx(0.0580, abs=5e-5)
     assert model.gilbert_elliott_stationary_loss(0.22004, 0.65) == pytest.approx(0.2529, abs=5e-5)
 
+
+
+def test_parity_ceiling_against_a_numerical_maximisation():
+    """max_q p_c(q) of Example II: the closed form against the spectral-radius condition solved numerically.
+
+    Independent route: at each q, the critical p is the root of rho(|lambda|^4 [[pq, p(1-q)], [q(1-q), (1-q)^2]]) = 1
+    (eigenvalues by LAPACK, root by brentq), maximised over q by a bounded scalar search; no closed form is used."""
+    from scipy.optimize import brentq, minimize_scalar
+
+    lam = 1.2
+    L = lam ** 4
+
+    def rho(p, q):
+        return np.max(np.abs(np.linalg.eigvals(L * np.array([[p * q, p * (1 - q)], [q * (1 - q), (1 - q) ** 2]]))))
+
+    def p_crit(q):
+        return brentq(lambda p: rho(p, q) - 1.0, 0.0, 1.0, xtol=1e-14)
+
+    q_zero = brentq(lambda q: rho(0.0, q) - 1.0, 0.01, 0.99, xtol=1e-14)  # p_c = 0 where (1-q)^2 L = 1
+    best = minimize_scalar(lambda q: -p_crit(q), bounds=(q_zero + 1e-6, 1.0 - 1e-9), method="bounded",
+                           options={"xatol": 1e-10})
+    got = model.parity_ceiling(lam)
+    assert got["p_max"] == pytest.approx(-best.fun, abs=1e-9)
+    assert got["q_star"] == pytest.approx(best.x, abs=1e-4)  # flat maximum: the argmax is resolved less finely
+    assert got["p_at_q1"] == pytest.approx(p_crit(1.0 - 1e-12), abs=1e-9)
+    assert got["q_zero"] == pytest.approx(q_zero, abs=1e-9)
+    # and it is the maximum of the closed-form curve the LMI tests use
+    qs = np.linspace(got["q_zero"], 1.0, 200001)
+    assert np.max(model.parity_bound_example2(lam, qs)) == pytest.approx(got["p_max"], abs=1e-9)
+    assert got["p_max"] == pytest.approx(0.5609, abs=5e-5) and got["p_at_q1"] == pytest.approx(0.4823, abs=5e-5)
+    with pytest.raises(ValueError, match=r"needs \|lambda\| > 1"):
+        model.parity_ceiling(0.9)

@@ -16,9 +16,10 @@ Every decision of the stability map comes from one of these, each a number we co
   ``|lambda_A|^2 (1-q) >= 1`` (the necessary condition of [18]).
 * **unbounded, parity** (:func:`parity_lower_bound`, Example II): when ``A^2 = lambda^2 I`` and
   ``C v = 0`` for some ``v != 0``, the chain ``xi_t`` (coordinate along ``v`` at even ``t``,
-  along ``w = A v / lambda`` at odd ``t``) is measured only at even times. On the event
-  ``E_k`` = {every reception before ``k`` at an odd time},
-  ``Var(xi_k | data) >= sigma^2 sum_{j<k-1} lambda^{2j}``, so
+  along ``w = A v / lambda`` at odd ``t``) is measured only at odd times (``C v = 0``), and its mirror
+  (``v`` at odd ``t``, ``w`` at even ``t``) only at even times. On the event
+  ``E_k`` = {every reception before ``k`` at an odd time} the mirror chain is never measured:
+  its variance given the data is ``>= sigma^2 sum_{j<k-1} lambda^{2j}``, so
   ``E||P_k|| >= sigma^2 / ||f||^2 sum_{j<k-1} lambda^{2j} P(E_k)``, growing like
   ``(lambda^4 (pq + (1-q)^2))^{k/2}`` (:func:`parity_growth`). Its boundary
   ``lambda^4 (pq + (1-q)^2) = 1`` is :func:`~.model.parity_bound_example2`, where Theorem 5 is tight.
@@ -34,7 +35,7 @@ from .model import H_matrix, LinearSystem, loss_factor, riccati_g, spectral_abs
 __all__ = [
     "thm1_radius", "loss_run_growth", "loss_run_lower_bound", "parity_structure", "parity_growth",
     "parity_lower_bound", "two_reception_bound", "critical_distance", "true_critical_curve", "certificate_grid",
-    "decide_certified",
+    "decide_certified", "iid_instability_end",
 ]
 
 
@@ -151,7 +152,8 @@ def parity_structure(A, C, Q, tol: float = 1e-12):
 
     In the basis ``(v, w = A v / lambda, U)`` the span of ``v, w`` is ``A``-invariant, ``A`` swaps
     the two coordinates (times ``lambda``), and ``C v = 0``; the chain ``xi`` (``v``-coordinate at even
-    times, ``w``-coordinate at odd times) is measured only at even times.
+    times, ``w``-coordinate at odd times) is measured only at odd times, its mirror (``v`` at odd times)
+    only at even times.
 
     Parameters
     ----------
@@ -478,3 +480,29 @@ def decide_certified(facts: dict, P, rho_margin: float, growth_margin: float):
                                         np.where(u_par, "parity lower bound grows (lambda^4 (pq + (1-q)^2) > 1)",
                                                  "undecided: no certificate"))))
     return verdict, method
+
+
+def iid_instability_end(A, C, Q):
+    """Arrival rate below which ``E||P_k||`` is certified unbounded on the i.i.d. line ``p + q = 1``.
+
+    On the i.i.d. line (arrival rate ``lambda = q = 1 - p``) the parity growth factor
+    ``|lambda_A|^4 (pq + (1-q)^2)`` of :func:`parity_growth` is ``|lambda_A|^4 (1 - lambda)``, so for a
+    parity-locked system (:func:`parity_structure`, Example II) the lower bound grows for every
+    ``lambda < 1 - |lambda_A|^-4``; otherwise the loss-run bound (:func:`loss_run_growth`) grows for
+    ``lambda < 1 - |lambda_A|^-2`` (the necessary condition of [18]). Any LMI that implies mean-square
+    stability (Sinopoli et al.'s, Theorem 2's) is therefore infeasible below this end.
+
+    Parameters
+    ----------
+    A, C, Q : array_like
+        System, output and process noise matrices.
+
+    Returns
+    -------
+    (float, str)
+        The end and the certificate that backs it.
+    """
+    lam = spectral_abs(A)
+    if parity_structure(A, C, Q) is not None:
+        return 1.0 - lam ** -4, "parity lower bound grows (|lambda|^4 (1 - lambda) > 1) below 1 - |lambda|^-4"
+    return 1.0 - lam ** -2, "loss-run lower bound grows (|lambda|^2 (1 - lambda) >= 1) up to 1 - |lambda|^-2"

@@ -17,7 +17,7 @@ from .model import spectral_abs
 
 __all__ = [
     "two_step_rate", "conditional_estimate", "conditional_validation", "asymptote_extrapolation",
-    "asymptote_backtest",
+    "asymptote_backtest", "asymptote_limit",
 ]
 
 
@@ -177,6 +177,42 @@ def asymptote_extrapolation(exact, k_max: int, rate2: float):
         mean[i] = vals[0]
         lo[i], hi[i] = min(vals), max(vals)
     return mean, lo, hi
+
+
+def asymptote_limit(exact, rate2: float):
+    """``lim_k E||P_k||`` of :func:`asymptote_extrapolation` (``m -> infinity``), with its bracket.
+
+    For ``R < 1`` the sum in :func:`asymptote_extrapolation` converges:
+
+    .. math:: E_\\infty = E_{K'} + D_{K'} \\frac{R}{1 - R},\\quad K' \\in \\{K-1, K\\}
+
+    ``limit`` takes ``R = rho^2`` and averages the two parity classes; ``lo, hi`` span both classes
+    and ``R`` between ``rho^2`` and the observed ratio (the bracket of :func:`asymptote_extrapolation`
+    carried to the limit). ``inf`` when either ratio is ``>= 1`` (the mean diverges).
+
+    Parameters
+    ----------
+    exact : ndarray
+        Exact ``E||P_k||``, ``k = 1..K`` (``K >= 6``).
+    rate2 : float
+        ``rho^2`` from :func:`two_step_rate`.
+
+    Returns
+    -------
+    (limit, lo, hi) : float
+    """
+    exact = np.asarray(exact, float)
+    K = len(exact)
+    if K < 6:
+        raise InputError(f"asymptote_limit needs at least 6 exact values, got {K}")
+    means, vals = [], []
+    for base in (K, K - 1):
+        D = exact[base - 1] - exact[base - 3]
+        r_obs = D / (exact[base - 3] - exact[base - 5])
+        at_rate, at_obs = (exact[base - 1] + D * R / (1.0 - R) if R < 1.0 else np.inf for R in (rate2, r_obs))
+        means.append(at_rate)
+        vals += [at_rate, at_obs]
+    return float(np.mean(means)), float(min(vals)), float(max(vals))
 
 
 def asymptote_backtest(exact, rate2: float, k0: int):

@@ -30,9 +30,13 @@ def figure_plane(params, inputs, outputs):
         ax.plot(c.q, c.p_thm5, color="k", lw=2, label="Theorem 5 lower bound p(q)")
         ax.plot(c.q, c.p_prop1, color="tab:blue", lw=1.5, ls="--", label="Proposition 1 (eq. 8)")
         if c.p_reference.notna().any():
-            ax.plot(c.q, c.p_reference, color="tab:purple", lw=1, ls=":", label="reference p_c (table column reference)")
+            # drawn last and on top: in Example II it coincides with the Theorem 5 curve
+            ax.plot(c.q, c.p_reference, color="magenta", lw=1.6, ls=(0, (2, 2)), zorder=5,
+                    label="reference p_c (dashed on top; = Theorem 5 in Example II)")
         qn = c.q_necessary.iloc[0]
-        ax.axvline(qn, color="tab:orange", lw=1.5, label=f"necessary |lambda|^2(1-q) = 1 (q = {qn:.3f})")
+        ax.axvline(qn, color="tab:orange", lw=1.5, label="necessary |lambda|^2(1-q) = 1 (q in each panel)")
+        ax.annotate(f"q = {qn:.3f}", (qn, 0.92), xytext=(4, 0), textcoords="offset points", color="tab:orange",
+                    fontsize=8, bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.9))
         ax.plot([0, 1], [1, 0], color="0.3", lw=1, ls="-.", label="i.i.d. line p + q = 1")
         r = iid.loc[name]
         ax.plot([r.q_thm5_on_iid_line], [1 - r.q_thm5_on_iid_line], "k*", ms=10, label="Thm 5 on the i.i.d. line")
@@ -52,7 +56,7 @@ _METHOD_STYLE = {
     "exact": dict(color="tab:orange", lw=2.5, ls="-", label="E||P_k|| exact (all channel paths)"),
     "estimate_conditional": dict(color="tab:red", lw=1.5, ls="-",
                                  label="E||P_k|| conditional estimator (validated, 95% CI)"),
-    "asymptote": dict(color="tab:purple", lw=1.5, ls="--", label="E||P_k|| asymptote (derived rate, bracket)"),
+    "asymptote": dict(color="tab:purple", lw=1.5, ls="--", label="E||P_k|| continued with the derived rate (bracket)"),
 }
 
 
@@ -65,6 +69,13 @@ def _draw_expectations(ax, x):
         ax.plot(sub.k, sub.mean_norm, **style)
         if method != "exact":
             ax.fill_between(sub.k, sub.lo, sub.hi, color=style["color"], alpha=0.2, lw=0)
+    lim = x[(x.method == "asymptote") & np.isfinite(x.limit.astype(float))] if "limit" in x else x.iloc[:0]
+    if len(lim):
+        r = lim.iloc[0]
+        ax.axhline(r.limit, color="tab:purple", lw=1.2, ls="-.",
+                   label=f"stable limit of E||P_k|| (derived rate): {r.limit:.4g} [{r.limit_lo:.4g}, {r.limit_hi:.4g}]")
+        if np.isfinite([r.limit_lo, r.limit_hi]).all():
+            ax.axhspan(r.limit_lo, r.limit_hi, color="tab:purple", alpha=0.1, lw=0)
     bad = x[x.method == "not_trustworthy"]
     if len(bad):
         ax.axvspan(bad.k.min(), bad.k.max(), color="0.85", alpha=0.5, label="E||P_k|| not trustworthy (omitted)")
@@ -168,7 +179,7 @@ def figure_estimators(params, inputs, outputs):
 
 
 def figure_curves(params, inputs, outputs):
-    """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values."""
+    """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values p_c."""
     curves = pd.read_csv(inputs["curves"])
     fig, ax = new_figure()
     for name, color in zip(params["examples"], ("tab:blue", "tab:green", "tab:red")):
@@ -177,6 +188,10 @@ def figure_curves(params, inputs, outputs):
         ax.plot(c.q, c.p_prop1_uncapped, color=color, lw=1, ls="--", label=f"Ex {name}: Proposition 1")
         sat = c[c.thm5_saturated.astype(str).str.lower() == "true"]
         ax.plot(sat.q, sat.p_thm5_uncapped, "^", color=color, ms=5, label=f"Ex {name}: search cap reached")
+        ref = c[c.p_reference.notna() & (c.p_reference > 0)]
+        if len(ref):
+            ax.plot(ref.q, ref.p_reference, color=color, lw=1.2, ls=":", marker="o", ms=2.5,
+                    label=f"Ex {name}: reference critical value p_c ({ref.reference.iloc[0].split(':')[0].split(' (')[0]})")
     ax.axhline(1.0, color="k", lw=0.8)
     ax.set_yscale("log")
     ax.set_xlabel("q")

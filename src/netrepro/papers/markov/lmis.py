@@ -17,11 +17,10 @@ from ...errors import InputError
 from .model import L_operator, h_radius, observability_index, stacked_output
 
 __all__ = [
-    "SOLVER", "CANDIDATE_STATUSES", "bisect_monotone", "LMIResult", "GilbertElliottLMI", "certify",
+    "CANDIDATE_STATUSES", "LMIResult", "GilbertElliottLMI", "certify",
     "rebuild_solve", "thm5_lower_bound", "sinopoli_lmi_threshold", "schur_residual", "lmi_necessary_condition", "as_verdict", "kernel_rate",
 ]
 
-SOLVER = "CLARABEL"
 # statuses whose answer is a *candidate*: it becomes a result only after the independent certificate
 CANDIDATE_STATUSES = ("optimal", "optimal_inaccurate")
 
@@ -32,21 +31,11 @@ def _cp():
     return cvxpy
 
 
-def bisect_monotone(*args, **kwargs):
-    """:func:`netrepro.engines.lmi.bisect_monotone` (imported lazily).
+def _solver() -> str:
+    """The shared engine's solver (:data:`netrepro.engines.lmi.SOLVER`), imported lazily with cvxpy."""
+    from ...engines.lmi import SOLVER
 
-    Parameters
-    ----------
-    *args, **kwargs
-        As :func:`netrepro.engines.lmi.bisect_monotone`.
-
-    Returns
-    -------
-    The engine's bisection result (``threshold``, ``lower``, ``bracketed``, ``n_evals``).
-    """
-    from ...engines.lmi import bisect_monotone as _bisect
-
-    return _bisect(*args, **kwargs)
+    return SOLVER
 
 
 # ----------------------------------------------------------------------------- Theorem 2 LMI (10)-(11)
@@ -96,7 +85,8 @@ class GilbertElliottLMI:
         (11):\\ \\Psi = \\begin{bmatrix} X & \\cdots & \\sqrt{w_i}\\,((A^i)'Y + C^{(i)\\prime}F_i) & \\cdots \\\\
                  \\vdots & & \\ddots \\\\ \\sqrt{w_i}\\,(YA^i + F_i'C^{(i)}) & & Y \\end{bmatrix} \\succ 0
 
-    with ``w_i = p (1-p)^{i-1}``. Derivation (tested in ``tests/test_markov.py``): the Schur
+    with ``w_i = p (1-p)^{i-1}``. Derivation (tested on the LMI's own blocks in
+    ``tests/papers/markov/test_lmis.py``): the Schur
     complement of (10) is ``Y - (1-q)A'YA - qA'XA >= 0``, hence ``Y >= Phi_X``; the Schur
     complement of (11) is ``X - sum_i w_i M_i' Y M_i`` with ``M_i = A^i + K^{(i)} C^{(i)}``,
     ``K^{(i)} = Y^{-1} F_i'``; so ``X > L_K(X)`` (Theorem 2 (iii)).
@@ -199,7 +189,7 @@ class GilbertElliottLMI:
         try:
             with warnings.catch_warnings():  # "optimal_inaccurate" is kept as a status, not printed
                 warnings.simplefilter("ignore", UserWarning)
-                self.problem.solve(solver=SOLVER)
+                self.problem.solve(solver=_solver())
             status = str(self.problem.status)
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
@@ -308,7 +298,7 @@ def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
     prob = cp.Problem(cp.Maximize(t), [0.5 * (lmi10 + lmi10.T) >> t * np.eye(3 * n),
                                        0.5 * (psi + psi.T) >> t * np.eye(n * (r + 1)), Y << np.eye(n)])
     try:
-        prob.solve(solver=SOLVER)
+        prob.solve(solver=_solver())
         status = str(prob.status)
     except cp.error.SolverError as exc:
         status = f"solver_error: {exc}"

@@ -20,7 +20,8 @@ from ...errors import InputError
 __all__ = [
     "LinearSystem", "spectral_abs", "observability_index", "stacked_output", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm",
-    "gilbert_elliott_stationary_loss", "parity_bound_example2", "norm_relaxation_bound",
+    "gilbert_elliott_stationary_loss", "parity_bound_example2", "parity_ceiling", "norm_relaxation_bound",
+    "prop1_closed_form",
 ]
 
 
@@ -456,6 +457,63 @@ def parity_bound_example2(lam_abs: float, q):
     q = np.asarray(q, dtype=float)
     l2 = lam_abs ** 2
     return (1.0 - (l2 * (1.0 - q)) ** 2) / (l2 * l2 * q)
+
+
+def parity_ceiling(lam_abs: float) -> dict:
+    """The largest critical failure rate of Example II over all recovery rates, and its ends.
+
+    With ``L = |lambda|^4`` the critical curve (:func:`parity_bound_example2`, the zero set of the
+    parity growth ``L (pq + (1-q)^2) = 1``) is ``p_c(q) = (1 - L (1-q)^2) / (L q)``. With
+    ``u = 1 - q``, ``d p_c / d u = 0`` gives ``L u^2 - 2 L u + 1 = 0``, so ``q* = sqrt(1 - 1/L)`` and,
+    using ``1 - L u^2 = 2 (1 - L u)``, ``max_q p_c(q) = 2 (1 - q*) = 2 (1 - sqrt(1 - |lambda|^-4))``
+    (a maximum: ``p_c`` is concave in ``q`` on ``(0, 1]``, ``p_c'' = -2 / (L q^3) < 0``). At ``q -> 1``
+    the curve ends at ``1 / L``; it reaches 0 at ``q = 1 - 1/|lambda|^2``, the necessary condition
+    ``|lambda|^2 (1-q) < 1`` of [18]. Since ``max_q p_c < 1``, every ``p`` above it is mean-square
+    unstable at every ``q`` (the parity lower bound grows: :func:`~.certificates.parity_growth` > 0).
+
+    Parameters
+    ----------
+    lam_abs : float
+        ``|lambda|`` of Example II (1.2 in eq. 13); ``|lambda| > 1``.
+
+    Returns
+    -------
+    dict
+        ``p_max`` (``max_q p_c(q)``), ``q_star`` (its argmax), ``p_at_q1`` (``p_c(1) = |lambda|^-4``),
+        ``q_zero`` (``1 - |lambda|^-2``, where ``p_c = 0``).
+
+    Raises
+    ------
+    InputError
+        If ``|lambda| <= 1`` (no critical curve: stable for every ``(p, q)``).
+    """
+    lam_abs = float(lam_abs)
+    if not lam_abs > 1.0:
+        raise InputError(f"parity_ceiling needs |lambda| > 1, got {lam_abs}")
+    L = lam_abs ** 4
+    q_star = float(np.sqrt(1.0 - 1.0 / L))
+    return {"p_max": 2.0 * (1.0 - q_star), "q_star": q_star, "p_at_q1": 1.0 / L, "q_zero": 1.0 - 1.0 / lam_abs ** 2}
+
+
+def prop1_closed_form(lam_abs: float, q):
+    """The closed form printed in Section 5.1: ``(1 - |lambda|^2 (1-q)) / (|lambda|^4 q)``.
+
+    Eq. (8) with ``l_o = 2`` as printed in the text (compared with :func:`prop1_bound`).
+
+    Parameters
+    ----------
+    lam_abs : float
+        ``|lambda_A|``.
+    q : array_like
+        Recovery rates.
+
+    Returns
+    -------
+    ndarray
+        The printed bound on ``p``.
+    """
+    q = np.asarray(q, dtype=float)
+    return (1.0 - lam_abs ** 2 * (1.0 - q)) / (lam_abs ** 4 * q)
 
 
 def norm_relaxation_bound(A, q, K=None, i_max: int = 4000):

@@ -6,10 +6,11 @@ the exact horizon leaves undecided. Both depend on thresholds; ``map_sensitivity
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from .estimators import rb_trace_grid
 
-__all__ = ["classify_growth", "refine_long_horizon", "decide_estimator"]
+__all__ = ["classify_growth", "refine_long_horizon", "decide_estimator", "single_transition"]
 
 
 def classify_growth(means: np.ndarray, bounded_tol: float, unbounded_tol: float):
@@ -133,3 +134,30 @@ def decide_estimator(means, long_rate, long_rel, bounded_tol, unbounded_tol, rel
                                                             np.where(long_rate > refine_unbounded_tol, "unbounded",
                                                                      "undecided")))
     return np.where(verdict == "undecided", v_long, verdict)
+
+
+def single_transition(smap: pd.DataFrame):
+    """Whether, at every ``q`` of the certified map, every bounded ``p`` lies below every unbounded ``p``.
+
+    The conclusion of Proposition 2 (one critical value ``p_c(q)`` per ``q``), checked on a map.
+
+    Parameters
+    ----------
+    smap : DataFrame
+        ``stability_map.csv`` (columns ``example, p, q, verdict``).
+
+    Returns
+    -------
+    (bool, str)
+        The property over all examples and ``q``, and a note with the counts.
+    """
+    bad, parts = 0, []
+    for name, s in smap.groupby("example", sort=True):
+        b = s[s.verdict == "bounded"].groupby("q").p.max()
+        u = s[s.verdict == "unbounded"].groupby("q").p.min()
+        both = b.index.intersection(u.index)
+        viol = int((b[both] >= u[both]).sum())
+        bad += viol
+        parts.append(f"Example {name}: {viol} of {s.q.nunique()} q with a bounded p above an unbounded p, "
+                     f"{int((s.verdict == 'undecided').sum())} undecided points")
+    return bool(bad == 0), "; ".join(parts)

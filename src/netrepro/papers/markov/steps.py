@@ -27,6 +27,10 @@ Tables (``results/markov/``)
     ``mode`` (parametrised / rebuilt), ``n_solves, seconds, solves_per_second``.
 ``iid_line.csv``
     ``example, lambda_lower`` (1 - 1/|lambda_max(A)|^2), ``lambda_lmi_upper`` (Sinopoli LMI),
+    ``lambda_lmi_upper_infeasible_end`` (the bisection's certified-infeasible end),
+    ``lambda_lmi_infeasible_certified_end`` (the larger of it and the arrival rate below which a lower
+    bound certifies divergence, where the LMI, sufficient for stability, cannot be feasible),
+    ``lambda_lmi_infeasible_evidence`` and ``lambda_lmi_bracket_width`` (upper minus that end),
     ``q_thm5_on_iid_line`` (smallest q with the Theorem 2 LMI certified at p = 1 - q),
     ``lambda_c_reference`` and ``reference``, ``consistent``.
 ``exact_moments.csv``
@@ -54,7 +58,9 @@ Tables (``results/markov/``)
     ``lo, hi`` and ``method``: ``exact`` (all channel paths, lo = hi = mean), ``estimate_conditional``
     (conditional estimator validated against the exact values, 95% interval, relative half-width
     below ``rel_tol``), ``asymptote`` (derived two-step rate, bracket from the observed ratio, validated
-    by a backtest on the exact range) or ``not_trustworthy`` (empty mean).
+    by a backtest on the exact range) or ``not_trustworthy`` (empty mean); on ``asymptote`` rows
+    ``limit, limit_lo, limit_hi``: ``lim_k E||P_k||`` of the asymptote and its bracket (``inf`` when it
+    diverges; :func:`.expectations.asymptote_limit`), empty elsewhere.
 """
 
 from __future__ import annotations
@@ -70,7 +76,8 @@ from .exact import ExactMoments, exact_moments_auto, find_split
 from .lmis import GilbertElliottLMI, as_verdict, rebuild_solve, sinopoli_lmi_threshold, thm5_lower_bound
 from .model import LinearSystem, observability_index, parity_bound_example2, prop1_bound, spectral_abs
 from .certificates import (
-    certificate_grid, critical_distance, decide_certified, parity_structure, true_critical_curve, two_reception_bound,
+    certificate_grid, critical_distance, decide_certified, iid_instability_end, parity_structure, true_critical_curve,
+    two_reception_bound,
 )
 from .stability import classify_growth, decide_estimator, refine_long_horizon
 
@@ -215,6 +222,9 @@ def iid_line_step(params, inputs, outputs):
         lam = spectral_abs(A)
         lower = 1.0 - 1.0 / lam ** 2
         upper, _, sin_br = sinopoli_lmi_threshold(A, C, tol)
+        # the LMI implies mean-square stability, so it is infeasible wherever a lower bound certifies divergence
+        unstable_end, unstable_evidence = iid_instability_end(A, C, ex["Q"])
+        infeasible_end = float(np.fmax(sin_br.infeasible_end, unstable_end))
         lmi = GilbertElliottLMI(A, C)
         # feasibility at (p, q) = (1 - q, q) is monotone in q: p falls while p_underline(q) rises
         res = bisect_certified(lambda q: as_verdict(lmi.solve(1.0 - q, q)), lower + 1e-6, 1.0 - 1e-6, tol=tol,
@@ -228,6 +238,10 @@ def iid_line_step(params, inputs, outputs):
             ref, text = np.nan, ""
         rows.append({"example": name, "lambda_lower": lower, "lambda_lmi_upper": upper,
                      "lambda_lmi_upper_infeasible_end": sin_br.infeasible_end, "lambda_lmi_certified": sin_br.certified,
+                     "lambda_lmi_infeasible_certified_end": infeasible_end,
+                     "lambda_lmi_infeasible_evidence": (unstable_evidence if not unstable_end < infeasible_end
+                                                        else "Sinopoli LMI bisection (certified infeasible end)"),
+                     "lambda_lmi_bracket_width": upper - infeasible_end,
                      "q_thm5_on_iid_line": res.feasible_end, "q_thm5_infeasible_end": res.infeasible_end,
                      "q_thm5_certified": res.certified, "lambda_c_reference": ref, "reference": text,
                      "consistent": bool(lower - tol <= ref <= min(upper, res.feasible_end) + tol)})
@@ -432,9 +446,10 @@ def _expectation_rows(case, exact, k_max, cond, asym):
             rows.append({"k": k, "mean_norm": mean[k - 1], "lo": mean[k - 1] - half[k - 1],
                          "hi": mean[k - 1] + half[k - 1], "method": "estimate_conditional"})
     elif asym is not None:
-        mean, lo, hi = asym
+        mean, lo, hi, limit = asym
         for i, k in enumerate(ks):
-            rows.append({"k": k, "mean_norm": mean[i], "lo": lo[i], "hi": hi[i], "method": "asymptote"})
+            rows.append({"k": k, "mean_norm": mean[i], "lo": lo[i], "hi": hi[i], "method": "asymptote",
+                         "limit": limit[0], "limit_lo": limit[1], "limit_hi": limit[2]})
     else:
         rows += [{"k": k, "mean_norm": np.nan, "lo": np.nan, "hi": np.nan, "method": "not_trustworthy"} for k in ks]
     return [{"example": case["example"], "p": float(case["p"]), "q": float(case["q"]), **r} for r in rows]
@@ -489,8 +504,10 @@ def expectations_step(params, inputs, outputs):
                 info.update(backtest_inside=inside, backtest_max_rel_err=err, backtest_monotone=mono,
                             asym_max_rel_halfwidth=width)
                 if parity and inside and mono:
-                    asym = (a_mean, a_lo, a_hi)
+                    limit = xp.asymptote_limit(exact, rate2)
+                    info.update(asym_limit=limit[0], asym_limit_lo=limit[1], asym_limit_hi=limit[2])
+                    asym = (a_mean, a_lo, a_hi, limit)
         rows += _expectation_rows(case, exact, k_max, cond, asym)
         prov[case["figure"]] = info
-    cols = ["example", "p", "q", "k", "mean_norm", "lo", "hi", "method"]
+    cols = ["example", "p", "q", "k", "mean_norm", "lo", "hi", "method", "limit", "limit_lo", "limit_hi"]
     return {"table": pd.DataFrame(rows, columns=cols), "provenance": prov}
