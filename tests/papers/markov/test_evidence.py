@@ -61,10 +61,10 @@ def test_prop1_closed_form_value():
 
 def test_single_transition():
     rows = [("I", p, 0.5, "bounded" if p < 0.4 else "unbounded") for p in (0.1, 0.3, 0.5, 0.7)]
-    ok, _ = stability.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    ok, _ = stability.single_transition(*zip(*rows))
     assert ok
     rows[3] = ("I", 0.7, 0.5, "bounded")
-    bad, note = stability.single_transition(pd.DataFrame(rows, columns=["example", "p", "q", "verdict"]))
+    bad, note = stability.single_transition(*zip(*rows))
     assert not bad and "1 of 1" in note
 
 

@@ -15,7 +15,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from ...verdicts import erratum_evidence, evidence_frame, load_claims
+from ...paperdata import load_claims
+from ...verdicts import erratum_evidence, evidence_frame
 from .certificates import parity_growth, parity_structure
 from .enumeration import enumerate_norms, mean_norm_enumerated, monotonicity_violation, transition_codes
 from .lmis import schur_residual
@@ -248,7 +249,7 @@ def _map_rows(smap, curves, sens, params):
         contra, und, far_und, est_wrong = contra + c, und + u, far_und + f, est_wrong + w
         notes.append(f"Example {name}: {c} contradictions, {u} of {len(s)} undecided ({f} at distance >= {far:g}), "
                      f"estimator contradicts at {w} and leaves {int((est == 'undecided').sum())} undecided")
-    single, detail = single_transition(smap)
+    single, detail = single_transition(smap.example, smap.p, smap.q, smap.verdict)
     rows = [dict(quantity="map.single_transition", value=single, note=detail),
             dict(quantity="map.contradictions", value=contra + far_und, note="; ".join(notes)),
             dict(quantity="map.estimator_contradictions", value=est_wrong, note="; ".join(notes))]

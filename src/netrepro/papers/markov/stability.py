@@ -6,7 +6,6 @@ the exact horizon leaves undecided. Both depend on thresholds; ``map_sensitivity
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from .estimators import rb_trace_grid
 
@@ -136,28 +135,34 @@ def decide_estimator(means, long_rate, long_rel, bounded_tol, unbounded_tol, rel
     return np.where(verdict == "undecided", v_long, verdict)
 
 
-def single_transition(smap: pd.DataFrame):
+def single_transition(example, p, q, verdict):
     """Whether, at every ``q`` of the certified map, every bounded ``p`` lies below every unbounded ``p``.
 
     The conclusion of Proposition 2 (one critical value ``p_c(q)`` per ``q``), checked on a map.
 
     Parameters
     ----------
-    smap : DataFrame
-        ``stability_map.csv`` (columns ``example, p, q, verdict``).
+    example, p, q, verdict : array_like
+        The columns ``example, p, q, verdict`` of ``stability_map.csv`` (one entry per map point;
+        ``verdict`` in ``bounded``, ``unbounded``, ``undecided``).
 
     Returns
     -------
     (bool, str)
         The property over all examples and ``q``, and a note with the counts.
     """
+    example, verdict = np.asarray(example).astype(str), np.asarray(verdict).astype(str)
+    p, q = np.asarray(p, dtype=float), np.asarray(q, dtype=float)
     bad, parts = 0, []
-    for name, s in smap.groupby("example", sort=True):
-        b = s[s.verdict == "bounded"].groupby("q").p.max()
-        u = s[s.verdict == "unbounded"].groupby("q").p.min()
-        both = b.index.intersection(u.index)
-        viol = int((b[both] >= u[both]).sum())
+    for name in sorted(set(example)):
+        mine = example == name
+        qs = np.unique(q[mine])
+        viol = 0
+        for qv in qs:
+            at = mine & (q == qv)
+            bounded, unbounded = p[at & (verdict == "bounded")], p[at & (verdict == "unbounded")]
+            viol += int(bounded.size > 0 and unbounded.size > 0 and bounded.max() >= unbounded.min())
         bad += viol
-        parts.append(f"Example {name}: {viol} of {s.q.nunique()} q with a bounded p above an unbounded p, "
-                     f"{int((s.verdict == 'undecided').sum())} undecided points")
+        parts.append(f"Example {name}: {viol} of {qs.size} q with a bounded p above an unbounded p, "
+                     f"{int((verdict[mine] == 'undecided').sum())} undecided points")
     return bool(bad == 0), "; ".join(parts)
