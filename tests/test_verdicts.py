@@ -314,3 +314,13 @@ def test_no_statement_or_printed_form_is_typed_in_python(slug):
     sources = "\n".join(p.read_text() for p in Path(__file__).resolve().parents[1].glob("src/netrepro/**/*.py"))
     typed = [t for t in texts if len(t) >= 25 and t in sources]
     assert not typed, typed
+
+
+def test_integers_of_the_evidence_table_stay_integers(tmp_path):
+    path = tmp_path / "evidence.csv"
+    path.write_text("quantity,variant,value,note\nseed,nominal,20150101,\nx,nominal,2.5,\nflag,nominal,True,\n")
+    from netrepro.verdicts import read_evidence
+
+    evidence = read_evidence(path)
+    assert evidence["seed"]["nominal"][0] == 20150101 and isinstance(evidence["seed"]["nominal"][0], int)
+    assert evidence["x"]["nominal"][0] == 2.5 and evidence["flag"]["nominal"][0] is True

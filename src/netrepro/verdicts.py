@@ -154,12 +154,17 @@ def erratum_evidence(erratum_id: str, printed, corrected=None, note: str = "") -
 
 
 def _parse(value):
-    """A cell of the evidence table: booleans and numbers back from their text."""
+    """A cell of the evidence table: booleans and numbers back from their text.
+
+    An integer stays an integer (a seed or a horizon is shown as ``20150101``, not ``20150101.0``).
+    """
     if isinstance(value, (bool, int, float)) and not isinstance(value, str):
         return value
     text = str(value).strip()
     if text in ("True", "False"):
         return text == "True"
+    if re.fullmatch(r"[+-]?\d+", text):
+        return int(text)
     try:
         return float(text)
     except ValueError:
