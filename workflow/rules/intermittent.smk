@@ -290,7 +290,7 @@ rule intermittent_evidence:
     params:
         cfg=as_json(
             {
-                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
+                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets"),
                 "two_sensor": pick(
                     ICFG.get("two_sensor", {}),
                     "a",
