@@ -442,12 +442,14 @@ def _tail_rows(sc, lam, curve, tails):
     inside = curve[(curve["lam"] > critical_probability(a))]
     between = bool(np.all((inside["stationary_hi"] >= inside["s_limit"]) & (inside["stationary_lo"] <= inside["r_limit"])))
     row = tails.loc[(tails["lam"] - lam).abs().idxmin()]
+    quantiles = [c for c in tails.columns if c.startswith("q") and c[1:].replace(".", "", 1).isdigit()]
     return [{"quantity": "tail_index_fig1", "value": alpha,
              "note": f"lambda = lambda_c + 0.1 = {lam:.4f}: P(p_inf > x) ~ x^-alpha, alpha = log(1/(1 - lambda))/log(a^2) "
                      f"= {alpha:.4f} < 2, so E(p_inf) = {float(row['stationary_mean']):.4f} is finite but the "
                      f"variance is infinite (finite only for lambda > 1 - 1/a^4 = {var_from:.4f}); exact law of "
-                     f"p_{int(row['k'])} by enumeration: median {row['q0.5']:.4g}, 99 % {row['q0.99']:.4g}, 99.99 % "
-                     f"{row['q0.9999']:.4g}, largest {row['p_max']:.4g} against its mean {row['mean']:.4g}"},
+                     f"p_{int(row['k'])} by enumeration: quantiles "
+                     + ", ".join(f"{c[1:]}: {row[c]:.4g}" for c in quantiles)
+                     + f", largest {row['p_max']:.4g} against its mean {row['mean']:.4g}"},
             {"quantity": "variance_threshold", "value": var_from,
              "note": "E(p_inf^2) < inf iff (1 - lambda) a^4 < 1, i.e. lambda > 1 - 1/a^4"},
             {"quantity": "stationary_within_bounds", "value": between,
