@@ -205,6 +205,67 @@ rule intermittent_two_sensor_simulation:
         step("netrepro.papers.intermittent.steps:two_sensor_simulation_step")
 
 
+rule intermittent_stationary_curve:
+    input:
+        code=code("netrepro.papers.intermittent.steps:stationary_curve_step"),
+    output:
+        table="results/intermittent/stationary_curve.csv",
+    log:
+        "logs/intermittent/stationary_curve.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(
+            {
+                **pick(ICFG.get("scalar", {}), "a", "R1", "R2", "lambda_offsets"),
+                **ICFG.get("stationary_curve", {}),
+            }
+        ),
+        io=io_json,
+    shell:
+        step("netrepro.papers.intermittent.steps:stationary_curve_step")
+
+
+rule intermittent_heavy_tail:
+    input:
+        code=code("netrepro.papers.intermittent.steps:heavy_tail_step"),
+    output:
+        table="results/intermittent/heavy_tail.csv",
+    log:
+        "logs/intermittent/heavy_tail.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(
+            {
+                **pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets"),
+                **ICFG.get("heavy_tail", {}),
+            }
+        ),
+        io=io_json,
+    shell:
+        step("netrepro.papers.intermittent.steps:heavy_tail_step")
+
+
+rule intermittent_region_closed_form:
+    input:
+        code=code("netrepro.papers.intermittent.steps:region_closed_form_step"),
+    output:
+        table="results/intermittent/region_closed_form.csv",
+    log:
+        "logs/intermittent/region_closed_form.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(pick(ICFG.get("two_sensor", {}), "a", "n_dense")),
+        io=io_json,
+    shell:
+        step("netrepro.papers.intermittent.steps:region_closed_form_step")
+
+
 rule intermittent_evidence:
     input:
         code=code("netrepro.papers.intermittent.evidence:evidence_step"),
@@ -212,6 +273,9 @@ rule intermittent_evidence:
         region=rules.intermittent_two_sensor_region.output.table,
         simulation=rules.intermittent_two_sensor_simulation.output.table,
         stationary=rules.intermittent_stationary_mean.output.table,
+        curve=rules.intermittent_stationary_curve.output.table,
+        tails=rules.intermittent_heavy_tail.output.table,
+        claims="src/netrepro/papers/intermittent/claims.yaml",
     output:
         table="results/evidence/intermittent.csv",
     log:
@@ -226,8 +290,14 @@ rule intermittent_evidence:
     params:
         cfg=as_json(
             {
-                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0"),
-                "two_sensor": pick(ICFG.get("two_sensor", {}), "a", "sigma2", "bisection_tol"),
+                "scalar": pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets"),
+                "two_sensor": pick(
+                    ICFG.get("two_sensor", {}),
+                    "a",
+                    "sigma2",
+                    "bisection_tol",
+                    "check_lambda1",
+                ),
                 "evidence": ICFG.get("evidence", {}),
             }
         ),
@@ -244,5 +314,8 @@ if enabled("intermittent"):
         rules.intermittent_monte_carlo.output.table,
         rules.intermittent_two_sensor_region.output.table,
         rules.intermittent_two_sensor_simulation.output.table,
+        rules.intermittent_stationary_curve.output.table,
+        rules.intermittent_heavy_tail.output.table,
+        rules.intermittent_region_closed_form.output.table,
         rules.intermittent_evidence.output.table,
     ]

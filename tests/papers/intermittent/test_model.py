@@ -67,3 +67,32 @@ def test_sinopoli_operator_minimum_is_the_modified_riccati_map():
     values = im.sinopoli_operator(ks, p, LAM_S, A, R1, R2)
     assert values.min() == pytest.approx(im.upper_bound_sequence(p, A, R1, R2, LAM_S, 1)[1], rel=1e-9)
     assert ks[values.argmin()] == pytest.approx(-A * p / (p + R2), abs=1e-4)
+
+
+def test_estimate_with_true_mean_is_exact_for_a_point_mass():
+    # if p_k is deterministic (s = r = E(p) = m), the report's formula is exactly the lambda-mixture of eq. (6)
+    m = np.array([10.0, 3.0, 0.7, 2.2])
+    out = im.estimate_with_true_mean(m, m, m, A, R1, R2, LAM_S)
+    with_arrival = A * A * m * R2 / (m + R2) + R1
+    without = A * A * m + R1
+    assert out[0] == m[0]
+    np.testing.assert_allclose(out[1:], (LAM_S * with_arrival + (1 - LAM_S) * without)[:-1], rtol=1e-13)
+
+
+def test_printed_condition_11_is_the_printed_condition_divided_by_a2_p():
+    # E2: (11) = [p > a^2 p + lambda a^2 p^2 (p + R2)^-2 (p - 2 + R2)] / (a^2 p), rearranged
+    p = np.logspace(-2, 2, 50)
+    lam = LAM_S
+    direct = p - (A * A * p + lam * A * A * p * p / (p + R2) ** 2 * (p - 2 + R2))
+    np.testing.assert_allclose(im.condition_11_printed(p, lam, A, R2) * A * A * p, direct, rtol=1e-12, atol=1e-14)
+
+
+def test_corrected_condition_11_is_x_minus_phi_at_the_optimal_gain():
+    p = np.logspace(-2, 2, 50)
+    phi = im.sinopoli_operator(-A * p / (p + R2), p, LAM_S, A, R1, R2)
+    np.testing.assert_allclose(im.condition_11_corrected(p, LAM_S, A, R1, R2) * A * A * p, p - phi, rtol=1e-10,
+                               atol=1e-13)
+    # the corrected condition holds for some p iff lambda > 1 - 1/a^2 (the MARE has a fixed point)
+    grid = np.logspace(-3, 6, 2000)
+    assert np.max(im.condition_11_corrected(grid, LAM_S, A, R1, R2)) > 0
+    assert np.max(im.condition_11_corrected(grid, LAM_S - 0.2, A, R1, R2)) < 0

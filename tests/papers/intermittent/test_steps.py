@@ -1,6 +1,8 @@
 import numpy as np
 import pandas as pd
+import pytest
 
+from netrepro.errors import InputError
 from netrepro.io import write_table
 from netrepro.papers.intermittent import steps
 
@@ -60,3 +62,56 @@ def test_simulation_step_columns():
     assert np.isfinite(table["mean"]).all()
     assert np.isfinite(table[table["side"] == "stable"]["stationary_mean"]).all()
     assert np.isinf(table[table["side"] == "unstable"]["stationary_mean"]).all()
+
+
+def test_stationary_curve_lies_between_its_bounds_and_flags_the_variance():
+    table = steps.stationary_curve_step(dict(a=A, R1=R1, R2=R2, n_lambda=12, first_fraction=1e-3,
+                                             lambda_offsets=[0.1, -0.1]), {}, {})["table"]
+    lam_c = 1 - 1 / A**2
+    assert table["lam"].min() == pytest.approx(lam_c + 1e-3 / A**2) and table["lam"].max() == 1.0
+    assert len(table) == 14 and table["report_setting"].sum() == 1
+    assert table.loc[table["report_setting"], "lam"].iloc[0] == pytest.approx(lam_c + 0.1)
+    assert (table["s_limit"] <= table["stationary_lo"]).all()
+    assert (table["stationary_lo"] <= table["r_limit"] * (1 + 1e-12)).all()
+    inner = table[table["lam"] < 1.0]
+    assert (inner["stationary_hi"] < inner["r_limit"]).all()  # E(p_inf) < r* strictly when arrivals are random
+    assert (table["variance_finite"] == (table["lam"] > 1 - 1 / A**4)).all()
+    # lambda = 1: the standard Kalman filter, E(p_inf) = r* = the positive root of p = a^2 p R2/(p + R2) + R1
+    last = table.iloc[-1]
+    p = last["stationary_mean"]
+    assert p == pytest.approx(A * A * p * R2 / (p + R2) + R1, rel=1e-12)
+    assert p == pytest.approx(last["r_limit"], rel=1e-12)
+    with pytest.raises(InputError, match="first_fraction"):
+        steps.stationary_curve_step(dict(a=A, R1=R1, R2=R2, n_lambda=5, first_fraction=1.0), {}, {})
+
+
+def test_heavy_tail_table_against_a_monte_carlo_of_p_k():
+    params = dict(a=A, R1=R1, R2=R2, Ep0=P0, horizon=12, lambda_offsets=[0.1], lambdas=[0.9], quantiles=[0.5, 0.9])
+    table = steps.heavy_tail_step(params, {}, {})["table"]
+    assert table["lam_label"].tolist() == ["lambda_c+0.1", "lambda=0.9"]
+    assert table["variance_finite"].tolist() == [False, True]
+    row = table.iloc[0]
+    assert row["mean"] == pytest.approx(row["mean_exact"], rel=1e-12)
+    # independent: simulate eq. (6) and compare the empirical quantiles (200k paths; the law is discrete, so
+    # compare through the CDF: P(p_12 <= q) >= level and P(p_12 < q) <= level, up to 4 binomial s.e.)
+    rng = np.random.default_rng(11)
+    lam = 1 - 1 / A**2 + 0.1
+    p = np.full(200_000, P0)
+    for _ in range(12):
+        g = rng.random(p.size) < lam
+        p = A * A * p + R1 - g * A * A * p * p / (p + R2)
+    se = 4 * np.sqrt(0.25 / p.size)
+    for level, q in ((0.5, row["q0.5"]), (0.9, row["q0.9"])):
+        assert np.mean(p <= q * (1 + 1e-12)) >= level - se
+        assert np.mean(p < q * (1 - 1e-12)) <= level + se
+    assert not row["variance_finite"] and row["mean_finite"]
+
+
+def test_region_closed_form_has_the_kink_exactly():
+    table = steps.region_closed_form_step(dict(a=A, n_dense=11), {}, {})["table"]
+    kink = 1 - 1 / A**2
+    assert kink in set(table["lambda1"]) and len(table) == 12
+    assert table.loc[table["lambda1"] == kink, "lambda2c_lower"].iloc[0] == pytest.approx(0.0, abs=1e-15)
+    below = table[table["lambda1"] < kink]
+    assert (below["lambda2c_lower"] > 0).all()
+    assert (table[table["lambda1"] > kink]["lambda2c_lower"] == 0).all()

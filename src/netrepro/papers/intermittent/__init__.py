@@ -14,15 +14,26 @@ Modules
     Sinopoli's operator phi(K, p).
 ``estimators``
     The conditional Monte Carlo estimator of E(p_k) (averages bounded quantities only).
+``exact``
+    Exact E(p_k) at every k and the stationary mean, with rigorous error bounds
+    (last-arrival decomposition, backward recursion on Chebyshev interpolants).
+``tails``
+    Sample paths and tails of p_k: the loss-run probability (log-scaled repeated squaring of the
+    substochastic run-length block, with two independent checks), the tail index of p_inf and the
+    moment thresholds 1 - 1/a^{2n}, quantiles of a discrete law.
+``readings``
+    How the report's figures and words are read: settling and forgetting steps, the worst
+    relative error, the one-step growth ratio.
 ``two_sensor``
     The two-sensor stability region (Liu & Goldsmith): closed-form lower bound and the
     certified LMI upper bound (eq. 16) by bisection.
 ``steps``
     Pipeline steps writing ``results/intermittent/*.csv``.
-``claims``
-    The claims, errata and reconstructions tables.
+``evidence``
+    Assembly only: the evidence table the claims, errata, reconstructions and findings
+    (``*.yaml`` beside this package) are judged against.
 ``figures``
-    Figs 1, 2, 4, 5 and S1 from the tables.
+    Figs 1, 2, 4, 5, S1 and S2 from the tables.
 ``checks``
     ``check_config``: configuration checks beyond the schema.
 """

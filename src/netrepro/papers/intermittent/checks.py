@@ -18,8 +18,9 @@ def check_config(section: dict) -> None:
     Raises
     ------
     ConfigError
-        If ``scalar.exact_horizon`` exceeds ``scalar.horizon``, or lambda_c + an offset of
-        ``scalar.lambda_offsets`` is not a probability; the message names the key.
+        If ``scalar.exact_horizon`` exceeds ``scalar.horizon``, lambda_c + an offset of
+        ``scalar.lambda_offsets`` is not a probability, or ``evidence.sample_path_horizons`` are not
+        increasing whole numbers; the message names the key.
     """
     scalar = section.get("scalar", {})
     if scalar and scalar.get("exact_horizon", 0) > scalar.get("horizon", 0):
@@ -33,3 +34,7 @@ def check_config(section: dict) -> None:
             raise ConfigError(
                 f"config key 'intermittent.scalar.lambda_offsets' has {off}: lambda_c + offset = {lam_c + off:.3f} "
                 "is not a probability in [0, 1]")
+    horizons = section.get("evidence", {}).get("sample_path_horizons", [])
+    if any(float(t) != int(float(t)) for t in horizons) or any(b <= a for a, b in zip(horizons, horizons[1:])):
+        raise ConfigError(f"config key 'intermittent.evidence.sample_path_horizons' = {horizons} must be increasing "
+                          "whole numbers")

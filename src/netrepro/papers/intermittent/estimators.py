@@ -77,7 +77,8 @@ def conditional_mean_paths(p_paths, p0, a, R1, sensor_vars, probs):
                  L^{k-1-j}(\\varphi_S(p_j))\\big] + \\pi_0^k L^k(p_0),
 
     where phi_S(p) = a^2 (p^{-1} + sum_{i in S} 1/sigma_i^2)^{-1} + R1 is bounded
-    by a^2 min_i sigma_i^2 + R1. The returned per-path quantity Y_k has
+    by a^2 max_i sigma_i^2 + R1 for every S (a single sensor i alone gives a^2 sigma_i^2 + R1 at most).
+    The returned per-path quantity Y_k has
     E(Y_k) = E(p_k) and is bounded, so its sample mean obeys the CLT,
     unlike the sample mean of p_k (heavy-tailed; infinite variance when
     pi_0 a^4 >= 1).

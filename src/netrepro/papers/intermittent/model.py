@@ -16,6 +16,9 @@ __all__ = [
     "lower_bound_sequence",
     "upper_bound_sequence",
     "report_estimate_sequence",
+    "estimate_with_true_mean",
+    "condition_11_printed",
+    "condition_11_corrected",
     "exact_mean_enumeration",
     "sinopoli_operator",
     "mare_fixed_point",
@@ -155,6 +158,78 @@ def report_estimate_sequence(m0, s, r, a, R1, R2, lam, printed=False) -> np.ndar
         else:
             m[k + 1] = a * a * m[k] + R1 - a * a * lam * (m[k] - R2 + R2 * R2 * inv)
     return m
+
+
+def estimate_with_true_mean(mean, s, r, a, R1, R2, lam) -> np.ndarray:
+    """The report's estimate of E(p_{k+1}) (section 4, the rewritten eq. (8)) with the exact E(p_k) plugged in.
+
+    E(p_{k+1}) ~ a^2 E(p_k) + R1 - a^2 lambda (E(p_k) - R2 + R2^2 (1/(s_k + R2) + 1/(r_k + R2)) / 2),
+    i.e. the other reading of the report's recipe (it does not say which E(p_k) goes on the right).
+
+    Parameters
+    ----------
+    mean, s, r : array_like (n,)
+        Exact E(p_k) and the bounds (10), (9).
+    a, R1, R2, lam : float
+        The scalar system and the arrival probability.
+
+    Returns
+    -------
+    ndarray (n,)
+        The estimate, with the estimate at k = 0 equal to E(p_0).
+    """
+    mean, s, r = (np.asarray(v, dtype=float) for v in (mean, s, r))
+    inv = 0.5 * (1.0 / (s + R2) + 1.0 / (r + R2))
+    out = np.empty_like(mean)
+    out[0] = mean[0]
+    out[1:] = a * a * mean[:-1] + R1 - a * a * lam * (mean[:-1] - R2 + R2 * R2 * inv[:-1])
+    return out
+def condition_11_printed(p, lam, a, R2):
+    """Right-hand side minus left-hand side of eq. (11) as printed: lambda p (2 - R2 - p)/(p + R2)^2 - (1 - 1/a^2).
+
+    Positive where the printed condition holds. It is eq. (11) of the report, i.e. the printed condition
+    before (11) (p > a^2 p + lambda a^2 p^2 (p + R2)^-2 (p - 2 + R2)) divided by a^2 p and rearranged, so
+    the two printed forms are one error (erratum E2).
+
+    Parameters
+    ----------
+    p : float or array_like
+        The scalar p~ > 0.
+    lam : float
+        Arrival probability.
+    a, R2 : float
+        System coefficient and measurement noise variance.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    p = np.asarray(p, dtype=float)
+    return lam * p * (2.0 - R2 - p) / (p + R2) ** 2 - (1.0 - 1.0 / (a * a))
+
+
+def condition_11_corrected(p, lam, a, R1, R2):
+    """Margin of the corrected eq. (11): lambda p/(p + R2) - R1/(a^2 p) - (1 - 1/a^2).
+
+    From p > phi(K~, p) = a^2 p + R1 - lambda a^2 p^2/(p + R2) (Sinopoli's operator at the optimal gain,
+    K~ = -a p/(p + R2)) divided by a^2 p. Positive where the condition holds; the MARE has a positive
+    fixed point iff the margin is positive for some p > 0.
+
+    Parameters
+    ----------
+    p : float or array_like
+        The scalar p~ > 0.
+    lam : float
+        Arrival probability.
+    a, R1, R2 : float
+        System coefficient, process and measurement noise variances.
+
+    Returns
+    -------
+    float or ndarray
+    """
+    p = np.asarray(p, dtype=float)
+    return lam * p / (p + R2) - R1 / (a * a * p) - (1.0 - 1.0 / (a * a))
 
 
 def exact_mean_enumeration(p0, a, R1, R2, lam, n_steps, return_distribution=False):

@@ -14,6 +14,12 @@ report_estimate_printed, plain_mean, plain_lo, plain_hi, cond_mean, cond_z``.
 ``results/intermittent/two_sensor_region.csv``: ``lambda1, lambda2c_lower, lambda2c_upper`` plus
 ``bracket_lower, certified, upper_certified_by, lower_certified_by, upper_slack, n_solves, n_undecided,
 status_at_threshold, statuses_seen`` (both bracket ends certified: see two_sensor.two_sensor_upper_bound).
+``results/intermittent/stationary_curve.csv``: ``lam, stationary_mean, stationary_lo, stationary_hi, s_limit,
+r_limit, tail_index, variance_finite, report_setting`` (lambda in (lambda_c, 1], with 1 - 1/a^4 and the report's
+stable lambdas as grid points).
+``results/intermittent/heavy_tail.csv``: ``lam, lam_label, tail_index, mean_finite, variance_finite, k, mean,
+mean_exact, std, q0.5, q0.9, q0.99, q0.999, q0.9999, p_max, stationary_mean`` (law of p_k by enumeration).
+``results/intermittent/region_closed_form.csv``: ``lambda1, lambda2c_lower`` on a dense grid with the kink.
 ``results/intermittent/two_sensor_simulation.csv``: ``lambda1, lambda2, side, k, mean, mean_lo, mean_hi,
 predicted_growth`` (mean exact) plus ``mean_method, mean_rel_error_bound, stationary_mean, mc_mean, mc_lo, mc_hi,
 mc_z``.
@@ -33,6 +39,7 @@ from .estimators import conditional_mean_paths
 from .exact import exact_mean, stationary_mean
 from .model import (critical_probability, exact_mean_enumeration, lower_bound_sequence, mare_fixed_point,
                     report_estimate_sequence, upper_bound_sequence)
+from .tails import moment_finite_threshold, tail_index, weighted_quantiles
 from .two_sensor import two_sensor_lower_bound, two_sensor_upper_bound
 
 __all__ = [
@@ -44,6 +51,9 @@ __all__ = [
     "two_sensor_region_shard_step",
     "two_sensor_region_merge_step",
     "two_sensor_simulation_step",
+    "stationary_curve_step",
+    "heavy_tail_step",
+    "region_closed_form_step",
 ]
 
 
@@ -230,3 +240,61 @@ def two_sensor_simulation_step(params, inputs, outputs):
             "mc_mean": mc_mean, "mc_lo": mc_lo, "mc_hi": mc_hi, "mc_z": z,
         }))
     return {"table": pd.concat(frames, ignore_index=True)}
+
+
+def stationary_curve_step(params, inputs, outputs):
+    """Step: the exact E(p_inf)(lambda) next to s*(lambda) and r*(lambda) for lambda in (lambda_c, 1], with the
+    tail index of p_inf and whether its variance is finite (tails.tail_index, tails.moment_finite_threshold)."""
+    a, R1, R2 = params["a"], params["R1"], params["R2"]
+    lam_c = critical_probability(a)
+    n, first = params["n_lambda"], params["first_fraction"]
+    if not 0.0 < first < 1.0:
+        raise InputError(f"stationary_curve.first_fraction = {first} must lie in (0, 1)")
+    offsets = np.geomspace(first * (1.0 - lam_c), 1.0 - lam_c, n)
+    lams = lam_c + offsets
+    lams[-1] = 1.0
+    var_from = moment_finite_threshold(2, a)
+    report = [lam_c + off for off in params.get("lambda_offsets", []) if off > 0]
+    # the variance threshold and the report's stable settings are grid points exactly
+    lams = np.union1d(lams, [var_from, *report])
+    rows = []
+    for lam in lams:
+        st = stationary_mean(a, R1, [R2], [lam], p0=R2)
+        growth = (1.0 - lam) * a * a
+        rows.append({"lam": lam, "stationary_mean": st["mean"], "stationary_lo": st["lo"], "stationary_hi": st["hi"],
+                     "s_limit": R1 / (1.0 - growth), "r_limit": mare_fixed_point(a, R1, R2, lam),
+                     "tail_index": tail_index(lam, a), "variance_finite": bool(lam > var_from),
+                     "report_setting": bool(np.any(np.isclose(lam, report, rtol=0, atol=1e-15)))})
+    return {"table": pd.DataFrame(rows)}
+
+
+def heavy_tail_step(params, inputs, outputs):
+    """Step: the law of p_k at k = horizon by enumeration of all 2^k arrival sequences (model.exact_mean_enumeration):
+    quantiles, mean and standard deviation, beside the tail index of the stationary law; at the report's lambdas
+    (lambda_c + the scalar offsets) and at the extra ``lambdas``."""
+    a, R1, R2, p0, k = params["a"], params["R1"], params["R2"], params["Ep0"], params["horizon"]
+    lam_c = critical_probability(a)
+    probs = [float(q) for q in params["quantiles"]]
+    rows = []
+    cases = [(lam_c + off, f"lambda_c{off:+g}") for off in params["lambda_offsets"]]
+    cases += [(float(x), f"lambda={x:g}") for x in params.get("lambdas", [])]
+    for lam, label in cases:
+        _, vals, w = exact_mean_enumeration(p0, a, R1, R2, lam, k, return_distribution=True)
+        mean = float(w @ vals)
+        row = {"lam": lam, "lam_label": label, "tail_index": tail_index(lam, a),
+               "mean_finite": bool(lam > lam_c), "variance_finite": bool(lam > moment_finite_threshold(2, a)), "k": k,
+               "mean": mean, "mean_exact": float(exact_mean(p0, a, R1, [R2], [lam], k).mean[-1]),
+               "std": float(np.sqrt(max(w @ (vals - mean) ** 2, 0.0)))}
+        row.update({f"q{q:g}": v for q, v in zip(probs, weighted_quantiles(vals, w, probs))})
+        row["p_max"] = float(vals.max())
+        row["stationary_mean"] = stationary_mean(a, R1, [R2], [lam], p0=p0)["mean"] if lam > lam_c else np.inf
+        rows.append(row)
+    return {"table": pd.DataFrame(rows)}
+
+
+def region_closed_form_step(params, inputs, outputs):
+    """Step: the closed-form lower bound of the two-sensor region (two_sensor.two_sensor_lower_bound) on a dense
+    lambda_1 grid with its kink lambda_1 = 1 - 1/a^2 inserted exactly (Fig. 4)."""
+    a = params["a"]
+    grid = np.union1d(np.linspace(0.0, 1.0, params["n_dense"]), [critical_probability(a)])
+    return {"table": pd.DataFrame({"lambda1": grid, "lambda2c_lower": two_sensor_lower_bound(grid, a)})}

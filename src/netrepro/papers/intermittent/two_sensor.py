@@ -62,7 +62,12 @@ def two_sensor_upper_bound(lambda1_grid, a, tol=1e-5) -> list[dict]:
     the answer, so sharding the grid cannot change any answer). Both ends of each bracket are
     certified; where lambda2 = 0 is already certified feasible (one sensor suffices), the
     threshold is 0 and there is no infeasible end. The noise terms of phi do not affect
-    feasibility (the condition is homogeneous in X), so the bound depends on a and the C_i only.
+    feasibility, though the condition is not homogeneous in X: for fixed gains it reads
+    X > L(X) + N with L linear and N >= 0, and a strict solution of the noise-free X > L(X) scaled
+    by a large t also solves X > L(X) + N (conversely any solution with noise solves the noise-free
+    one). So the LMI solved here is the noise-free one and the bound depends on a and the C_i only.
+    With C_1 = C_2 = 1 invertible it is moreover the closed form of :func:`two_sensor_lower_bound`
+    (gains -a/C_i cancel the error in every mode with an arrival).
 
     Parameters
     ----------
