@@ -218,6 +218,11 @@ def _evidence_quantities(slug: str, pkg: Path, root: Path):
         return set(), [], "evidence.py"
     tree = ast.parse(path.read_text())
     literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+    # netrepro.verdicts.erratum_evidence("<id>", ...) names <id>.residual_printed and <id>.residual_corrected
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", "")) == "erratum_evidence"
+                and node.args and isinstance(node.args[0], ast.Constant)):
+            literals |= {f"{node.args[0].value}.residual_printed", f"{node.args[0].value}.residual_corrected"}
     prefixes = []
     for node in ast.walk(tree):
         if isinstance(node, ast.JoinedStr):

@@ -15,7 +15,8 @@ import numpy as np
 from ...engines.riccati import Sensor, expected_riccati_map
 from ...errors import InputError
 from ...io import read_table
-from ...verdicts import erratum_evidence, evidence_frame, load_claims
+from ...paperdata import load_claims
+from ...verdicts import erratum_evidence, evidence_frame
 from .exact import exact_mean
 from .model import (condition_11_corrected, condition_11_printed, critical_probability, estimate_with_true_mean,
                     exact_mean_enumeration, lower_bound_sequence, mare_fixed_point, report_estimate_sequence,
