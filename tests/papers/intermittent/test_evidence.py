@@ -56,7 +56,7 @@ def test_only_declared_ranges_label_the_variants_of_the_intermittent_claims(tmp_
     ref = pd.read_csv(REFERENCE / "evidence" / "intermittent.csv")
     data = load_paper_data("intermittent")
     entries = [(c.claim_id, (c.ours or {}).get("quantity"), c.depends_on) for c in data.claims]
-    entries += [(f["id"], f.get("quantity"), f.get("depends_on", [])) for f in data.findings]
+    entries += [(f.finding_id, f.quantity, f.depends_on) for f in data.findings]
     for name, q, depends_on in entries:
         labels = ref.loc[(ref["quantity"] == q) & (ref["variant"] != "nominal"), "variant"]
         for label in labels:
@@ -69,10 +69,10 @@ def test_every_finding_has_a_rule_evidence_and_prior_work():
 
     ref = pd.read_csv(REFERENCE / "evidence" / "intermittent.csv")
     for f in load_paper_data("intermittent").findings:
-        assert f["rule"]["reason"] and f["kind"] in ("numeric", "boolean") and f["prior_work"], f["id"]
-        assert f["quantity"] in f["evidence_quantities"], f["id"]
-        assert set(f["evidence_quantities"]) <= set(ref["quantity"]), f["id"]
-        assert isinstance(f["known"], bool)
+        assert f.rule_reason and f.kind in ("numeric", "boolean") and f.prior_work, f.finding_id
+        assert f.quantity in f.evidence_quantities, f.finding_id
+        assert set(f.evidence_quantities) <= set(ref["quantity"]), f.finding_id
+        assert isinstance(f.known, bool)
 
 
 def test_mean_is_concave_in_p0_so_the_two_point_laws_bracket_the_p0_range():
