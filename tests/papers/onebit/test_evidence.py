@@ -13,6 +13,8 @@ import yaml
 from scipy import integrate, stats
 
 from netrepro.papers.onebit import evidence, steps
+from netrepro.papers.onebit.model import axis_shift_db
+from netrepro.papers.onebit.randomwalk import ratios_at, snr_shift_deviation
 from netrepro.verdicts import NOMINAL, load_paper_data, read_evidence, verdicts_step
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -64,18 +66,18 @@ def test_ratios_at_against_plain_iteration(eps, snr_db, definition):
     s = snr * eps * (2 - eps) if definition == "stationary" else snr
     var = s / (eps * (2 - eps))
     ref = _ratios_by_iteration(eps, s, _efq_by_quad(var))
-    ours = evidence.ratios_at([snr_db], eps, 1.0, definition)
+    ours = ratios_at([snr_db], eps, 1.0, definition)
     for k, v in ref.items():
         assert ours[k][0] == pytest.approx(v, abs=1e-6), k
 
 
 def test_limit_low_snr_closed_form():
     """alpha -> 1 and SNR -> 0: rho_F = rho_SL = sqrt(2/pi), rho_S = 2 sqrt(2/pi) (Sec. 1, Sec. 5)."""
-    r = evidence.ratios_at([-80.0], 0.0)
+    r = ratios_at([-80.0], 0.0)
     assert r["rho_f_db"][0] == pytest.approx(5 * math.log10(2 / math.pi), abs=1e-6)
     assert r["rho_sl_db"][0] == pytest.approx(5 * math.log10(2 / math.pi), abs=1e-6)
     assert r["rho_s_db"][0] == pytest.approx(10 * math.log10(2 * math.sqrt(2 / math.pi)), abs=1e-6)
-    assert np.isnan(evidence.ratios_at([-10.0], 0.0, definition="innovation")["rho_s_db"][0])
+    assert np.isnan(ratios_at([-10.0], 0.0, definition="innovation")["rho_s_db"][0])
 
 
 def test_limit_is_approached_by_finite_alpha():
@@ -83,7 +85,7 @@ def test_limit_is_approached_by_finite_alpha():
     eps = 1e-7
     s = eps * (2 - eps)
     ref = _ratios_by_iteration(eps, s, _efq_by_quad(1.0), n=2_000_000)
-    lim = evidence.ratios_at([0.0], 0.0)
+    lim = ratios_at([0.0], 0.0)
     for k, v in ref.items():
         assert lim[k][0] == pytest.approx(v, abs=2e-3), k
 
@@ -92,15 +94,15 @@ def test_limit_is_approached_by_finite_alpha():
 def test_axis_shift(eps):
     """The innovation SNR is the stationary SNR times 1 - alpha^2, (33); the curves coincide after the shift."""
     a = 1 - eps
-    assert evidence.axis_shift_db(eps) == pytest.approx(10 * math.log10(1 - a * a), rel=1e-12)
+    assert axis_shift_db(eps) == pytest.approx(10 * math.log10(1 - a * a), rel=1e-12)
     snr_stat = -12.0
     s = 10 ** (snr_stat / 10) * (1 - a * a)          # the same sigma_z^2 ...
     snr_inno = 10 * math.log10(s)                     # ... labelled by the innovation reading
-    ours = evidence.ratios_at([snr_inno], eps, 1.0, "innovation")
+    ours = ratios_at([snr_inno], eps, 1.0, "innovation")
     ref = _ratios_by_iteration(eps, s, _efq_by_quad(10 ** (snr_stat / 10)))
     for k, v in ref.items():
         assert ours[k][0] == pytest.approx(v, abs=1e-6), k
-    assert evidence.snr_shift_deviation(np.array([-30.0, 0.0, 10.0]), eps) < 1e-9
+    assert snr_shift_deviation(np.array([-30.0, 0.0, 10.0]), eps) < 1e-9
 
 
 def test_low_snr_cases():
@@ -146,8 +148,9 @@ def tables(cfg, tmp_path_factory):
     for name, key in (("estimator", "table"), ("estimator_ratios", "ratios"), ("crossing", "crossing")):
         paths[name] = tmp / f"{name}.csv"
         est[key].to_csv(paths[name], index=False)
-    table = evidence.evidence_step(c, {**{k: str(v) for k, v in paths.items()}, "shards": [str(s) for s in shards]},
-                                   {})["table"]
+    root = ROOT / "src" / "netrepro" / "papers" / "onebit"
+    table = evidence.evidence_step(c, {**{k: str(v) for k, v in paths.items()}, "shards": [str(s) for s in shards],
+                                       "findings_file": str(root / "findings.yaml")}, {})["table"]
     ev_path = tmp / "evidence.csv"
     table.to_csv(ev_path, index=False)
     root = ROOT / "src" / "netrepro" / "papers" / "onebit"
@@ -173,12 +176,20 @@ def test_every_claim_quantity_has_evidence(tables):
 def test_evidence_values(tables):
     ev, out = tables
     # same loss: exactly zero in the limit, not at alpha = 1 - 1e-5 (prior information at low SNR)
-    assert ev["same_loss_db"]["alpha -> 1, SNR = -30 dB"][0] == 0.0
+    assert ev["same_loss_db"]["alpha_to_1: alpha -> 1, SNR = -30 dB"][0] == 0.0
     assert ev["same_loss_db"][NOMINAL][0] > 0.01
     # the innovation reading moves rho_S > 0 out of the low-medium SNR range
     assert ev["rho_s_positive"][NOMINAL][0] is True
-    assert ev["rho_s_positive"]["SNR = sigma_z^2/sigma_eta^2, alpha = 1 - 1e-05"][0] is False
-    assert ev["rho_s_alpha_threshold"]["SNR = sigma_z^2/sigma_eta^2"][0] is False
+    assert ev["rho_s_positive"]["snr_definition: SNR = sigma_z^2/sigma_eta^2, alpha = 1 - 1e-05"][0] is False
+    assert ev["rho_s_alpha_threshold"]["snr_definition: SNR = sigma_z^2/sigma_eta^2"][0] is False
+    # the medium regime's declared ends are variants named by their key (issue 27, convention 2)
+    assert {"medium_snr_regime=2.5 dB", "medium_snr_regime=5 dB"} <= set(ev["rho_s_positive"])
+    assert "low_snr_regime=-5 dB" in ev["rho_s_low_snr_max_db"]
+    keys = {"snr_grid_db", "alpha_to_1", "snr_definition", "low_snr_regime", "medium_snr_regime", "estimator"}
+    for q, variants in ev.items():
+        for label in variants:
+            if label != NOMINAL and not q.startswith("reconstruction."):
+                assert label.split(":")[0].split("=")[0] in keys, (q, label)
     # the break-even lag exists exactly where rho_S > 0 (why it is no separate claim)
     assert ev["break_even_lag"][NOMINAL][0] is True
     # run halves: n = 20 of 40 runs each
@@ -187,4 +198,17 @@ def test_evidence_values(tables):
     assert claims.loc["same_loss", "verdict"] == "conditional"
     assert "alpha -> 1" in claims.loc["same_loss", "condition"].split("; not for")[0]
     assert claims.loc["rho_s_gt_rho_f", "verdict"] == "reproduced"
-    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 5
+    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 7
+    # the crossing: a local fit on the crossing SNRs, the former straight line and the bound beside it
+    assert "local fit, crossing SNRs" in ev["rho_s_crossing"][NOMINAL][1]
+
+
+def test_findings_are_judged_like_claims():
+    """Every finding has a rule, evidence quantities, depends_on naming reconstructions, and prior work (issue 27)."""
+    data = load_paper_data("onebit")
+    keys = {r["key"] for r in data.reconstructions}
+    for f in data.findings:
+        assert f.get("rule", {}).get("reason"), f["id"]
+        assert f.get("evidence_quantities") and f["quantity"] in f["evidence_quantities"], f["id"]
+        assert set(f.get("depends_on", [])) <= keys, f["id"]
+        assert f.get("prior_work"), f["id"]
