@@ -187,6 +187,23 @@ def figure_estimator_ratios(params, inputs, outputs):
                             label=rf"achievable crossing {e:.2f} dB [{lo:.2f}, {hi:.2f}], $\alpha = {alpha:g}$")
             ax.plot([cr[(alpha, "bound")]], [0.0], color=col, marker="|", ms=14, mew=2, ls="none", zorder=6,
                     label=rf"bound crossing {cr[(alpha, 'bound')]:.2f} dB, $\alpha = {alpha:g}$")
+    if len(cross_pts):   # zoom on the crossing SNRs (the empty lower left of the axes)
+        ins = ax.inset_axes([0.04, 0.06, 0.4, 0.45])
+        rs = pd.concat([cross_pts, allrat])
+        rs = rs[(rs["quantity"] == "rho_S") & rs["alpha"].isin(cross_pts["alpha"].unique())]
+        lo_x, hi_x = cross_pts["snr_db"].min() - 1.2, cross_pts["snr_db"].max() + 0.7
+        rs = rs[(rs["snr_db"] >= lo_x) & (rs["snr_db"] <= hi_x)]
+        for alpha, g in rs.groupby("alpha"):
+            col = "C0" if alpha == a_main else "C4"
+            ins.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
+                         color=col, marker="x", ls="none", ms=4, lw=0.8)
+            if "crossing" in inputs:
+                e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
+                ins.errorbar([e], [0.0], xerr=[[e - lo], [hi - e]], color=col, marker="D", ms=5, capsize=3)
+        ins.axhline(0.0, color="k", lw=0.6)
+        ins.set_xlim(lo_x, hi_x)
+        ins.tick_params(labelsize=6)
+        ins.set_title(r"$\rho_S$ near its crossing", fontsize=7)
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
     ax.set_ylabel("ratio [dB]")
