@@ -174,3 +174,22 @@ def test_run_tail_statistics_against_direct_formulas():
     # iid runs: the ratio is about 1 on average over many independent experiments
     ratios = [estimators.run_tail_statistics(rng.normal(size=400), blocks)["se_ratio"] for _ in range(300)]
     assert abs(np.sqrt(np.mean(np.square(ratios))) - 1.0) < 0.05
+
+
+def test_pooled_se_ratio_against_chi_square_by_simulation():
+    from scipy import stats
+
+    pooled, dof, lo, hi = estimators.pooled_se_ratio([1.0, 1.0], [8, 16])
+    assert (pooled, dof) == (1.0, 22)
+    assert lo == pytest.approx(math.sqrt(stats.chi2.ppf(0.025, 22) / 22)) and hi > 1.0
+    # normal runs with correct standard errors: the pooled ratio falls inside its band about 95 % of the time
+    rng = np.random.default_rng(11)
+    blocks = np.repeat(np.arange(8), 25)
+    inside = 0
+    for _ in range(200):
+        rs = [estimators.run_tail_statistics(rng.normal(size=200), blocks)["se_ratio"] for _ in range(5)]
+        p, _, a, b = estimators.pooled_se_ratio(rs, [8] * 5)
+        inside += a <= p <= b
+    assert 175 <= inside <= 200
+    with pytest.raises(InputError, match="n_blocks >= 2"):
+        estimators.pooled_se_ratio([1.0], [1])

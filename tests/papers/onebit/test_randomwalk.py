@@ -265,3 +265,16 @@ def test_axis_shift(eps):
     for k, v in ref.items():
         assert ours[k][0] == pytest.approx(v, abs=1e-6), k
     assert snr_shift_deviation(np.array([-30.0, 0.0, 10.0]), eps) < 1e-9
+
+
+def test_ratio_window_of_fig1_by_plain_iteration():
+    """The window where rho_SL(alpha = 1 - 1e-5) is within 0.005 dB of -0.98 dB, checked at its ends by iteration."""
+    grid = np.arange(-40.0, -15.0 + 0.25, 0.5)
+    lo, hi = randomwalk.ratio_window(grid, 1e-5, "rho_sl_db", -0.98, 0.005)
+    assert -40.0 < lo < hi < -15.0
+    eps = 1e-5
+    for snr_db, inside in ((lo, True), (lo - 0.5, False), (hi, True), (hi + 0.5, False)):
+        s = 10 ** (snr_db / 10) * eps * (2 - eps)
+        ref = _ratios_by_iteration(eps, s, _efq_by_quad(10 ** (snr_db / 10)), n=3_000_000)["rho_sl_db"]
+        assert (abs(ref + 0.98) <= 0.005) is inside, snr_db
+    assert all(math.isnan(v) for v in randomwalk.ratio_window(grid, 1e-5, "rho_sl_db", 5.0, 0.005))

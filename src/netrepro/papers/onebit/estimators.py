@@ -30,6 +30,7 @@ __all__ = [
     "downward_root",
     "local_crossing_fit",
     "run_tail_statistics",
+    "pooled_se_ratio",
 ]
 
 
@@ -672,3 +673,39 @@ def run_tail_statistics(values, blocks) -> dict:
     se_batch = float(means.std(ddof=1)) * math.sqrt(m_block) / math.sqrt(len(v)) if nb > 1 else float("nan")
     return dict(kurtosis=kurt, max_over_mean=float(v.max() / v.mean()),
                 se_ratio=se_batch / se_normal if se_normal > 0 else float("nan"), n_blocks=nb)
+
+
+def pooled_se_ratio(se_ratio, n_blocks) -> tuple:
+    r"""Pool the replicate/normal standard-error ratios of independent cases, with a 95 % chi-square band.
+
+    Case :math:`c` has ratio :math:`r_c` from :math:`B_c` seed blocks (:func:`run_tail_statistics`).
+    Under normal block means with the variance the normal standard error assumes,
+    :math:`(B_c - 1) r_c^2 \sim \chi^2_{B_c-1}`, so over independent cases
+    :math:`\sum_c (B_c-1) r_c^2 \sim \chi^2_{\nu}`, :math:`\nu = \sum_c (B_c-1)`. The pooled ratio is
+    :math:`\sqrt{\sum_c (B_c-1) r_c^2/\nu}` and its band :math:`\sqrt{\chi^2_{\nu; 0.025, 0.975}/\nu}`.
+
+    Parameters
+    ----------
+    se_ratio : array_like
+        Per-case ratios :math:`r_c`.
+    n_blocks : array_like of int
+        Per-case block counts :math:`B_c` (at least 2).
+
+    Returns
+    -------
+    tuple
+        ``(pooled, dof, band_lo, band_hi)``.
+
+    Raises
+    ------
+    InputError
+        If the inputs differ in length, are empty, or a case has fewer than two blocks.
+    """
+    from scipy import stats
+
+    r, b = np.asarray(se_ratio, dtype=float), np.asarray(n_blocks, dtype=float)
+    if r.shape != b.shape or r.ndim != 1 or len(r) == 0 or (b < 2).any():
+        raise InputError(f"se_ratio and n_blocks must be 1-D of one length with n_blocks >= 2; got {r.shape}, {b.shape}")
+    dof = float((b - 1).sum())
+    band = np.sqrt(stats.chi2.ppf([0.025, 0.975], dof) / dof)
+    return math.sqrt(float(((r**2) * (b - 1)).sum()) / dof), int(dof), float(band[0]), float(band[1])

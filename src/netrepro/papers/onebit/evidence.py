@@ -30,14 +30,14 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 from scipy.special import ndtri
 
 from ...verdicts import erratum_evidence, evidence_frame, load_paper_data
-from .estimators import paired_ratio_interval
+from .estimators import paired_ratio_interval, pooled_se_ratio
 from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
 from .model import axis_shift_db, prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
 from .randomwalk import (
+    ratio_window,
     ratios_at,
     rho_s_threshold_eps,
     rho_s_zero_crossing,
@@ -276,14 +276,6 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
     return rows
 
 
-def _pooled_se_ratio(rows: pd.DataFrame) -> tuple:
-    """Pooled replicate/normal standard-error ratio ``sqrt(sum (B-1) r^2 / sum (B-1))``, its df and 95 % chi-square band."""
-    df = float((rows["n_blocks"] - 1).sum())
-    pooled = math.sqrt(float(((rows["se_ratio"] ** 2) * (rows["n_blocks"] - 1)).sum()) / df)
-    band = np.sqrt(stats.chi2.ppf([0.025, 0.975], df) / df)
-    return pooled, int(df), float(band[0]), float(band[1])
-
-
 def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.DataFrame, crossing) -> list:
     """Evidence of our own findings (settings: the ``at:`` fields of findings.yaml)."""
     se, ev = params["sigma_eta"], params["evidence"]
@@ -317,9 +309,9 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
     sm = est_mse[est_mse["kind"].isin(["smoother_1bit", "filter_1bit"])]
     ref = est_mse[est_mse["kind"].isin(["kalman_filter", "rts_smoother"])]
     one = est_mse[est_mse["kind"] == "smoother_1bit"]   # one row per case: independent replicates across rows
-    pooled, df, b_lo, b_hi = _pooled_se_ratio(one)
+    pooled, df, b_lo, b_hi = pooled_se_ratio(one["se_ratio"], one["n_blocks"])
     heavy = one[one["kurtosis"] > heavy_min]
-    hp = _pooled_se_ratio(heavy) if len(heavy) else (float("nan"), 0, float("nan"), float("nan"))
+    hp = pooled_se_ratio(heavy["se_ratio"], heavy["n_blocks"]) if len(heavy) else (float("nan"), 0, float("nan"), float("nan"))
     a0 = est_mse["alpha"].max()
     top = sm[(sm["alpha"] == a0) & (sm["snr_db"] >= 0)]
     rows.append(dict(
@@ -386,25 +378,23 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
     rows.append(dict(quantity="rho_s_crossing", value=round(float(cr.loc[(a_nom, "estimate"), "snr_db_crossing"]), 4),
                      note="; ".join(parts) + f"; alpha -> 1 bound {rho_s_zero_crossing_limit():.2f} dB "
                                              "(sigma_eta^2 E[F_q] = 1/4)"))
-    for a in sorted(crossing["alpha"].unique(), reverse=True)[1:]:
-        rows.append(dict(quantity="rho_s_crossing", variant=variant_label("estimator", alpha_label(1.0 - a)),
-                         value=round(float(cr.loc[(a, "estimate"), "snr_db_crossing"]), 4)))
     return rows
 
 
 def _fig1_window_note(params) -> str:
-    """Where the Fig 1 curve (alpha = 1 - 1e-5) is within half a printed unit of -0.98 dB: a window of SNRs."""
+    """Where the Fig 1 curve (alpha = 1 - 1e-5) is within the tolerance of claim rho_sl_fig1's value: a window of SNRs."""
     se = params["sigma_eta"]
     eps5 = float(params["fig1_one_minus_alpha"])
-    tol = params["evidence"]["flat_tol_db"]
+    claim = params["_claims"]["rho_sl_fig1"]
+    target, tol = float(claim.paper_value), float(claim.tolerance)
     w = params["_at"]["finite_alpha_low_snr"]["fig1_window_db"]
     fine = np.arange(w["start"], w["stop"] + w["step"] / 2, w["step"])
-    r = ratios_at(fine, eps5, se)["rho_sl_db"]
-    ok = np.abs(r + 0.98) <= tol
-    if not ok.any():
-        return f"{alpha_label(eps5)}: rho_SL is nowhere within {tol:g} dB of -0.98 dB on {w['start']:g} to {w['stop']:g} dB"
-    return (f"{alpha_label(eps5)}: rho_SL within {tol:g} dB of -0.98 dB only for SNR in [{fine[ok].min():.1f}, "
-            f"{fine[ok].max():.1f}] dB ({w['step']:g} dB grid from {w['start']:g} to {w['stop']:g} dB)")
+    lo, hi = ratio_window(fine, eps5, "rho_sl_db", target, tol, se)
+    if math.isnan(lo):
+        return (f"{alpha_label(eps5)}: rho_SL is nowhere within {tol:g} dB of {target:g} dB on {w['start']:g} to "
+                f"{w['stop']:g} dB")
+    return (f"{alpha_label(eps5)}: rho_SL within {tol:g} dB of {target:g} dB only for SNR in [{lo:.1f}, {hi:.1f}] dB "
+            f"({w['step']:g} dB grid from {w['start']:g} to {w['stop']:g} dB)")
 
 
 def _reconstruction_rows(params) -> list:
@@ -456,12 +446,12 @@ def _reconstruction_rows(params) -> list:
     ]
 
 
-def _settings_at(path) -> dict:
-    """``{id: at}`` of the claims and findings files beside ``path`` (default: this package's files)."""
+def _paper_side(path) -> tuple:
+    """``({id: at}, {claim id: ClaimEntry})`` of the claims and findings files beside ``path`` (default: this package's)."""
     data = load_paper_data("onebit", Path(path).parent if path else None)
-    out = {c.claim_id: dict(c.at) for c in data.claims if c.at}
-    out.update({f["id"]: dict(f.get("at") or {}) for f in data.findings if f.get("at")})
-    return out
+    at = {c.claim_id: dict(c.at) for c in data.claims if c.at}
+    at.update({f["id"]: dict(f.get("at") or {}) for f in data.findings if f.get("at")})
+    return at, {c.claim_id: c for c in data.claims}
 
 
 def evidence_step(params, inputs, outputs):
@@ -473,7 +463,8 @@ def evidence_step(params, inputs, outputs):
     Low-SNR values are recomputed at each case from (29), (34)/(36) and (47)-(49)
     (:func:`.randomwalk.ratios_at`), the same functions as ``ratios.csv``.
     """
-    params = dict(params, _at=_settings_at(inputs.get("findings_file")))
+    at, claims = _paper_side(inputs.get("findings_file"))
+    params = dict(params, _at=at, _claims=claims)
     se, ev, q = params["sigma_eta"], params["evidence"], params["quadrature"]
     ratios = pd.read_csv(inputs["ratios"])
     efq = pd.read_csv(inputs["efq"])

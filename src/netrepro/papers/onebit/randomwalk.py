@@ -39,6 +39,7 @@ __all__ = [
     "rho_s_zero_crossing",
     "ratios_at",
     "snr_shift_deviation",
+    "ratio_window",
 ]
 
 
@@ -922,3 +923,36 @@ def snr_shift_deviation(snr_db, eps: float, sigma_eta: float = 1.0) -> float:
     stat = ratios_at(snr_db, eps, sigma_eta, "stationary")
     inno = ratios_at(snr_db + axis_shift_db(eps), eps, sigma_eta, "innovation")
     return float(max(np.max(np.abs(stat[k] - inno[k])) for k in stat))
+
+
+def ratio_window(snr_db, eps: float, ratio: str, target_db: float, tol_db: float, sigma_eta: float = 1.0) -> tuple:
+    r"""The range of SNRs on a grid at which a steady-state ratio (47)-(49) is within ``tol_db`` of ``target_db``.
+
+    At finite alpha, :math:`\rho_{SL}` (47) passes through its alpha -> 1 asymptote
+    :math:`\sqrt{2/\pi}` (-0.98 dB) only inside a window of SNRs: below it the prior information
+    :math:`(1-\alpha^2)/\sigma_z^2` lifts it towards 0 dB, above it the SNR loss sets in.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Increasing SNR grid (dB, stationary reading).
+    eps : float
+        ``1 - alpha``.
+    ratio : {'rho_sl_db', 'rho_f_db', 'rho_s_db'}
+        Which ratio of :func:`ratios_at`.
+    target_db, tol_db : float
+        Target value and tolerance (dB).
+    sigma_eta : float
+        Noise standard deviation.
+
+    Returns
+    -------
+    tuple of float
+        ``(lo, hi)``: the smallest and largest grid SNR within the tolerance; NaNs if none is.
+    """
+    snr_db = np.asarray(snr_db, dtype=float)
+    r = ratios_at(snr_db, eps, sigma_eta)[ratio]
+    ok = np.abs(r - target_db) <= tol_db
+    if not ok.any():
+        return float("nan"), float("nan")
+    return float(snr_db[ok].min()), float(snr_db[ok].max())
