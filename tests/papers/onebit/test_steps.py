@@ -82,7 +82,7 @@ def test_estimator_tables_have_the_issue_columns_and_a_steady_window(cfg):
                 10 * np.log10(mse[k + ("kalman_filter",)] / mse[k + ("smoother_1bit",)]), abs=1e-12)
             assert r[k + ("rho_SL",)] == pytest.approx(
                 10 * np.log10(mse[k + ("rts_smoother",)] / mse[k + ("smoother_1bit",)]), abs=1e-12)
-    assert set(out["crossing"]["curve"]) == {"estimate", "lo", "hi", "grid_linear", "bound"}
+    assert {"estimate", "lo", "hi", "grid_linear", "bound"} <= set(out["crossing"]["curve"])
     assert {"kurtosis", "max_over_mean", "se_ratio"} <= set(out["table"].columns)
     assert (out["table"]["kurtosis"] >= 1.0).all()    # Pearson kurtosis is at least 1 for any law
 

@@ -372,7 +372,10 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
         parts.append(f"alpha = {a:g}: achievable {e['snr_db_crossing']:.2f} dB [{cr.loc[(a, 'lo'), 'snr_db_crossing']:.2f}, "
                      f"{cr.loc[(a, 'hi'), 'snr_db_crossing']:.2f}] ({e['method']}, {e['fit_snr_lo']:g} to "
                      f"{e['fit_snr_hi']:g} dB, {int(e['n_points'])} SNRs x {int(e['n_runs'])} runs, {int(e['n_boot'])} "
-                     f"bootstrap refits, fit residual {e['fit_residual_rms']:.3f} dB), bound "
+                     f"bootstrap refits, fit residual {e['fit_residual_rms']:.3f} dB; sensitivity: " + ", ".join(
+                         f"{c.replace('_', ' ')} {cr.loc[(a, c), 'snr_db_crossing']:.2f}" for c in
+                         ("fit_degree_1", "fit_degree_3", "runs_first_half", "runs_second_half") if (a, c) in cr.index)
+                     + f"), bound "
                      f"{cr.loc[(a, 'bound'), 'snr_db_crossing']:.2f} dB; former straight line across the grid "
                      f"{cr.loc[(a, 'grid_linear'), 'snr_db_crossing']:.2f} dB")
     rows.append(dict(quantity="rho_s_crossing", value=round(float(cr.loc[(a_nom, "estimate"), "snr_db_crossing"]), 4),

@@ -67,6 +67,7 @@ from scipy.special import ndtri
 from .estimators import (
     bootstrap_ratio_db,
     db_zero_crossing,
+    downward_root,
     grid_smoother_at,
     kalman_rts,
     local_crossing_fit,
@@ -264,13 +265,21 @@ def estimator_shard_step(params, inputs, outputs):
     return {"provenance": {"blocks": grid_blocks, "seed": est["seed"]}}
 
 
+def _half_ratios_db(num, den) -> tuple:
+    """The MSE ratio (dB) on the first and on the second half of the runs (disjoint seed blocks)."""
+    n = len(num) // 2
+    return tuple(float(10.0 * np.log10(num[sl].mean() / den[sl].mean())) for sl in (slice(0, n), slice(n, 2 * n)))
+
+
 def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
     """Rows of ``estimator_crossing.csv`` for every simulated alpha: local fit with a bootstrap interval, and the bound.
 
     Where the configuration has crossing cases for an alpha, the fit uses those SNRs; otherwise
     the grid points around the first sign change of the grid estimate (one on each side of the
-    two bracketing points, when they exist). ``grid_linear`` is the straight line between the two
-    bracketing grid estimates (the former estimate, for comparison only).
+    two bracketing points, when they exist). ``fit_degree_<d>`` and ``runs_first_half`` /
+    ``runs_second_half`` are point estimates of the same fit with another degree or on half the runs
+    (sensitivity). ``grid_linear`` is the straight line between the two bracketing grid estimates
+    (the former estimate, for comparison only).
     """
     est, se = params["estimator"], params["sigma_eta"]
     degree = int(est.get("crossing", {}).get("degree", 2))
@@ -303,6 +312,15 @@ def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
                         boot_fail_frac=fit["fail_frac"], fit_residual_rms=fit["residual_rms"])
             for curve in ("estimate", "lo", "hi"):
                 rows.append(dict(base, curve=curve, snr_db_crossing=fit[curve], **info))
+            # sensitivity (point estimates): the fit's degree, and each half of the runs at the configured degree
+            for deg in sorted({1, 3} - {degree}):
+                if len(x) > deg:
+                    rows.append(dict(base, degree=deg, curve=f"fit_degree_{deg}", **info,
+                                     snr_db_crossing=downward_root(np.polyfit(x, y, deg), x.min(), x.max())))
+            for h, name in enumerate(("runs_first_half", "runs_second_half")):
+                yh = np.array([r["half_db"][h] for r in pts])
+                rows.append(dict(base, curve=name, **dict(info, n_runs=info["n_runs"] // 2),
+                                 snr_db_crossing=downward_root(np.polyfit(x, yh, degree), x.min(), x.max())))
         else:
             for curve in ("estimate", "lo", "hi"):
                 rows.append(dict(base, curve=curve, snr_db_crossing=float("nan")))
@@ -366,11 +384,11 @@ def estimator_step(params, inputs, outputs):
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
                                    steady_dev=max(dev[ref], dev[onebit]), **design_cols, case_set=case.case_set,
-                                   key=key))
+                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit])))
         # bootstrap replicates of the achievable rho_S for the crossing fit (its own resampling per case)
         boot[key] = bootstrap_ratio_db(runs[ref_s], runs[onebit_s], est["n_boot"], seed)
     crossing = _crossing_rows(params, ratio_rows, boot)
-    ratios = pd.DataFrame(ratio_rows).drop(columns="key")
+    ratios = pd.DataFrame(ratio_rows).drop(columns=["key", "half_db"])
     return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": crossing}
 
 
