@@ -105,7 +105,12 @@ def test_evidence_values(tables):
     for q, variants in ev.items():
         for label in variants:
             if label != NOMINAL and not q.startswith("reconstruction."):
-                assert label.split(":")[0].split("=")[0] in keys, (q, label)
+                # a declared range (<key>: / <key>=) or the counterfactual a finding's cause names
+                assert label.split(":")[0].split("=")[0] in keys | {"cause"}, (q, label)
+    causes = [f["cause"]["variant"] for f in load_paper_data("onebit").findings if f.get("cause")]
+    for c in causes:
+        q, label = c.split(" / ", 1)
+        assert label in ev[q], c
     # the break-even lag exists exactly where rho_S > 0 (why it is no separate claim)
     assert ev["break_even_lag"][NOMINAL][0] is True
     # run halves: n = 20 of 40 runs each

@@ -278,3 +278,15 @@ def test_ratio_window_of_fig1_by_plain_iteration():
         ref = _ratios_by_iteration(eps, s, _efq_by_quad(10 ** (snr_db / 10)), n=3_000_000)["rho_sl_db"]
         assert (abs(ref + 0.98) <= 0.005) is inside, snr_db
     assert all(math.isnan(v) for v in randomwalk.ratio_window(grid, 1e-5, "rho_sl_db", 5.0, 0.005))
+
+
+def test_ratios_without_mean_reversion_by_plain_iteration():
+    """alpha = 1 in the recursions with the sigma_z^2 and E[F_q] of alpha = 1 - 1e-5: the plain loops at eps = 0."""
+    eps, snr_db = 1e-5, -50.0
+    s = 10 ** (snr_db / 10) * eps * (2 - eps)
+    ref = _ratios_by_iteration(0.0, s, _efq_by_quad(10 ** (snr_db / 10)), n=3_000_000)
+    ours = randomwalk.ratios_without_mean_reversion([snr_db], eps)
+    for k, v in ref.items():
+        assert ours[k][0] == pytest.approx(v, abs=1e-6), k
+    # with the mean reversion the prior information lifts rho_SL towards 0 dB; without it, it stays near -0.98 dB
+    assert ratios_at([snr_db], eps)["rho_sl_db"][0] > ours["rho_sl_db"][0] + 0.3

@@ -39,6 +39,7 @@ from .model import axis_shift_db, prior_check, sigma_z2_from_snr, snr_grid, stat
 from .randomwalk import (
     ratio_window,
     ratios_at,
+    ratios_without_mean_reversion,
     rho_s_threshold_eps,
     rho_s_zero_crossing,
     rw_lag_needed,
@@ -359,6 +360,13 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
                      note=f"{alpha_label(eps5)}: " + ", ".join(
                          f"{x:g} dB: rho_SL {a:.3f}, rho_F {b:.3f}" for x, a, b in
                          zip(very_low, r["rho_sl_db"], r["rho_f_db"])) + "; " + _fig1_window_note(params)))
+    # the stated cause, tested: the same sigma_z^2 and E[F_q] without the mean reversion (no prior information)
+    nr = ratios_without_mean_reversion(very_low, eps5, se)
+    rows.append(dict(quantity="finite_alpha_low_snr", variant="cause: alpha = 1 in (24)/(27), same sigma_z^2, E[F_q]",
+                     value=round(float(nr["rho_sl_db"][0]), 4),
+                     note="without the prior information (1 - alpha^2)/sigma_z^2: " + ", ".join(
+                         f"{x:g} dB: rho_SL {a:.3f}, rho_F {b:.3f}" for x, a, b in
+                         zip(very_low, nr["rho_sl_db"], nr["rho_f_db"]))))
     # where the achievable rho_S crosses 0 dB (local fit, bootstrap over runs), against the bound
     cr = crossing.set_index(["alpha", "curve"])
     a_nom = float(crossing["alpha"].max())

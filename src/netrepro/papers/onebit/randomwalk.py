@@ -40,6 +40,7 @@ __all__ = [
     "ratios_at",
     "snr_shift_deviation",
     "ratio_window",
+    "ratios_without_mean_reversion",
 ]
 
 
@@ -956,3 +957,36 @@ def ratio_window(snr_db, eps: float, ratio: str, target_db: float, tol_db: float
     if not ok.any():
         return float("nan"), float("nan")
     return float(snr_db[ok].min()), float(snr_db[ok].max())
+
+
+def ratios_without_mean_reversion(snr_db, eps: float, sigma_eta: float = 1.0) -> dict:
+    r"""The ratios (47)-(49) in dB with the mean reversion of (21) removed: a counterfactual for the prior's role.
+
+    For each stationary SNR, :math:`\sigma_z^2` and :math:`E[F_q]` are those of ``eps`` (by (33) and
+    (29)), but the fixed points of (24)/(34) and (27)/(37)-(38) are taken at :math:`\alpha = 1`: the
+    stationary prior information :math:`(1-\alpha^2)/\sigma_z^2`, which the mean reversion supplies,
+    is gone while the information per measurement and per transition stays. Comparing with
+    :func:`ratios_at` at the same SNR isolates the effect of that prior information.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Stationary SNRs in dB.
+    eps : float
+        ``1 - alpha`` that sets :math:`\sigma_z^2` and :math:`E[F_q]` (> 0).
+    sigma_eta : float
+        Noise standard deviation.
+
+    Returns
+    -------
+    dict of ndarray
+        ``rho_sl_db, rho_f_db, rho_s_db``.
+    """
+    snr_db = np.atleast_1d(np.asarray(snr_db, dtype=float))
+    s = sigma_z2_from_snr(snr_db, eps, sigma_eta, "stationary")
+    Fq = expected_fisher_1bit(stationary_variance(eps, s) / sigma_eta**2) / sigma_eta**2
+    Fi = np.full_like(s, 1.0 / sigma_eta**2)
+    jf_q, jf_i = rw_filtering_fixed_point(Fq, 0.0, s), rw_filtering_fixed_point(Fi, 0.0, s)
+    js_q = jf_q + rw_smoothing_gain_fixed_point(Fq, 0.0, s)
+    js_i = jf_i + rw_smoothing_gain_fixed_point(Fi, 0.0, s)
+    return dict(rho_sl_db=_db(js_q / js_i), rho_f_db=_db(jf_q / jf_i), rho_s_db=_db(js_q / jf_i))
