@@ -169,7 +169,7 @@ rule onebit_estimator:
         CONDA_ENV
     threads: 1
     resources:
-        mem_mb=500,
+        mem_mb=1000,
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["estimator"])),
@@ -230,6 +230,8 @@ rule onebit_evidence:
         crossing=rules.onebit_estimator.output.crossing,
         alpha_threshold=rules.onebit_alpha_scan.output.threshold,
         shards=rules.onebit_estimator.input.shards,
+        findings_file="src/netrepro/papers/onebit/findings.yaml",
+        claims_file="src/netrepro/papers/onebit/claims.yaml",
     output:
         table="results/evidence/onebit.csv",
     log:

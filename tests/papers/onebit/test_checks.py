@@ -59,3 +59,18 @@ def test_schema_requires_five_time_constants_before_the_window(cfg):
     bad["estimator"]["burn_in_taus"] = 4.0
     with pytest.raises(jsonschema.ValidationError, match="burn_in_taus|4.0"):
         jsonschema.Draft202012Validator(schema).validate(bad)
+
+
+def test_crossing_snrs_must_allow_a_local_fit():
+    check_config = checks.check_config
+    root = Path(__file__).resolve().parents[3]
+    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())["onebit"]
+    check_config(cfg)
+    bad = copy.deepcopy(cfg)
+    bad["estimator"]["crossing"]["snr_db"] = [1.0, 2.0]
+    with pytest.raises(ConfigError, match="more than degree"):
+        check_config(bad)
+    bad = copy.deepcopy(cfg)
+    bad["estimator"]["crossing"]["one_minus_alpha"] = [0.5]
+    with pytest.raises(ConfigError, match="not in onebit.estimator.one_minus_alpha"):
+        check_config(bad)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from netrepro.errors import InputError
 from netrepro.papers.onebit import estimators
 from netrepro.papers.onebit import model
 
@@ -117,3 +118,78 @@ def test_paired_bootstrap_collapses_for_proportional_runs_and_is_narrower_than_u
 def test_db_zero_crossing_linear():
     assert estimators.db_zero_crossing([0.0, 1.0, 2.0], [2.0, 1.0, -1.0]) == pytest.approx(1.5)
     assert math.isnan(estimators.db_zero_crossing([0.0, 1.0], [1.0, 2.0]))
+
+
+def test_downward_root_of_a_known_parabola():
+    # y = -(x - 1)(x - 3): up through 1, down through 3
+    coefs = np.polyfit([0.0, 1.0, 2.0, 3.0], [-3.0, 0.0, 1.0, 0.0], 2)
+    assert estimators.downward_root(coefs, 0.0, 4.0) == pytest.approx(3.0, abs=1e-9)
+    assert math.isnan(estimators.downward_root(coefs, 0.0, 2.5))
+
+
+def test_local_crossing_fit_recovers_a_known_crossing_and_covers_it():
+    """A concave curve with noise of known size: the fit's root against the exact root, and its bootstrap interval."""
+    x = np.array([1.0, 1.5, 2.0, 2.5, 3.0])
+    truth = lambda t: 0.9 - 0.1 * t - 0.15 * t**2  # noqa: E731  root at t = 2.1 (0.9 = 0.1 t + 0.15 t^2)
+    root = (-0.1 + math.sqrt(0.01 + 4 * 0.15 * 0.9)) / (2 * 0.15)
+    rng = np.random.default_rng(1)
+    sd = 0.05
+    y = truth(x) + rng.normal(0, sd, size=x.shape)
+    yb = y + rng.normal(0, sd, size=(2000, len(x)))     # replicates with the noise's spread
+    fit = estimators.local_crossing_fit(x, y, yb)
+    assert fit["lo"] < root < fit["hi"]
+    assert abs(fit["estimate"] - root) < 0.15
+    exact = estimators.local_crossing_fit(x, truth(x), np.tile(truth(x), (10, 1)))
+    assert exact["estimate"] == pytest.approx(root, abs=1e-9) and exact["fail_frac"] == 0.0
+    with pytest.raises(InputError, match="need m > degree points"):
+        estimators.local_crossing_fit(x[:2], y[:2], yb[:, :2])
+
+
+def test_bootstrap_ratio_db_matches_a_plain_loop():
+    rng = np.random.default_rng(3)
+    a, b = rng.exponential(2.0, 50), rng.exponential(1.0, 50)
+    reps = estimators.bootstrap_ratio_db(a, b, 30, seed=7, chunk=7)
+    g = np.random.default_rng(7)
+    plain = []
+    for r0 in range(0, 30, 7):
+        idx = g.integers(0, 50, size=(min(7, 30 - r0), 50))
+        plain += [10 * math.log10(a[i].mean() / b[i].mean()) for i in idx]
+    np.testing.assert_allclose(reps, plain, rtol=0, atol=1e-12)
+    with pytest.raises(InputError, match="same length"):
+        estimators.bootstrap_ratio_db(a, b[:-1], 10, seed=1)
+
+
+def test_run_tail_statistics_against_direct_formulas():
+    rng = np.random.default_rng(5)
+    v = rng.lognormal(0.0, 1.0, 400)
+    blocks = np.repeat(np.arange(8), 50)
+    out = estimators.run_tail_statistics(v, blocks)
+    d = v - v.mean()
+    assert out["kurtosis"] == pytest.approx(np.mean(d**4) / np.mean(d**2) ** 2, rel=1e-12)
+    from scipy import stats
+    assert out["kurtosis"] == pytest.approx(stats.kurtosis(v, fisher=False), rel=1e-10)
+    means = v.reshape(8, 50).mean(axis=1)
+    assert out["se_ratio"] == pytest.approx(means.std(ddof=1) / (v.std(ddof=1) / math.sqrt(50)), rel=1e-12)
+    assert out["n_blocks"] == 8 and out["max_over_mean"] == pytest.approx(v.max() / v.mean())
+    # iid runs: the ratio is about 1 on average over many independent experiments
+    ratios = [estimators.run_tail_statistics(rng.normal(size=400), blocks)["se_ratio"] for _ in range(300)]
+    assert abs(np.sqrt(np.mean(np.square(ratios))) - 1.0) < 0.05
+
+
+def test_pooled_se_ratio_against_chi_square_by_simulation():
+    from scipy import stats
+
+    pooled, dof, lo, hi = estimators.pooled_se_ratio([1.0, 1.0], [8, 16])
+    assert (pooled, dof) == (1.0, 22)
+    assert lo == pytest.approx(math.sqrt(stats.chi2.ppf(0.025, 22) / 22)) and hi > 1.0
+    # normal runs with correct standard errors: the pooled ratio falls inside its band about 95 % of the time
+    rng = np.random.default_rng(11)
+    blocks = np.repeat(np.arange(8), 25)
+    inside = 0
+    for _ in range(200):
+        rs = [estimators.run_tail_statistics(rng.normal(size=200), blocks)["se_ratio"] for _ in range(5)]
+        p, _, a, b = estimators.pooled_se_ratio(rs, [8] * 5)
+        inside += a <= p <= b
+    assert 175 <= inside <= 200
+    with pytest.raises(InputError, match="n_blocks >= 2"):
+        estimators.pooled_se_ratio([1.0], [1])

@@ -80,11 +80,11 @@ def test_band_forward_backward_rejects_csr_outside_the_grid():
             np.ones((4, 3), dtype=bool), prior, np.array([-1, -1, -1, -1, 0]), 3, out, out.copy()]
     bad = T.indices.copy()
     bad[5] = len(x)
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="CSR matrix does not fit a grid"):
         band_forward_backward(*args[:4], bad, *args[5:])
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="likelihoods need"):
         band_forward_backward(*args[:6], lik_pos[1:], *args[7:])
-    with pytest.raises(InputError):
+    with pytest.raises(InputError, match="output arrays do not fit"):
         band_forward_backward(*args[:12], out[:, 1:], out.copy()[:, 1:])
     band_forward_backward(*args)   # the valid call
 

@@ -7,12 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy import linalg
+from scipy import integrate, linalg, stats
 
 from netrepro.engines.kernels import scalar_information_steps
 from netrepro.papers.onebit import fisher
 from netrepro.papers.onebit import model
 from netrepro.papers.onebit import randomwalk
+from netrepro.papers.onebit.model import axis_shift_db
+from netrepro.papers.onebit.randomwalk import ratios_at, snr_shift_deviation
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -181,3 +183,110 @@ def test_rho_s_crossings_and_alpha_threshold():
     e = randomwalk.rho_s_threshold_eps(-20.0)
     r = [float(randomwalk.information_ratios(np.array([-20.0]), v)["rho_s_db"][0]) for v in (e * 0.999, e * 1.001)]
     assert r[0] > 0 >= r[1]
+
+
+# ratios_at, axis_shift_db, snr_shift_deviation (moved from evidence.py, issue 29): against plain loops
+
+def _efq_by_quad(var):
+    """(29) with (30), sigma_eta = 1, by adaptive quadrature of the plain formula (no product-Gaussian trick)."""
+    def f(t):
+        q = stats.norm.sf(t) * stats.norm.cdf(t)
+        return math.exp(-t * t) / (2 * math.pi * q) * stats.norm.pdf(t, scale=math.sqrt(var))
+    sd = math.sqrt(var)
+    return integrate.quad(f, -12 * sd, 12 * sd, points=[0.0], limit=400, epsabs=0, epsrel=1e-12)[0]
+
+
+def _ratios_by_iteration(eps, sigma_z2, F_q, n=200_000):
+    """(24)/(34) and (27)/(37)-(38) iterated to their fixed points (plain loops), then (47)-(49) in dB."""
+    a = 1.0 - eps
+
+    def fixed(F):
+        J = 1.0
+        for _ in range(n):
+            J_new = 1 / sigma_z2 + F - (a / sigma_z2) ** 2 / (J + a * a / sigma_z2)
+            if abs(J_new - J) <= 1e-15 * J_new:
+                break
+            J = J_new
+        k = 0.0
+        for _ in range(n):
+            k_new = a * a / sigma_z2 - (a / sigma_z2) ** 2 / (1 / sigma_z2 + F + k)
+            if abs(k_new - k) <= 1e-15 * abs(k_new):
+                break
+            k = k_new
+        return J, J + k
+
+    jf_i, js_i = fixed(1.0)
+    jf_q, js_q = fixed(F_q)
+    db = lambda x: 10 * math.log10(x)  # noqa: E731
+    return dict(rho_sl_db=db(js_q / js_i), rho_f_db=db(jf_q / jf_i), rho_s_db=db(js_q / jf_i))
+
+
+@pytest.mark.parametrize("eps,snr_db,definition", [(1e-2, 0.0, "stationary"), (1e-1, -10.0, "stationary"),
+                                                   (1e-2, -20.0, "innovation")])
+def test_ratios_at_against_plain_iteration(eps, snr_db, definition):
+    snr = 10 ** (snr_db / 10)
+    s = snr * eps * (2 - eps) if definition == "stationary" else snr
+    var = s / (eps * (2 - eps))
+    ref = _ratios_by_iteration(eps, s, _efq_by_quad(var))
+    ours = ratios_at([snr_db], eps, 1.0, definition)
+    for k, v in ref.items():
+        assert ours[k][0] == pytest.approx(v, abs=1e-6), k
+
+
+def test_limit_low_snr_closed_form():
+    """alpha -> 1 and SNR -> 0: rho_F = rho_SL = sqrt(2/pi), rho_S = 2 sqrt(2/pi) (Sec. 1, Sec. 5)."""
+    r = ratios_at([-80.0], 0.0)
+    assert r["rho_f_db"][0] == pytest.approx(5 * math.log10(2 / math.pi), abs=1e-6)
+    assert r["rho_sl_db"][0] == pytest.approx(5 * math.log10(2 / math.pi), abs=1e-6)
+    assert r["rho_s_db"][0] == pytest.approx(10 * math.log10(2 * math.sqrt(2 / math.pi)), abs=1e-6)
+    assert np.isnan(ratios_at([-10.0], 0.0, definition="innovation")["rho_s_db"][0])
+
+
+def test_limit_is_approached_by_finite_alpha():
+    """The closed-form limit against the plain iteration at a tiny 1 - alpha (fixed stationary SNR 0 dB)."""
+    eps = 1e-7
+    s = eps * (2 - eps)
+    ref = _ratios_by_iteration(eps, s, _efq_by_quad(1.0), n=2_000_000)
+    lim = ratios_at([0.0], 0.0)
+    for k, v in ref.items():
+        assert lim[k][0] == pytest.approx(v, abs=2e-3), k
+
+
+@pytest.mark.parametrize("eps", [1e-3, 1e-5, 0.3])
+def test_axis_shift(eps):
+    """The innovation SNR is the stationary SNR times 1 - alpha^2, (33); the curves coincide after the shift."""
+    a = 1 - eps
+    assert axis_shift_db(eps) == pytest.approx(10 * math.log10(1 - a * a), rel=1e-12)
+    snr_stat = -12.0
+    s = 10 ** (snr_stat / 10) * (1 - a * a)          # the same sigma_z^2 ...
+    snr_inno = 10 * math.log10(s)                     # ... labelled by the innovation reading
+    ours = ratios_at([snr_inno], eps, 1.0, "innovation")
+    ref = _ratios_by_iteration(eps, s, _efq_by_quad(10 ** (snr_stat / 10)))
+    for k, v in ref.items():
+        assert ours[k][0] == pytest.approx(v, abs=1e-6), k
+    assert snr_shift_deviation(np.array([-30.0, 0.0, 10.0]), eps) < 1e-9
+
+
+def test_ratio_window_of_fig1_by_plain_iteration():
+    """The window where rho_SL(alpha = 1 - 1e-5) is within 0.005 dB of -0.98 dB, checked at its ends by iteration."""
+    grid = np.arange(-40.0, -15.0 + 0.25, 0.5)
+    lo, hi = randomwalk.ratio_window(grid, 1e-5, "rho_sl_db", -0.98, 0.005)
+    assert -40.0 < lo < hi < -15.0
+    eps = 1e-5
+    for snr_db, inside in ((lo, True), (lo - 0.5, False), (hi, True), (hi + 0.5, False)):
+        s = 10 ** (snr_db / 10) * eps * (2 - eps)
+        ref = _ratios_by_iteration(eps, s, _efq_by_quad(10 ** (snr_db / 10)), n=3_000_000)["rho_sl_db"]
+        assert (abs(ref + 0.98) <= 0.005) is inside, snr_db
+    assert all(math.isnan(v) for v in randomwalk.ratio_window(grid, 1e-5, "rho_sl_db", 5.0, 0.005))
+
+
+def test_ratios_without_mean_reversion_by_plain_iteration():
+    """alpha = 1 in the recursions with the sigma_z^2 and E[F_q] of alpha = 1 - 1e-5: the plain loops at eps = 0."""
+    eps, snr_db = 1e-5, -50.0
+    s = 10 ** (snr_db / 10) * eps * (2 - eps)
+    ref = _ratios_by_iteration(0.0, s, _efq_by_quad(10 ** (snr_db / 10)), n=3_000_000)
+    ours = randomwalk.ratios_without_mean_reversion([snr_db], eps)
+    for k, v in ref.items():
+        assert ours[k][0] == pytest.approx(v, abs=1e-6), k
+    # with the mean reversion the prior information lifts rho_SL towards 0 dB; without it, it stays near -0.98 dB
+    assert ratios_at([snr_db], eps)["rho_sl_db"][0] > ours["rho_sl_db"][0] + 0.3

@@ -31,6 +31,7 @@ def test_vector_check_table(cfg):
 def test_grid_smoother_and_kalman_against_bounds(cfg):
     c = copy.deepcopy(cfg)
     c["estimator"].update(one_minus_alpha=[1e-2], snr_db=[0.0], n_runs=200, block_size=100)
+    c["estimator"].pop("crossing")   # one case only
     frame = steps.run_estimator(c)["table"].set_index("kind")
     assert set(frame.index) == {"filter_1bit", "smoother_1bit", "kalman_filter", "rts_smoother"}
     se = (frame["mse_hi"] - frame["mse"]) / 1.959964
@@ -71,16 +72,19 @@ def test_estimator_tables_have_the_issue_columns_and_a_steady_window(cfg):
     assert (ratios["start_over_tau"] >= 5.0).all()                       # window after >= 5 time constants
     assert ((ratios["horizon"] - ratios["window_stop"]) >= 5.0 * ratios["tau"]).all()
     assert (ratios["steady_dev"] < 1e-3).all()                            # bound over the window = steady state
-    mse = out["table"].set_index(["alpha", "snr_db", "kind"])["mse"]
-    r = ratios.set_index(["alpha", "snr_db", "quantity"])["estimate_db"]
+    assert set(ratios["case_set"]) == {"grid", "crossing"}
+    mse = out["table"].set_index(["case_set", "alpha", "snr_db", "kind"])["mse"]
+    r = ratios.set_index(["case_set", "alpha", "snr_db", "quantity"])["estimate_db"]
     for eps in cfg["estimator"]["one_minus_alpha"]:
         for snr in cfg["estimator"]["snr_db"]:  # the ratios are the MSE ratios of the same runs
-            k = (1 - eps, snr)
+            k = ("grid", 1 - eps, snr)
             assert r[k + ("rho_S",)] == pytest.approx(
                 10 * np.log10(mse[k + ("kalman_filter",)] / mse[k + ("smoother_1bit",)]), abs=1e-12)
             assert r[k + ("rho_SL",)] == pytest.approx(
                 10 * np.log10(mse[k + ("rts_smoother",)] / mse[k + ("smoother_1bit",)]), abs=1e-12)
-    assert set(out["crossing"]["curve"]) == {"estimate", "lo", "hi", "bound"}
+    assert {"estimate", "lo", "hi", "grid_linear", "bound"} <= set(out["crossing"]["curve"])
+    assert {"kurtosis", "max_over_mean", "se_ratio"} <= set(out["table"].columns)
+    assert (out["table"]["kurtosis"] >= 1.0).all()    # Pearson kurtosis is at least 1 for any law
 
 
 def test_estimator_runs_are_paired_same_paths_and_noise(cfg):

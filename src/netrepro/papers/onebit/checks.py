@@ -25,6 +25,15 @@ def check_config(section: dict) -> None:
     if any(b <= a for a, b in zip(est["snr_db"], est["snr_db"][1:])):
         raise ConfigError(f"config key 'onebit.estimator.snr_db' = {est['snr_db']!r} must be strictly increasing "
                           "(the 0 dB crossing is interpolated along it)")
+    cr = est.get("crossing")
+    if cr:
+        if any(b <= a for a, b in zip(cr["snr_db"], cr["snr_db"][1:])) or len(cr["snr_db"]) <= cr["degree"]:
+            raise ConfigError(f"config key 'onebit.estimator.crossing.snr_db' = {cr['snr_db']!r} must be strictly "
+                              f"increasing with more than degree = {cr['degree']} SNRs (a local fit)")
+        missing = [e for e in cr["one_minus_alpha"] if e not in est["one_minus_alpha"]]
+        if missing:
+            raise ConfigError(f"config key 'onebit.estimator.crossing.one_minus_alpha' = {cr['one_minus_alpha']!r}: "
+                              f"{missing!r} not in onebit.estimator.one_minus_alpha = {est['one_minus_alpha']!r}")
     vec = section["vector_check"]
     A = require_matrix("onebit.vector_check.A", vec["A"], square=True)
     n = A.shape[0]

@@ -26,6 +26,11 @@ __all__ = [
     "paired_ratio_interval",
     "paired_ratio_intervals",
     "db_zero_crossing",
+    "bootstrap_ratio_db",
+    "downward_root",
+    "local_crossing_fit",
+    "run_tail_statistics",
+    "pooled_se_ratio",
 ]
 
 
@@ -511,3 +516,196 @@ def db_zero_crossing(x, y) -> float:
         if y[i] > 0 >= y[i + 1]:
             return float(x[i] + (x[i + 1] - x[i]) * y[i] / (y[i] - y[i + 1]))
     return float("nan")
+
+
+def bootstrap_ratio_db(num, den, n_boot: int, seed: int, chunk: int = 250):
+    r"""Paired bootstrap replicates of :math:`10\log_{10}(\bar a / \bar b)` over runs.
+
+    Each replicate resamples the runs with replacement and uses the same run indices for ``a = num``
+    and ``b = den`` (as :func:`paired_ratio_interval`). The indices are drawn ``chunk`` replicates
+    at a time (bounded memory for many runs); the stream is fixed by ``seed`` and ``chunk``.
+
+    Parameters
+    ----------
+    num, den : ndarray (n_runs,)
+        Per-run values, paired by run.
+    n_boot : int
+        Replicates.
+    seed : int
+        Seed of the resampling generator.
+    chunk : int
+        Replicates per draw of indices.
+
+    Returns
+    -------
+    ndarray (n_boot,)
+        The replicates in dB.
+
+    Raises
+    ------
+    InputError
+        If ``num`` and ``den`` differ in length or are empty.
+    """
+    a, b = np.asarray(num, dtype=float), np.asarray(den, dtype=float)
+    if a.shape != b.shape or a.ndim != 1 or len(a) == 0:
+        raise InputError(f"num and den must be 1-D of the same length, got {a.shape} and {b.shape}")
+    n = len(a)
+    rng = np.random.default_rng(seed)
+    out = np.empty(n_boot)
+    for r0 in range(0, n_boot, chunk):
+        idx = rng.integers(0, n, size=(min(chunk, n_boot - r0), n))
+        out[r0:r0 + len(idx)] = 10.0 * np.log10(a[idx].mean(axis=1) / b[idx].mean(axis=1))
+    return out
+
+
+def downward_root(coefs, lo: float, hi: float) -> float:
+    """The smallest root in ``[lo, hi]`` of the polynomial ``coefs`` (highest power first) where it decreases.
+
+    Parameters
+    ----------
+    coefs : array_like
+        Polynomial coefficients, highest power first (as :func:`numpy.polyfit`).
+    lo, hi : float
+        The window.
+
+    Returns
+    -------
+    float
+        The root, NaN if the polynomial does not cross 0 downwards inside the window.
+    """
+    p = np.poly1d(np.asarray(coefs, dtype=float))
+    dp = p.deriv()
+    roots = [float(r.real) for r in np.atleast_1d(p.roots) if abs(r.imag) <= 1e-12 * max(1.0, abs(r.real))]
+    ok = sorted(r for r in roots if lo <= r <= hi and dp(r) < 0)
+    return ok[0] if ok else float("nan")
+
+
+def local_crossing_fit(x, y, y_boot, degree: int = 2, level: float = 0.95) -> dict:
+    r"""Where a curve known at a few points crosses 0 downwards: a local polynomial fit with a bootstrap interval.
+
+    The points ``(x_i, y_i)`` (e.g. the achievable :math:`\rho_S` in dB at SNRs around its
+    crossing) are fitted by least squares with a polynomial of degree ``degree``; the crossing is
+    its downward root inside ``[min x, max x]`` (:func:`downward_root`). The interval refits every
+    bootstrap replicate (row of ``y_boot``: the curve recomputed from runs resampled independently
+    at each point) and takes percentiles of the replicate roots. Replicates whose fit has no root
+    in the window are counted in ``fail_frac``; they are placed beyond the window on the side
+    their fit lies on (all above 0: right end; all below: left end), so the percentiles (order statistics) stay
+    those of all replicates.
+
+    Parameters
+    ----------
+    x : array_like (m,)
+        Abscissae, ``m > degree``.
+    y : array_like (m,)
+        Values at ``x``.
+    y_boot : array_like (n_boot, m)
+        Bootstrap replicates of ``y``.
+    degree : int
+        Degree of the local fit.
+    level : float
+        Coverage of the percentile interval.
+
+    Returns
+    -------
+    dict
+        ``estimate, lo, hi`` (float), ``fail_frac`` (float), ``residual_rms`` (float, of the fit
+        to ``y``), ``coefs`` (ndarray).
+
+    Raises
+    ------
+    InputError
+        If there are not more points than the degree, or shapes disagree.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    yb = np.atleast_2d(np.asarray(y_boot, dtype=float))
+    if x.ndim != 1 or x.shape != y.shape or len(x) <= degree or yb.shape[1] != len(x):
+        raise InputError(f"need m > degree points with y_boot of shape (n_boot, m); got x {x.shape}, y {y.shape}, "
+                         f"y_boot {yb.shape}, degree {degree}")
+    lo_x, hi_x = float(x.min()), float(x.max())
+    coefs = np.polyfit(x, y, degree)
+    est = downward_root(coefs, lo_x, hi_x)
+    cb = np.polyfit(x, yb.T, degree).T          # (n_boot, degree + 1)
+    roots = np.array([downward_root(c, lo_x, hi_x) for c in cb])
+    fail = np.isnan(roots)
+    if fail.any():
+        above = np.array([np.polyval(c, hi_x) > 0 for c in cb[fail]])
+        roots[fail] = np.where(above, np.inf, -np.inf)
+    q = 100.0 * (1.0 - level) / 2.0
+    lo, hi = np.percentile(roots, [q, 100.0 - q], method="inverted_cdf")   # order statistics: no inf - inf
+    return dict(estimate=float(est), lo=float(lo), hi=float(hi), fail_frac=float(fail.mean()),
+                residual_rms=float(np.sqrt(np.mean((np.polyval(coefs, x) - y) ** 2))), coefs=coefs)
+
+
+def run_tail_statistics(values, blocks) -> dict:
+    r"""How heavy-tailed the per-run values are, and whether their normal standard error holds.
+
+    ``kurtosis`` is Pearson's :math:`m_4/m_2^2` (3 for a normal law); ``max_over_mean`` the largest
+    run over the mean. The standard error of the mean, :math:`s/\sqrt n`, is checked against
+    independent seed replicates: the runs of each seed block (its own generator) form one
+    replicate, and the batch-means standard error :math:`\mathrm{sd}(\bar v_b)/\sqrt B` over the
+    ``B`` equal-size blocks is divided by :math:`s/\sqrt n` (``se_ratio``, about 1 when the normal
+    error is right; its own relative sampling error is about :math:`1/\sqrt{2(B-1)}`).
+
+    Parameters
+    ----------
+    values : ndarray (n,)
+        Per-run values.
+    blocks : ndarray (n,) of int
+        Seed block of each run.
+
+    Returns
+    -------
+    dict
+        ``kurtosis, max_over_mean, se_ratio`` (float) and ``n_blocks`` (int, the full-size blocks used).
+    """
+    v = np.asarray(values, dtype=float)
+    b = np.asarray(blocks)
+    d = v - v.mean()
+    m2 = float(np.mean(d * d))
+    kurt = float(np.mean(d**4) / m2**2) if m2 > 0 else float("nan")
+    ids, counts = np.unique(b, return_counts=True)
+    full = ids[counts == counts.max()]
+    means = np.array([v[b == i].mean() for i in full])
+    se_normal = float(v.std(ddof=1)) / math.sqrt(len(v))
+    nb = len(full)
+    m_block = int(counts.max())
+    # batch means over full blocks: sd of a block mean / sqrt(m_block) is the per-run sd they imply
+    se_batch = float(means.std(ddof=1)) * math.sqrt(m_block) / math.sqrt(len(v)) if nb > 1 else float("nan")
+    return dict(kurtosis=kurt, max_over_mean=float(v.max() / v.mean()),
+                se_ratio=se_batch / se_normal if se_normal > 0 else float("nan"), n_blocks=nb)
+
+
+def pooled_se_ratio(se_ratio, n_blocks) -> tuple:
+    r"""Pool the replicate/normal standard-error ratios of independent cases, with a 95 % chi-square band.
+
+    Case :math:`c` has ratio :math:`r_c` from :math:`B_c` seed blocks (:func:`run_tail_statistics`).
+    Under normal block means with the variance the normal standard error assumes,
+    :math:`(B_c - 1) r_c^2 \sim \chi^2_{B_c-1}`, so over independent cases
+    :math:`\sum_c (B_c-1) r_c^2 \sim \chi^2_{\nu}`, :math:`\nu = \sum_c (B_c-1)`. The pooled ratio is
+    :math:`\sqrt{\sum_c (B_c-1) r_c^2/\nu}` and its band :math:`\sqrt{\chi^2_{\nu; 0.025, 0.975}/\nu}`.
+
+    Parameters
+    ----------
+    se_ratio : array_like
+        Per-case ratios :math:`r_c`.
+    n_blocks : array_like of int
+        Per-case block counts :math:`B_c` (at least 2).
+
+    Returns
+    -------
+    tuple
+        ``(pooled, dof, band_lo, band_hi)``.
+
+    Raises
+    ------
+    InputError
+        If the inputs differ in length, are empty, or a case has fewer than two blocks.
+    """
+    from scipy import stats
+
+    r, b = np.asarray(se_ratio, dtype=float), np.asarray(n_blocks, dtype=float)
+    if r.shape != b.shape or r.ndim != 1 or len(r) == 0 or (b < 2).any():
+        raise InputError(f"se_ratio and n_blocks must be 1-D of one length with n_blocks >= 2; got {r.shape}, {b.shape}")
+    dof = float((b - 1).sum())
+    band = np.sqrt(stats.chi2.ppf([0.025, 0.975], dof) / dof)
+    return math.sqrt(float(((r**2) * (b - 1)).sum()) / dof), int(dof), float(band[0]), float(band[1])

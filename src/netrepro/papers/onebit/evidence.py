@@ -3,47 +3,55 @@
 Table ``results/evidence/onebit.csv`` (``quantity, variant, value, note``), read by the shared
 verdict step (:func:`netrepro.verdicts.verdicts_step`) together with the paper's side in
 ``claims.yaml``, ``errata.yaml``, ``reconstructions.yaml`` and ``findings.yaml`` beside this
-module. Every claim that depends on a reconstruction is re-judged across its range here:
+module. Assembly only: every value comes from the math modules (:mod:`.randomwalk`,
+:mod:`.model`, :mod:`.fisher`, :mod:`.estimators`) or the result tables. Every claim that
+depends on a reconstruction is re-judged across that reconstruction's declared range, one key at
+a time, and a variant row that does so is labelled ``<key>: ...`` or ``<key>=<value>`` with the
+key of ``reconstructions.yaml`` (issue 27, convention 2):
 
-- the low-SNR end of the figure axis (lost in extraction): the grid start and
+- ``snr_grid_db``: the low-SNR end of the figure axis (lost in extraction): the grid start and
   ``evidence.low_snr_db``;
-- ``alpha``: the configured ``1 - alpha`` values beside the alpha -> 1 limit of Fig 2;
-- the SNR definition: at fixed alpha the other reading (SNR = sigma_z^2 / sigma_eta^2) only
-  shifts the SNR axis by ``10 log10(1 - alpha^2)`` (shown here), so it is a variant only of the
-  claims that name a place on the SNR axis;
-- the Monte Carlo: the other simulated alphas and the two halves of the runs.
+- ``alpha_to_1``: the configured ``1 - alpha`` values beside the alpha -> 1 limit of Fig 2;
+- ``snr_definition``: the other reading (SNR = sigma_z^2 / sigma_eta^2), for the claims that name
+  a place on the SNR axis;
+- ``low_snr_regime``, ``medium_snr_regime``: the upper ends of 'the low' and 'the low to medium'
+  SNR regime (``evidence.low_regime_max_db``, ``evidence.medium_regime_max_db``; first nominal);
+- ``estimator``: the other simulated alphas and the two halves of the runs.
 
-No statement, paper value or tolerance is held here; notes are computed.
+Settings of the findings' evidence (which SNRs a note quotes) are the ``at:`` fields of
+``findings.yaml`` (input ``findings_file``). No statement, paper value or tolerance is held here;
+notes are computed.
 """
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-from ...verdicts import erratum_evidence, evidence_frame
-from .estimators import paired_ratio_interval
+from ...verdicts import erratum_evidence, evidence_frame, load_paper_data
+from .estimators import paired_ratio_interval, pooled_se_ratio
 from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
-from .model import prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
+from .model import axis_shift_db, prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
 from .randomwalk import (
-    information_ratios,
-    information_ratios_limit,
+    ratio_window,
+    ratios_at,
+    ratios_without_mean_reversion,
     rho_s_threshold_eps,
     rho_s_zero_crossing,
     rw_lag_needed,
     rw_scalar_check,
+    snr_shift_deviation,
     variance_sum_check,
 )
-from .steps import RATIO_DEFS, _estimator_cases, _merged_runs
+from .runs import RATIO_DEFS, estimator_cases, merged_runs
 
 __all__ = [
     "alpha_label",
-    "ratios_at",
-    "axis_shift_db",
-    "snr_shift_deviation",
+    "variant_label",
     "low_snr_cases",
     "errata_rows",
     "evidence_step",
@@ -57,60 +65,9 @@ def alpha_label(eps: float) -> str:
     return "alpha -> 1" if eps == 0 else f"alpha = 1 - {eps:g}"
 
 
-def ratios_at(snr_db, eps: float, sigma_eta: float = 1.0, definition: str = "stationary",
-              quadrature: dict | None = None) -> dict:
-    r"""The steady-state ratios (47)-(49) in dB at the given SNRs; ``eps = 0`` is the alpha -> 1 limit.
-
-    The limit exists only at fixed stationary SNR (:func:`information_ratios_limit`); with
-    ``definition='innovation'`` it is NaN (the stationary variance (33) diverges as alpha -> 1).
-
-    Parameters
-    ----------
-    snr_db : array_like
-        SNRs in dB.
-    eps : float
-        ``1 - alpha``; 0 for the limit.
-    sigma_eta : float
-        Noise standard deviation.
-    definition : {'stationary', 'innovation'}
-        SNR reading.
-    quadrature : dict, optional
-        ``half_width, step`` of the trapezoid rule for (29).
-
-    Returns
-    -------
-    dict of ndarray
-        ``rho_sl_db, rho_f_db, rho_s_db``.
-    """
-    snr_db = np.atleast_1d(np.asarray(snr_db, dtype=float))
-    if eps == 0:
-        if definition != "stationary":
-            nan = np.full(snr_db.shape, np.nan)
-            return dict(rho_sl_db=nan, rho_f_db=nan.copy(), rho_s_db=nan.copy())
-        lim = information_ratios_limit(snr_db)
-        return {k: lim[k] for k in ("rho_sl_db", "rho_f_db", "rho_s_db")}
-    q = quadrature or {}
-    s = sigma_z2_from_snr(snr_db, eps, sigma_eta, definition)
-    e = expected_fisher_1bit(stationary_variance(eps, s) / sigma_eta**2, **q)
-    res = information_ratios(snr_db, eps, sigma_eta, definition, efq=e)
-    return {k: res[k] for k in ("rho_sl_db", "rho_f_db", "rho_s_db")}
-
-
-def axis_shift_db(eps: float) -> float:
-    r"""SNR-axis shift between the readings at fixed alpha: :math:`10\log_{10}(1-\alpha^2)` by (33).
-
-    With :math:`\sigma^2_{\theta,\infty} = \sigma_z^2/(1-\alpha^2)`, the innovation SNR
-    :math:`\sigma_z^2/\sigma_\eta^2` equals the stationary SNR times :math:`1-\alpha^2`.
-    """
-    return 10.0 * math.log10(eps * (2.0 - eps))
-
-
-def snr_shift_deviation(snr_db, eps: float, sigma_eta: float = 1.0) -> float:
-    """Largest |ratio(innovation, SNR + shift) - ratio(stationary, SNR)| in dB over the grid and (47)-(49)."""
-    snr_db = np.asarray(snr_db, dtype=float)
-    stat = ratios_at(snr_db, eps, sigma_eta, "stationary")
-    inno = ratios_at(snr_db + axis_shift_db(eps), eps, sigma_eta, INNOVATION)
-    return float(max(np.max(np.abs(stat[k] - inno[k])) for k in stat))
+def variant_label(key: str, text: str) -> str:
+    """The label of a variant row inside the declared range of reconstruction ``key``: ``'<key>: <text>'``."""
+    return f"{key}: {text}"
 
 
 def low_snr_cases(nominal_eps: float, grid_start: float, other_ends, other_eps) -> list:
@@ -127,16 +84,16 @@ def low_snr_cases(nominal_eps: float, grid_start: float, other_ends, other_eps) 
     return cases
 
 
-def _case_label(eps: float, snr: float) -> str:
-    return f"{alpha_label(eps)}, SNR = {snr:g} dB"
-
-
 def _value_rows(quantity: str, cases, fn, note: str = "") -> list:
-    """Evidence rows of ``quantity``: the first case is nominal, the others are variants."""
+    """Evidence rows of ``quantity``: the first case is nominal, the others variants of ``alpha_to_1``
+    (alpha differs from the nominal) or ``snr_grid_db`` (only the low-SNR end differs)."""
     rows = []
+    eps0 = cases[0][0]
     for i, (eps, snr) in enumerate(cases):
-        rows.append(dict(quantity=quantity, value=round(float(fn(eps, snr)), 4),
-                         variant="nominal" if i == 0 else _case_label(eps, snr), note=note if i == 0 else ""))
+        key = "alpha_to_1" if eps != eps0 else "snr_grid_db"
+        label = "nominal" if i == 0 else variant_label(key, f"{alpha_label(eps)}, SNR = {snr:g} dB")
+        rows.append(dict(quantity=quantity, value=round(float(fn(eps, snr)), 4), variant=label,
+                         note=note if i == 0 else ""))
     return rows
 
 
@@ -172,11 +129,18 @@ def errata_rows(params) -> list:
     return rows
 
 
+def _regimes(params) -> tuple:
+    """``(low_ends, medium_ends)``: the declared upper ends (dB) of the two SNR regimes, nominal first."""
+    ev = params["evidence"]
+    as_list = lambda v: [float(x) for x in (v if isinstance(v, (list, tuple)) else [v])]  # noqa: E731
+    return as_list(ev["low_regime_max_db"]), as_list(ev["medium_regime_max_db"])
+
+
 def _grid_claim_rows(params, ratios: pd.DataFrame, q: dict) -> list:
     """rho_S > rho_F everywhere, rho_S > 0 at low-medium SNR, the largest rho_S at low SNR; with variants."""
-    se, ev = params["sigma_eta"], params["evidence"]
+    se = params["sigma_eta"]
     grid = snr_grid(**params["snr_grid_db"])
-    med, low = grid[grid <= ev["medium_regime_max_db"]], grid[grid <= ev["low_regime_max_db"]]
+    low_ends, med_ends = _regimes(params)
     epss = [0.0] + [float(e) for e in params["one_minus_alpha"]]
     rows = []
     # rho_S > rho_F: every (alpha, SNR) of ratios.csv, then per alpha and under the other SNR reading
@@ -187,55 +151,75 @@ def _grid_claim_rows(params, ratios: pd.DataFrame, q: dict) -> list:
                           f"rho_S - rho_F = {margin:.3g} dB (rho_S/rho_F = 1 + kappa/J_f > 1 for any kappa > 0)"))
     for eps in epss:
         r = ratios_at(grid, eps, se, "stationary", q)
-        rows.append(dict(quantity="rho_s_gt_rho_f", variant=alpha_label(eps),
+        rows.append(dict(quantity="rho_s_gt_rho_f", variant=variant_label("alpha_to_1", alpha_label(eps)),
                          value=bool(np.all(r["rho_s_db"] > r["rho_f_db"]))))
     for eps in epss[1:]:
         r = ratios_at(grid, eps, se, INNOVATION, q)
-        rows.append(dict(quantity="rho_s_gt_rho_f", variant=f"SNR = sigma_z^2/sigma_eta^2, {alpha_label(eps)}",
+        rows.append(dict(quantity="rho_s_gt_rho_f",
+                         variant=variant_label("snr_definition", f"SNR = sigma_z^2/sigma_eta^2, {alpha_label(eps)}"),
                          value=bool(np.all(r["rho_s_db"] > r["rho_f_db"]))))
-    # rho_S > 0 at every grid SNR <= medium_regime_max_db
+    # rho_S > 0 at every grid SNR <= the medium regime's upper end, one declared range at a time
+    cases = [("nominal", 0.0, "stationary", med_ends[0])]
+    cases += [(variant_label("alpha_to_1", alpha_label(e)), e, "stationary", med_ends[0]) for e in epss[1:]]
+    cases += [(variant_label("snr_definition", f"SNR = sigma_z^2/sigma_eta^2, {alpha_label(e)}"), e, INNOVATION,
+               med_ends[0]) for e in epss[1:]]
+    cases += [(f"medium_snr_regime={m:g} dB", 0.0, "stationary", m) for m in med_ends[1:]]
     pos_note = []
-    for i, (eps, definition) in enumerate([(e, "stationary") for e in epss] + [(e, INNOVATION) for e in epss[1:]]):
+    first = len(rows)
+    for label, eps, definition, smax in cases:
+        med = grid[grid <= smax]
         r = ratios_at(med, eps, se, definition, q)["rho_s_db"]
-        label = alpha_label(eps) if definition == "stationary" else f"SNR = sigma_z^2/sigma_eta^2, {alpha_label(eps)}"
         neg = med[~(r > 0)]
-        pos_note.append(f"{label}: " + ("rho_S > 0 at all" if len(neg) == 0 else
-                                         f"rho_S <= 0 at {len(neg)} of {len(med)} SNRs (from {neg.min():g} dB)"))
-        rows.append(dict(quantity="rho_s_positive", variant="nominal" if i == 0 else label,
-                         value=bool(np.all(r > 0)), note=""))
+        pos_note.append(f"{label} ({alpha_label(eps)}, SNR <= {smax:g} dB): " + (
+            "rho_S > 0 at all" if len(neg) == 0 else f"rho_S <= 0 at {len(neg)} of {len(med)} SNRs (from {neg.min():g} dB)"))
+        rows.append(dict(quantity="rho_s_positive", variant=label, value=bool(np.all(r > 0)), note=""))
     cross = [f"{alpha_label(0.0)}: {rho_s_zero_crossing_limit():.2f} dB"] + [
         f"{alpha_label(e)}: {rho_s_zero_crossing(e, se, 'stationary'):.2f} dB" for e in epss[1:]]
-    rows[-len(pos_note)]["note"] = (f"SNR grid {med.min():g} to {med.max():g} dB: " + "; ".join(pos_note)
-                                    + ". rho_S crosses 0 dB (stationary SNR) at " + ", ".join(cross))
+    rows[first]["note"] = (f"SNR grid from {grid.min():g} dB: " + "; ".join(pos_note)
+                           + ". rho_S crosses 0 dB (stationary SNR) at " + ", ".join(cross))
     # the largest rho_S over the low-SNR regime
-    for i, eps in enumerate(epss):
+    cases = [("nominal", 0.0, low_ends[0])] + [(variant_label("alpha_to_1", alpha_label(e)), e, low_ends[0])
+                                                for e in epss[1:]]
+    cases += [(f"low_snr_regime={m:g} dB", 0.0, m) for m in low_ends[1:]]
+    for label, eps, smax in cases:
+        low = grid[grid <= smax]
         r = ratios_at(low, eps, se, "stationary", q)["rho_s_db"]
         j = int(np.argmax(r))
-        rows.append(dict(quantity="rho_s_low_snr_max_db", variant="nominal" if i == 0 else alpha_label(eps),
-                         value=round(float(r[j]), 4),
-                         note=f"largest rho_S over SNR {low.min():g} to {low.max():g} dB, at {low[j]:g} dB" if i == 0
-                         else f"at {low[j]:g} dB"))
+        rows.append(dict(quantity="rho_s_low_snr_max_db", variant=label, value=round(float(r[j]), 4),
+                         note=f"largest rho_S over SNR {low.min():g} to {low.max():g} dB, at {low[j]:g} dB"
+                         if label == "nominal" else f"at {low[j]:g} dB"))
     return rows
 
 
 def _threshold_rows(params, threshold: pd.DataFrame) -> list:
-    """Whether rho_S > 0 needs alpha close to one, and how close (alpha_threshold.csv), under both SNR readings."""
+    """Whether rho_S > 0 needs alpha close to one, and how close (alpha_threshold.csv), per medium-regime end."""
     se = params["sigma_eta"]
-    thr = threshold.set_index("snr_db")
-    ok = bool(thr["single_sign_change"].all() and (thr["one_minus_alpha_max"] > 0).all()
-              and thr["one_minus_alpha_max"].notna().all())
-    binding = thr["one_minus_alpha_max"].idxmin()
-    note = (f"rho_S > 0 dB at every scanned SNR ({thr.index.min():g} to {thr.index.max():g} dB) iff 1 - alpha < "
-            f"{thr['one_minus_alpha_max'].min():.3g} (alpha > {1 - thr['one_minus_alpha_max'].min():.3f}, binding at "
-            f"{binding:g} dB); per SNR, largest 1 - alpha: " + ", ".join(
-                f"{x:g} dB: {v:.3g}" for x, v in thr["one_minus_alpha_max"].items())
-            + "; one sign change along the scanned alphas at each SNR (results/onebit/alpha_threshold.csv)")
+    _, med_ends = _regimes(params)
+    eps_tiny = float(params["_at"]["rho_s_alpha_threshold"]["innovation_one_minus_alpha"])
+    thr_all = threshold.set_index("snr_db")
+    rows = []
+    for i, smax in enumerate(med_ends):
+        thr = thr_all[thr_all.index <= smax]
+        ok = bool(len(thr) > 0 and thr["single_sign_change"].all() and (thr["one_minus_alpha_max"] > 0).all()
+                  and thr["one_minus_alpha_max"].notna().all())
+        binding = thr["one_minus_alpha_max"].idxmin()
+        note = (f"rho_S > 0 dB at every scanned SNR ({thr.index.min():g} to {thr.index.max():g} dB) iff 1 - alpha < "
+                f"{thr['one_minus_alpha_max'].min():.3g} (alpha > {1 - thr['one_minus_alpha_max'].min():.4f}, binding "
+                f"at {binding:g} dB)")
+        if i == 0:
+            note += ("; per SNR, largest 1 - alpha: " + ", ".join(
+                f"{x:g} dB: {v:.3g}" for x, v in thr_all["one_minus_alpha_max"].items())
+                + "; one sign change along the scanned alphas at each SNR (results/onebit/alpha_threshold.csv)")
+        rows.append(dict(quantity="rho_s_alpha_threshold", variant="nominal" if i == 0 else
+                         f"medium_snr_regime={smax:g} dB", value=ok, note=note))
+    thr = thr_all[thr_all.index <= med_ends[0]]
     inno = {float(x): rho_s_threshold_eps(float(x), se, definition=INNOVATION) for x in thr.index}
-    tiny = {float(x): float(ratios_at([x], 1e-9, se, INNOVATION)["rho_s_db"][0]) for x in thr.index}
+    tiny = {float(x): float(ratios_at([x], eps_tiny, se, INNOVATION)["rho_s_db"][0]) for x in thr.index}
     inno_ok = all(v > 0 and not math.isnan(v) for v in inno.values())
-    return [dict(quantity="rho_s_alpha_threshold", value=ok, note=note),
-            dict(quantity="rho_s_alpha_threshold", variant="SNR = sigma_z^2/sigma_eta^2", value=inno_ok,
-                 note="rho_S at 1 - alpha = 1e-9: " + ", ".join(f"{x:g} dB: {v:.2f} dB" for x, v in tiny.items()))]
+    rows.append(dict(quantity="rho_s_alpha_threshold", variant=variant_label("snr_definition", "SNR = sigma_z^2/sigma_eta^2"),
+                     value=inno_ok, note=f"rho_S at 1 - alpha = {eps_tiny:g}: " + ", ".join(
+                         f"{x:g} dB: {v:.2f} dB" for x, v in tiny.items())))
+    return rows
 
 
 def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -> list:
@@ -243,48 +227,60 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
 
     The first simulated alpha is nominal; the others are variants when ``1 - alpha < eps_max`` (the
     bound's own threshold for rho_S > 0, i.e. inside 'alpha close to one'), else shown in the note.
+    Every simulated SNR up to the medium regime's end counts (grid and crossing cases).
     """
-    est, ev = params["estimator"], params["evidence"]
-    smax = ev["medium_regime_max_db"]
-    rs = est_ratios[(est_ratios["quantity"] == "rho_S") & (est_ratios["snr_db"] <= smax)]
+    est = params["estimator"]
+    _, med_ends = _regimes(params)
+    rs_all = est_ratios[est_ratios["quantity"] == "rho_S"]
+    eps0 = float(est["one_minus_alpha"][0])
+
+    def judged(eps, smax):
+        sub = rs_all[np.isclose(rs_all["alpha"], 1.0 - eps, rtol=0, atol=1e-15) & (rs_all["snr_db"] <= smax)]
+        sub = sub.sort_values(["snr_db", "n_runs"])
+        value = bool(len(sub) > 0 and (sub["lo_db"] > 0).all())
+        note = "; ".join(f"{r.snr_db:g} dB: {r.estimate_db:.2f} [{r.lo_db:.2f}, {r.hi_db:.2f}] (bound {r.bound_db:.2f}, "
+                         f"n = {r.n_runs})" for r in sub.itertuples())
+        return value, note
+
     rows, outside = [], []
     for i, eps in enumerate(est["one_minus_alpha"]):
-        sub = rs[np.isclose(rs["alpha"], 1.0 - eps, rtol=0, atol=1e-15)].sort_values("snr_db")
-        value = bool(len(sub) > 0 and (sub["lo_db"] > 0).all())
-        note = "; ".join(f"{r.snr_db:g} dB: {r.estimate_db:.2f} [{r.lo_db:.2f}, {r.hi_db:.2f}] (bound {r.bound_db:.2f})"
-                         for r in sub.itertuples())
-        note = (f"n = {int(sub['n_runs'].min())} runs per SNR; " if len(sub) else "") + note
+        value, note = judged(float(eps), med_ends[0])
         if i > 0 and not eps < eps_max:
             outside.append(f"{alpha_label(eps)} (outside 'alpha close to one', 1 - alpha >= {eps_max:.3g}): "
-                           f"{'significant' if value else 'not significant'} at every SNR <= {smax:g} dB; {note}")
+                           f"{'significant' if value else 'not significant'} at every SNR <= {med_ends[0]:g} dB; {note}")
             continue
-        rows.append(dict(quantity="achievable_rho_s_positive", variant="nominal" if i == 0 else alpha_label(eps),
-                         value=value, note=note))
+        rows.append(dict(quantity="achievable_rho_s_positive", value=value, note=note,
+                         variant="nominal" if i == 0 else variant_label("estimator", alpha_label(eps))))
+    for smax in med_ends[1:]:
+        value, note = judged(eps0, smax)
+        rows.append(dict(quantity="achievable_rho_s_positive", variant=f"medium_snr_regime={smax:g} dB", value=value,
+                         note=note))
     if outside:
         rows[0]["note"] += ". Not judged: " + " | ".join(outside)
     # the two halves of the runs at the nominal alpha: other seeds' blocks, half the sample size
     ref, onebit, _ = RATIO_DEFS["rho_S"]
-    eps0 = float(est["one_minus_alpha"][0])
     halves = {0: [], 1: []}
-    for key, eps, snr, seed in _estimator_cases(params):
-        if eps != eps0 or snr > smax:
+    for case in estimator_cases(params):
+        if case.eps != eps0 or case.snr_db > med_ends[0] or case.case_set != "grid":
             continue
-        runs = _merged_runs(shards, key)
+        runs = merged_runs(shards, case.key)
         n = len(runs[ref])
         for h, sl in enumerate((slice(0, n // 2), slice(n // 2, n))):
-            e, lo, hi = paired_ratio_interval(runs[ref][sl], runs[onebit][sl], est["n_boot"], seed)
-            halves[h].append((snr, e, lo, hi, sl.stop - sl.start))
+            e, lo, hi = paired_ratio_interval(runs[ref][sl], runs[onebit][sl], est["n_boot"], case.seed)
+            halves[h].append((case.snr_db, e, lo, hi, sl.stop - sl.start))
     for h, res in halves.items():
         if not res:
             continue
-        label = f"{alpha_label(eps0)}, runs {'first' if h == 0 else 'second'} half (n = {res[0][4]})"
+        label = variant_label("estimator", f"{alpha_label(eps0)}, runs {'first' if h == 0 else 'second'} half "
+                                           f"(n = {res[0][4]})")
         rows.append(dict(quantity="achievable_rho_s_positive", variant=label, value=all(r[2] > 0 for r in res)))
     return rows
 
 
 def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.DataFrame, crossing) -> list:
-    """Evidence of our own findings: the bound is a bound, the delay, the lag tolerance, the prior at finite alpha."""
+    """Evidence of our own findings (settings: the ``at:`` fields of findings.yaml)."""
     se, ev = params["sigma_eta"], params["evidence"]
+    at = params["_at"]
     rows = []
     # the BCRB lies below the MSE of near-optimal estimators (Bonferroni over rows, one-sided, 5 % family-wise)
     m = len(est_mse)
@@ -293,17 +289,51 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
     zs = (est_mse["bound"] - est_mse["mse"]) / se_mse
     worst = est_mse.loc[zs.idxmax()]
     rows.append(dict(quantity="bound_below_mse", value=bool((zs <= z_family).all()),
-                     note=f"{m} estimator x SNR x alpha rows, {int(est_mse['n_runs'].min())} runs each: no MSE below its "
+                     note=f"{m} estimator x SNR x alpha rows, {int(est_mse['n_runs'].min())} to "
+                          f"{int(est_mse['n_runs'].max())} runs each: no MSE below its "
                           f"bound by more than z = {z_family:.2f} standard errors (one-sided, 5 % family-wise, "
                           f"Bonferroni); largest z = {zs.max():.2f} ({worst['kind']}, alpha = {worst['alpha']:g}, "
                           f"{worst['snr_db']:g} dB)"))
+    # how loose the 1-bit bound becomes: the smoother's MSE/BCRB from 0 dB up, per simulated alpha
+    grid_mse = est_mse[(est_mse["case_set"] == "grid") & (est_mse["kind"] == "smoother_1bit")]
+    lo_snr = float(at["bound_loose_above_0db"]["from_snr_db"])
+    for i, (alpha, g) in enumerate(sorted(grid_mse.groupby("alpha"), key=lambda t: -t[0])):
+        g = g[g["snr_db"] >= lo_snr].sort_values("snr_db")
+        lower = g["mse_lo"] / g["bound"]
+        value = bool(len(g) > 1 and (lower > 1).all() and (np.diff(g["mse_over_bound"].to_numpy()) > 0).all())
+        note = (f"1-bit smoother MSE/BCRB at {alpha_label(1.0 - alpha)}: " + ", ".join(
+            f"{r.snr_db:g} dB: {r.mse_over_bound:.2f} (lower 95 % end {r.mse_lo / r.bound:.2f})" for r in g.itertuples()))
+        rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note,
+                         variant="nominal" if i == 0 else variant_label("alpha_to_1", alpha_label(1.0 - alpha))))
+    # heavy tails of the per-run MSEs, and the normal standard error against independent seed blocks
+    heavy_min = float(at["mse_standard_errors_valid"]["kurtosis_heavy"])
+    sm = est_mse[est_mse["kind"].isin(["smoother_1bit", "filter_1bit"])]
+    ref = est_mse[est_mse["kind"].isin(["kalman_filter", "rts_smoother"])]
+    one = est_mse[est_mse["kind"] == "smoother_1bit"]   # one row per case: independent replicates across rows
+    pooled, df, b_lo, b_hi = pooled_se_ratio(one["se_ratio"], one["n_blocks"])
+    heavy = one[one["kurtosis"] > heavy_min]
+    hp = pooled_se_ratio(heavy["se_ratio"], heavy["n_blocks"]) if len(heavy) else (float("nan"), 0, float("nan"), float("nan"))
+    a0 = est_mse["alpha"].max()
+    top = sm[(sm["alpha"] == a0) & (sm["snr_db"] >= 0)]
+    rows.append(dict(
+        quantity="mse_standard_errors_valid", value=bool(b_lo <= pooled <= b_hi),
+        note=f"1-bit smoother, {len(one)} cases: replicate (seed-block batch-means) / normal standard error pooled "
+             f"{pooled:.3f} on {df} df (95 % chi-square band [{b_lo:.3f}, {b_hi:.3f}]); the {len(heavy)} cases with "
+             f"kurtosis > {heavy_min:g}: {hp[0]:.3f} on {hp[1]} df [{hp[2]:.3f}, {hp[3]:.3f}]. Per-run kurtosis at "
+             f"alpha = {a0:g}, SNR >= 0 dB (1-bit filter/smoother): {top['kurtosis'].min():.0f} to "
+             f"{top['kurtosis'].max():.0f}, largest run {top['max_over_mean'].min():.0f} to "
+             f"{top['max_over_mean'].max():.0f} times the mean; Kalman/RTS everywhere: kurtosis <= "
+             f"{ref['kurtosis'].max():.1f}. Window {int(top['window_stop'].sub(top['window_start']).min())} to "
+             f"{int(top['window_stop'].sub(top['window_start']).max())} steps against the correlation time "
+             f"1/(1 - alpha) = {1.0 / (1.0 - a0):.0f} steps"))
     # the break-even lag exists exactly where rho_S > 0 (so it is no separate claim), and how long it is
     merged = lag.merge(ratios[["alpha", "snr_db", "rho_s_db"]], on=["alpha", "snr_db"])
     same = (merged["delta_break_even"].notna() == (merged["rho_s_db"] > 0))
     parts = []
+    quote = [float(x) for x in at["break_even_lag"]["snr_db"]]
     for alpha, g in lag.groupby("alpha"):
         g = g.set_index("snr_db")["delta_break_even"]
-        pts = [x for x in (-30.0, -20.0, -10.0, 0.0, 10.0) if x in g.index]
+        pts = [x for x in quote if x in g.index]
         parts.append(f"alpha = {alpha:g}: " + ", ".join(
             f"{x:g} dB: {'never' if np.isnan(g[x]) else int(g[x])}" for x in pts))
     rows.append(dict(quantity="break_even_lag", value=bool(same.all()),
@@ -311,7 +341,7 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
                           "smallest Delta with J_{k|k+Delta,q} > J_{k|k,inf}: " + "; ".join(parts)))
     # the lag needed to be within tol of the Delta -> infinity limit, across tolerances
     grid_start = float(params["snr_grid_db"]["start"])
-    pts = np.array([grid_start, -10.0, 0.0])
+    pts = np.array([grid_start] + [float(x) for x in at["lag_needed_tolerance"]["snr_db"]])
     parts = []
     for eps in params["one_minus_alpha"]:
         s = sigma_z2_from_snr(pts, eps, se, params["snr_definition"])
@@ -329,19 +359,59 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
     rows.append(dict(quantity="finite_alpha_low_snr", value=round(float(r["rho_sl_db"][0]), 4),
                      note=f"{alpha_label(eps5)}: " + ", ".join(
                          f"{x:g} dB: rho_SL {a:.3f}, rho_F {b:.3f}" for x, a, b in
-                         zip(very_low, r["rho_sl_db"], r["rho_f_db"]))))
-    # where rho_S crosses 0 dB: bound vs achievable
-    cr = crossing.set_index(["alpha", "curve"])["snr_db_crossing"]
-    parts = [f"alpha = {a:g}: achievable {cr[(a, 'estimate')]:.2f} dB [{cr[(a, 'lo')]:.2f}, {cr[(a, 'hi')]:.2f}], "
-             f"bound {cr[(a, 'bound')]:.2f} dB" for a in crossing["alpha"].unique()]
-    rows.append(dict(quantity="rho_s_crossing", value=round(rho_s_zero_crossing_limit(), 4),
-                     note="alpha -> 1 bound (sigma_eta^2 E[F_q] = 1/4); " + "; ".join(parts)))
+                         zip(very_low, r["rho_sl_db"], r["rho_f_db"])) + "; " + _fig1_window_note(params)))
+    # the stated cause, tested: the same sigma_z^2 and E[F_q] without the mean reversion (no prior information)
+    nr = ratios_without_mean_reversion(very_low, eps5, se)
+    rows.append(dict(quantity="finite_alpha_low_snr", variant="cause: alpha = 1 in (24)/(27), same sigma_z^2, E[F_q]",
+                     value=round(float(nr["rho_sl_db"][0]), 4),
+                     note="without the prior information (1 - alpha^2)/sigma_z^2: " + ", ".join(
+                         f"{x:g} dB: rho_SL {a:.3f}, rho_F {b:.3f}" for x, a, b in
+                         zip(very_low, nr["rho_sl_db"], nr["rho_f_db"]))))
+    # where the achievable rho_S crosses 0 dB (local fit, bootstrap over runs), against the bound
+    cr = crossing.set_index(["alpha", "curve"])
+    a_nom = float(crossing["alpha"].max())
+    parts = []
+    for a in sorted(crossing["alpha"].unique(), reverse=True):
+        e = cr.loc[(a, "estimate")]
+        if not np.isfinite(e["n_points"]):
+            parts.append(f"alpha = {a:g}: achievable: no sign change on the simulated SNRs; bound "
+                         f"{cr.loc[(a, 'bound'), 'snr_db_crossing']:.2f} dB")
+            continue
+        parts.append(f"alpha = {a:g}: achievable {e['snr_db_crossing']:.2f} dB [{cr.loc[(a, 'lo'), 'snr_db_crossing']:.2f}, "
+                     f"{cr.loc[(a, 'hi'), 'snr_db_crossing']:.2f}] ({e['method']}, {e['fit_snr_lo']:g} to "
+                     f"{e['fit_snr_hi']:g} dB, {int(e['n_points'])} SNRs x {int(e['n_runs'])} runs, {int(e['n_boot'])} "
+                     f"bootstrap refits, fit residual {e['fit_residual_rms']:.3f} dB; sensitivity: " + ", ".join(
+                         f"{c.replace('_', ' ')} {cr.loc[(a, c), 'snr_db_crossing']:.2f}" for c in
+                         ("fit_degree_1", "fit_degree_3", "runs_first_half", "runs_second_half") if (a, c) in cr.index)
+                     + f"), bound "
+                     f"{cr.loc[(a, 'bound'), 'snr_db_crossing']:.2f} dB; former straight line across the grid "
+                     f"{cr.loc[(a, 'grid_linear'), 'snr_db_crossing']:.2f} dB")
+    rows.append(dict(quantity="rho_s_crossing", value=round(float(cr.loc[(a_nom, "estimate"), "snr_db_crossing"]), 4),
+                     note="; ".join(parts) + f"; alpha -> 1 bound {rho_s_zero_crossing_limit():.2f} dB "
+                                             "(sigma_eta^2 E[F_q] = 1/4)"))
     return rows
+
+
+def _fig1_window_note(params) -> str:
+    """Where the Fig 1 curve (alpha = 1 - 1e-5) is within the tolerance of claim rho_sl_fig1's value: a window of SNRs."""
+    se = params["sigma_eta"]
+    eps5 = float(params["fig1_one_minus_alpha"])
+    claim = params["_claims"]["rho_sl_fig1"]
+    target, tol = float(claim.paper_value), float(claim.tolerance)
+    w = params["_at"]["finite_alpha_low_snr"]["fig1_window_db"]
+    fine = np.arange(w["start"], w["stop"] + w["step"] / 2, w["step"])
+    lo, hi = ratio_window(fine, eps5, "rho_sl_db", target, tol, se)
+    if math.isnan(lo):
+        return (f"{alpha_label(eps5)}: rho_SL is nowhere within {tol:g} dB of {target:g} dB on {w['start']:g} to "
+                f"{w['stop']:g} dB")
+    return (f"{alpha_label(eps5)}: rho_SL within {tol:g} dB of {target:g} dB only for SNR in [{lo:.1f}, {hi:.1f}] dB "
+            f"({w['step']:g} dB grid from {w['start']:g} to {w['stop']:g} dB)")
 
 
 def _reconstruction_rows(params) -> list:
     """``reconstruction.<key>`` rows: configured values and computed sensitivities."""
     se, ref, eps5 = params["sigma_eta"], params["reference_snr_db"], float(params["fig1_one_minus_alpha"])
+    at = params["_at"]
     grid = snr_grid(**params["snr_grid_db"])
     shifts = ", ".join(f"{alpha_label(e)}: {axis_shift_db(e):.2f} dB" for e in params["one_minus_alpha"])
     dev = max(snr_shift_deviation(grid, e, se) for e in params["one_minus_alpha"])
@@ -349,15 +419,21 @@ def _reconstruction_rows(params) -> list:
     inno = ratios_at([ref], eps5, se, INNOVATION)
     near = ratios_at(grid, eps5, se)
     lim = ratios_at(grid, 0.0, se)
-    hi = grid >= -20.0
+    hi_from = float(at["finite_alpha_low_snr"]["near_limit_from_snr_db"])
+    hi = grid >= hi_from
     gaps = "; ".join(f"{k[:-3]}: {np.max(np.abs(near[k] - lim[k])):.3f} dB over the grid, "
-                     f"{np.max(np.abs(near[k] - lim[k])[hi]):.3f} dB for SNR >= -20 dB" for k in near)
+                     f"{np.max(np.abs(near[k] - lim[k])[hi]):.3f} dB for SNR >= {hi_from:g} dB" for k in near)
     est = params["estimator"]
-    fine = np.arange(-60.0, 0.25, 0.5)
+    f = at["finite_alpha_low_snr"]["flat_grid_db"]
+    fine = np.arange(f["start"], f["stop"] + f["step"] / 2, f["step"])
     lim0 = 10.0 * math.log10(math.sqrt(2.0 / math.pi))
     tol = params["evidence"]["flat_tol_db"]
     flat_ok = np.abs(ratios_at(fine, 0.0, se)["rho_sl_db"] - lim0) <= tol
     flat = float(fine[flat_ok].max()) if flat_ok.any() else float("nan")
+    low_ends, med_ends = _regimes(params)
+    cr = est.get("crossing") or {}
+    cross = (f"; crossing cases: 1 - alpha in {cr['one_minus_alpha']}, SNR {cr['snr_db']} dB, {cr['n_runs']} runs, "
+             f"seed {cr['seed']}, local fit of degree {cr['degree']}" if cr else "")
     return [
         dict(quantity="reconstruction.snr_definition", value=params["snr_definition"],
              note=f"axis shift 10 log10(1 - alpha^2): {shifts}; largest difference between the stationary curves and "
@@ -370,19 +446,36 @@ def _reconstruction_rows(params) -> list:
         dict(quantity="reconstruction.lag_tol_db", value=params["lag_tol_db"]),
         dict(quantity="reconstruction.snr_grid_db", value=str(params["snr_grid_db"]),
              note=f"the alpha -> 1 rho_SL is within {tol:g} dB of its SNR -> 0 value {lim0:.4f} dB for SNR <= {flat:g} dB"),
+        dict(quantity="reconstruction.low_snr_regime", value=f"SNR <= {low_ends[0]:g} dB",
+             note="declared range of the upper end: " + ", ".join(f"{x:g}" for x in low_ends) + " dB"),
+        dict(quantity="reconstruction.medium_snr_regime", value=f"SNR <= {med_ends[0]:g} dB",
+             note="declared range of the upper end: " + ", ".join(f"{x:g}" for x in med_ends) + " dB; the bound's "
+                  "rho_S threshold on 1 - alpha per end is in the evidence of rho_s_alpha_threshold"),
         dict(quantity="reconstruction.estimator",
              value=f"1 - alpha in {est['one_minus_alpha']}, SNR {est['snr_db']} dB, {est['n_runs']} runs, seed "
-                   f"{est['seed']}, {est['n_boot']} bootstrap resamples"),
+                   f"{est['seed']}, {est['n_boot']} bootstrap resamples" + cross),
     ]
+
+
+def _paper_side(path) -> tuple:
+    """``({id: at}, {claim id: ClaimEntry})`` of the claims and findings files beside ``path`` (default: this package's)."""
+    data = load_paper_data("onebit", Path(path).parent if path else None)
+    at = {c.claim_id: dict(c.at) for c in data.claims if c.at}
+    at.update({f["id"]: dict(f.get("at") or {}) for f in data.findings if f.get("at")})
+    return at, {c.claim_id: c for c in data.claims}
 
 
 def evidence_step(params, inputs, outputs):
     """Step of rule ``onebit_evidence``: table ``results/evidence/onebit.csv``.
 
     Inputs: ``ratios``, ``efq``, ``lag``, ``estimator`` (MSEs), ``estimator_ratios``, ``crossing``,
-    ``alpha_threshold`` and the estimator ``shards``. Low-SNR values are recomputed at each case
-    from (29), (34)/(36) and (47)-(49) (:func:`ratios_at`), the same functions as ``ratios.csv``.
+    ``alpha_threshold``, the estimator ``shards`` and (optional) ``findings_file``, whose entries'
+    ``at:`` fields (and those of ``claims.yaml`` beside it) give the settings the evidence quotes.
+    Low-SNR values are recomputed at each case from (29), (34)/(36) and (47)-(49)
+    (:func:`.randomwalk.ratios_at`), the same functions as ``ratios.csv``.
     """
+    at, claims = _paper_side(inputs.get("findings_file"))
+    params = dict(params, _at=at, _claims=claims)
     se, ev, q = params["sigma_eta"], params["evidence"], params["quadrature"]
     ratios = pd.read_csv(inputs["ratios"])
     efq = pd.read_csv(inputs["efq"])
@@ -399,8 +492,10 @@ def evidence_step(params, inputs, outputs):
     for snr in [grid_start] + [float(x) for x in ev["low_snr_db"]]:
         if snr != float(e_lo["snr_db"]):
             val = 10.0 * math.log10(float(expected_fisher_1bit(10.0 ** (snr / 10.0), **q)))
-            rows.append(dict(quantity="efq_low_snr_db", variant=f"SNR = {snr:g} dB", value=round(val, 4)))
-    rows.append(dict(quantity="efq_low_snr_db", variant="SNR -> 0", value=round(10.0 * math.log10(2.0 / math.pi), 4)))
+            rows.append(dict(quantity="efq_low_snr_db", variant=variant_label("snr_grid_db", f"SNR = {snr:g} dB"),
+                             value=round(val, 4)))
+    rows.append(dict(quantity="efq_low_snr_db", variant=variant_label("snr_grid_db", "SNR -> 0"),
+                     value=round(10.0 * math.log10(2.0 / math.pi), 4)))
 
     def ratio(col):
         return lambda eps, snr: ratios_at([snr], eps, se, "stationary", q)[col][0]
@@ -409,7 +504,8 @@ def evidence_step(params, inputs, outputs):
                         ratio("rho_f_db"), note="rho_F (48) at the low-SNR end")
     # Fig 1 states its alpha: re-judged over the low-SNR ends and against the limit its 'asymptotic value' names
     cases5 = low_snr_cases(eps5, grid_start, ev["low_snr_db"], [0.0])
-    rows += _value_rows("rho_sl_low_snr_db", cases5, ratio("rho_sl_db"), note="rho_SL (47) at the low-SNR end")
+    rows += _value_rows("rho_sl_low_snr_db", cases5, ratio("rho_sl_db"),
+                        note="rho_SL (47) at the low-SNR end; " + _fig1_window_note(params))
 
     def gap(eps, snr):
         r = ratios_at([snr], eps, se, "stationary", q)
@@ -419,8 +515,9 @@ def evidence_step(params, inputs, outputs):
     rows += _grid_claim_rows(params, ratios, q)
     threshold = pd.read_csv(inputs["alpha_threshold"])
     rows += _threshold_rows(params, threshold)
-    rows += _achievable_rows(params, pd.read_csv(inputs["estimator_ratios"]), shards,
-                             float(threshold["one_minus_alpha_max"].min()))
+    _, med_ends = _regimes(params)
+    eps_max = float(threshold[threshold["snr_db"] <= med_ends[0]]["one_minus_alpha_max"].min())
+    rows += _achievable_rows(params, pd.read_csv(inputs["estimator_ratios"]), shards, eps_max)
     rows += _finding_rows(params, pd.read_csv(inputs["estimator"]), pd.read_csv(inputs["lag"]), ratios,
                           pd.read_csv(inputs["crossing"]))
     rows += errata_rows(params)

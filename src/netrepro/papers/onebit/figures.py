@@ -34,11 +34,16 @@ def figure_rho_sl(params, inputs, outputs):
     rat = pd.read_csv(inputs["ratios"])
     fig, ax = _new_fig()
     a_main = 1.0 - params["fig1_one_minus_alpha"]
-    for alpha, g in rat.groupby("alpha"):
+    for i, (alpha, g) in enumerate(rat.groupby("alpha")):
         main = np.isclose(alpha, a_main, rtol=0, atol=1e-15)
         lab = _alpha_label(alpha)
-        ax.plot(g["snr_db"], g["rho_sl_db"], lw=2.0 if main else 1.0, ls="-" if main else ":", label=lab)
-    ax.axhline(5 * math.log10(2 / math.pi), color="k", lw=0.8, ls="--", label=r"$\sqrt{2/\pi}$ (-0.98 dB)")
+        if alpha == 1.0:   # the limit lies on the main curve over most of the axis: dashed on top, markers offset
+            ax.plot(g["snr_db"], g["rho_sl_db"], color="k", lw=1.2, ls="--", marker="o", mfc="none", ms=4,
+                    markevery=(5, 10), zorder=5, label=lab)
+            continue
+        ax.plot(g["snr_db"], g["rho_sl_db"], color=f"C{i}", lw=2.0 if main else 1.0, ls="-" if main else ":",
+                marker="s" if not main else None, ms=3, markevery=(0, 10), label=lab)
+    ax.axhline(5 * math.log10(2 / math.pi), color="0.5", lw=0.8, ls="-.", label=r"$\sqrt{2/\pi}$ (-0.98 dB)")
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
     ax.set_ylabel(r"$\rho_{SL}$ [dB]")
     ax.set_title(r"Fig 1: 1-bit loss of smoothing, $\rho_{SL}$")
@@ -51,13 +56,18 @@ def figure_rho_s_f(params, inputs, outputs):
     """Fig 2: rho_S and rho_F vs SNR as alpha -> 1 (limit bold, finite alphas thin)."""
     rat = pd.read_csv(inputs["ratios"])
     fig, ax = _new_fig()
+    finite = sorted(a for a in rat["alpha"].unique() if a != 1.0)
+    style = {a: dict(s=c_s, f=c_f, marker=mk) for a, c_s, c_f, mk in zip(finite, ("C9", "C2", "C4"), ("C1", "C6", "C5"),
+                                                                      ("^", "s", "D"))}
     for alpha, g in rat.groupby("alpha"):
         lim = alpha == 1.0
         lab = _alpha_label(alpha)
-        ax.plot(g["snr_db"], g["rho_s_db"], color="C0", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
-                label=rf"$\rho_S$, {lab}")
-        ax.plot(g["snr_db"], g["rho_f_db"], color="C3", lw=2.0 if lim else 0.9, ls="-" if lim else ":",
-                label=rf"$\rho_F$, {lab}")
+        st = style.get(alpha, {})
+        kw = dict(lw=2.0, ls="-") if lim else dict(lw=0.9, ls=":", marker=st["marker"], ms=4, markevery=(0, 8))
+        ax.plot(g["snr_db"], g["rho_s_db"], color="C0" if lim else st["s"], label=rf"$\rho_S$, {lab}", **kw)
+        kw = dict(kw, markevery=(4, 8)) if not lim else kw
+        ax.plot(g["snr_db"], g["rho_f_db"], color="C3" if lim else st["f"], label=rf"$\rho_F$, {lab}",
+                **(kw if lim else dict(kw, mfc="none")))
     ax.axhline(0.0, color="k", lw=0.8)
     ax.axhline(10 * math.log10(2 * math.sqrt(2 / math.pi)), color="k", lw=0.8, ls="--", label="+2.03 dB")
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
@@ -71,6 +81,8 @@ def figure_rho_s_f(params, inputs, outputs):
 def figure_estimator(params, inputs, outputs):
     """Fig S1: MSE of the grid filter/smoother (1-bit) and Kalman/RTS with 95% CIs next to the bounds."""
     est = pd.read_csv(inputs["estimator"])
+    if "case_set" in est:
+        est = est[est["case_set"] == "grid"]       # the crossing SNRs are shown in Fig S4
     est = est[est["alpha"] == est["alpha"].max()]  # the simulated alpha closest to one
     fig, (ax, ax2) = new_figure(1, 2, figsize=(10.0, 4.0))
     styles = {"filter_1bit": ("C3", "o"), "smoother_1bit": ("C0", "s"), "kalman_filter": ("C1", "^"),
@@ -120,7 +132,7 @@ def figure_convergence(params, inputs, outputs):
 def figure_lag(params, inputs, outputs):
     """Fig S3: smoothing lag Delta needed (0.01 dB) vs SNR."""
     lag = pd.read_csv(inputs["lag"])
-    fig, ax = _new_fig()
+    fig, ax = _new_fig(figsize=(9.0, 4.0))
     for i, (alpha, g) in enumerate(lag.groupby("alpha")):
         ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", color=f"C{i}", label=_alpha_label(alpha))
         if "delta_break_even" in g:
@@ -128,18 +140,24 @@ def figure_lag(params, inputs, outputs):
                         label=rf"break-even $\Delta$ ($J_{{k|k+\Delta,q}} > J_{{k|k,\infty}}$), {_alpha_label(alpha)}")
     ax.set_xlabel("SNR [dB]")
     ax.set_ylabel(r"lag $\Delta$ for %g dB" % lag["tol_db"].iloc[0])
-    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed (solid) and break-even lag (dashed)")
-    ax.legend()
+    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed (solid) and break-even lag (dashed)", fontsize=10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)   # outside: covers no curve
     save_figure(fig, outputs["figure"])
     return {}
 
 
 def figure_estimator_ratios(params, inputs, outputs):
-    """Fig S4: rho_F, rho_S, rho_SL from the estimators' MSEs (paired-bootstrap 95 % intervals) next to the bound."""
+    """Fig S4: rho_F, rho_S, rho_SL from the estimators' MSEs (paired-bootstrap 95 % intervals) next to the bound.
+
+    The crossing SNRs' rho_S are crosses; the achievable rho_S = 0 dB crossing (local fit, bootstrap
+    interval) is a diamond with its interval on the 0 dB line, the bound's crossing a vertical tick.
+    """
     allrat = pd.read_csv(inputs["ratios"])
+    cross_pts = allrat[allrat["case_set"] == "crossing"] if "case_set" in allrat else allrat.iloc[:0]
+    allrat = allrat[allrat["case_set"] == "grid"] if "case_set" in allrat else allrat
     a_main = allrat["alpha"].max()
     rat = allrat[allrat["alpha"] == a_main]
-    fig, ax = _new_fig()
+    fig, ax = _new_fig(figsize=(10.0, 4.4))
     colors = {"rho_F": "C3", "rho_S": "C0", "rho_SL": "C2"}
     others = allrat[(allrat["alpha"] != a_main) & (allrat["quantity"] == "rho_S")]
     for j, (alpha, g) in enumerate(others.groupby("alpha", sort=False)):
@@ -154,10 +172,44 @@ def figure_estimator_ratios(params, inputs, outputs):
         ax.errorbar(x, g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
                     color=colors[qty], marker="o", ls="none", label=f"{names[qty]} from MSEs")
         ax.plot(g["snr_db"], g["bound_db"], color=colors[qty], lw=1.0, label=f"{names[qty]} bound (47)-(49)")
+    for j, (alpha, g) in enumerate(cross_pts[cross_pts["quantity"] == "rho_S"].groupby("alpha", sort=False)):
+        col = "C0" if alpha == a_main else "C4"
+        ax.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
+                    color=col, marker="x", ls="none", ms=5,
+                    label=rf"$\rho_S$ at the crossing SNRs, $\alpha = {alpha:g}$ ({int(g['n_runs'].min())} runs)")
+    if "crossing" in inputs:
+        cr = pd.read_csv(inputs["crossing"]).set_index(["alpha", "curve"])["snr_db_crossing"]
+        for alpha in sorted({a for a, _ in cr.index}, reverse=True):
+            col = "C0" if alpha == a_main else "C4" if alpha == sorted({a for a, _ in cr.index})[-2] else "C5"
+            e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
+            if np.isfinite(e):
+                ax.errorbar([e], [0.0], xerr=[[e - lo], [hi - e]], color=col, marker="D", ms=6, capsize=3, zorder=6,
+                            label=rf"achievable crossing {e:.2f} dB [{lo:.2f}, {hi:.2f}], $\alpha = {alpha:g}$")
+            ax.plot([cr[(alpha, "bound")]], [0.0], color=col, marker="|", ms=14, mew=2, ls="none", zorder=6,
+                    label=rf"bound crossing {cr[(alpha, 'bound')]:.2f} dB, $\alpha = {alpha:g}$")
+    if len(cross_pts):   # zoom on the crossing SNRs (the empty lower left of the axes)
+        ins = ax.inset_axes([0.04, 0.06, 0.4, 0.45])
+        rs = pd.concat([cross_pts, allrat])
+        rs = rs[(rs["quantity"] == "rho_S") & rs["alpha"].isin(cross_pts["alpha"].unique())]
+        lo_x, hi_x = cross_pts["snr_db"].min() - 1.2, cross_pts["snr_db"].max() + 0.7
+        rs = rs[(rs["snr_db"] >= lo_x) & (rs["snr_db"] <= hi_x)]
+        for alpha, g in rs.groupby("alpha"):
+            col = "C0" if alpha == a_main else "C4"
+            ins.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
+                         color=col, marker="x", ls="none", ms=4, lw=0.8)
+            if "crossing" in inputs:
+                e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
+                ins.errorbar([e], [0.0], xerr=[[e - lo], [hi - e]], color=col, marker="D", ms=5, capsize=3)
+        ins.axhline(0.0, color="k", lw=0.6)
+        ins.set_xlim(lo_x, hi_x)
+        ins.tick_params(labelsize=6)
+        ins.set_title(r"$\rho_S$ near its crossing", fontsize=7)
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
     ax.set_ylabel("ratio [dB]")
-    ax.set_title(rf"Fig S4: achievable ratios vs the bound ($\alpha = {a_main:g}$)")
-    ax.legend(fontsize=7)
+    others_txt = ", ".join(f"{a:g}" for a in sorted(others["alpha"].unique(), reverse=True))
+    ax.set_title(rf"Fig S4: achievable ratios vs the bound ($\alpha = {a_main:g}$; $\rho_S$ also at {others_txt})",
+                 fontsize=9)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     save_figure(fig, outputs["figure"])
     return {}

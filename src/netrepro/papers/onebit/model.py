@@ -30,6 +30,7 @@ __all__ = [
     "theta_variance",
     "stationary_variance",
     "sigma_z2_from_snr",
+    "axis_shift_db",
     "linear_gaussian_blocks",
     "filtering_bim_step",
     "prediction_bim_step",
@@ -179,6 +180,26 @@ def sigma_z2_from_snr(snr_db, eps: float, sigma_eta: float = 1.0, definition: st
 
 
 # ============================================================================ general vector BIMs
+def axis_shift_db(eps: float) -> float:
+    r"""SNR-axis shift between the two SNR readings at fixed alpha: :math:`10\log_{10}(1-\alpha^2)`, by (33).
+
+    With :math:`\sigma^2_{\theta,\infty} = \sigma_z^2/(1-\alpha^2)`, the innovation SNR
+    :math:`\sigma_z^2/\sigma_\eta^2` equals the stationary SNR
+    :math:`\sigma^2_{\theta,\infty}/\sigma_\eta^2` times :math:`1-\alpha^2 = \varepsilon(2-\varepsilon)`.
+
+    Parameters
+    ----------
+    eps : float
+        ``1 - alpha``, in (0, 1].
+
+    Returns
+    -------
+    float
+        The shift in dB (negative): innovation SNR = stationary SNR + shift.
+    """
+    return 10.0 * math.log10(eps * (2.0 - eps))
+
+
 def _as_mat(x):
     return np.atleast_2d(np.asarray(x, dtype=float))
 

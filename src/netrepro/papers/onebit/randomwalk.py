@@ -14,7 +14,7 @@ import numpy as np
 
 from ...errors import InputError, ModelError
 from .fisher import expected_fisher_1bit, expected_fisher_interpolator
-from .model import kalman_covariances, sigma_z2_from_snr, stationary_variance, theta_variance
+from .model import axis_shift_db, kalman_covariances, sigma_z2_from_snr, stationary_variance, theta_variance
 
 __all__ = [
     "rw_filtering_step",
@@ -37,6 +37,10 @@ __all__ = [
     "rw_break_even_iterated",
     "rho_s_threshold_eps",
     "rho_s_zero_crossing",
+    "ratios_at",
+    "snr_shift_deviation",
+    "ratio_window",
+    "ratios_without_mean_reversion",
 ]
 
 
@@ -851,3 +855,138 @@ def rho_s_zero_crossing(eps: float, sigma_eta: float = 1.0, definition: str = "s
         return float(information_ratios(np.array([d]), eps, sigma_eta, definition)["rho_s_db"][0])
 
     return float(optimize.brentq(f, grid[i], grid[i + 1], xtol=1e-10))
+
+
+def ratios_at(snr_db, eps: float, sigma_eta: float = 1.0, definition: str = "stationary",
+              quadrature: dict | None = None) -> dict:
+    r"""The steady-state ratios (47)-(49) in dB at the given SNRs; ``eps = 0`` is the alpha -> 1 limit.
+
+    The expected 1-bit information is (29) by the trapezoid rule (:func:`.fisher.expected_fisher_1bit`),
+    the fixed points those of (24)/(34) and (27)/(37)-(38) (:func:`information_ratios`).
+
+    The limit exists only at fixed stationary SNR (:func:`information_ratios_limit`); with
+    ``definition='innovation'`` it is NaN (the stationary variance (33) diverges as alpha -> 1).
+
+    Parameters
+    ----------
+    snr_db : array_like
+        SNRs in dB.
+    eps : float
+        ``1 - alpha``; 0 for the limit.
+    sigma_eta : float
+        Noise standard deviation.
+    definition : {'stationary', 'innovation'}
+        SNR reading.
+    quadrature : dict, optional
+        ``half_width, step`` of the trapezoid rule for (29).
+
+    Returns
+    -------
+    dict of ndarray
+        ``rho_sl_db, rho_f_db, rho_s_db``.
+    """
+    snr_db = np.atleast_1d(np.asarray(snr_db, dtype=float))
+    if eps == 0:
+        if definition != "stationary":
+            nan = np.full(snr_db.shape, np.nan)
+            return dict(rho_sl_db=nan, rho_f_db=nan.copy(), rho_s_db=nan.copy())
+        lim = information_ratios_limit(snr_db)
+        return {k: lim[k] for k in ("rho_sl_db", "rho_f_db", "rho_s_db")}
+    q = quadrature or {}
+    s = sigma_z2_from_snr(snr_db, eps, sigma_eta, definition)
+    e = expected_fisher_1bit(stationary_variance(eps, s) / sigma_eta**2, **q)
+    res = information_ratios(snr_db, eps, sigma_eta, definition, efq=e)
+    return {k: res[k] for k in ("rho_sl_db", "rho_f_db", "rho_s_db")}
+
+
+def snr_shift_deviation(snr_db, eps: float, sigma_eta: float = 1.0) -> float:
+    r"""Largest difference (dB) between the ratios (47)-(49) under the two SNR readings after the axis shift.
+
+    Evaluates :func:`ratios_at` at the stationary SNRs ``snr_db`` and under the innovation reading
+    at ``snr_db + axis_shift_db(eps)`` (the same :math:`\sigma_z^2`); both describe the same
+    model, so the difference is rounding only.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Stationary SNRs in dB.
+    eps : float
+        ``1 - alpha`` (> 0).
+    sigma_eta : float
+        Noise standard deviation.
+
+    Returns
+    -------
+    float
+        ``max |ratio(innovation, SNR + shift) - ratio(stationary, SNR)|`` over the grid and the three ratios.
+    """
+    snr_db = np.asarray(snr_db, dtype=float)
+    stat = ratios_at(snr_db, eps, sigma_eta, "stationary")
+    inno = ratios_at(snr_db + axis_shift_db(eps), eps, sigma_eta, "innovation")
+    return float(max(np.max(np.abs(stat[k] - inno[k])) for k in stat))
+
+
+def ratio_window(snr_db, eps: float, ratio: str, target_db: float, tol_db: float, sigma_eta: float = 1.0) -> tuple:
+    r"""The range of SNRs on a grid at which a steady-state ratio (47)-(49) is within ``tol_db`` of ``target_db``.
+
+    At finite alpha, :math:`\rho_{SL}` (47) passes through its alpha -> 1 asymptote
+    :math:`\sqrt{2/\pi}` (-0.98 dB) only inside a window of SNRs: below it the prior information
+    :math:`(1-\alpha^2)/\sigma_z^2` lifts it towards 0 dB, above it the SNR loss sets in.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Increasing SNR grid (dB, stationary reading).
+    eps : float
+        ``1 - alpha``.
+    ratio : {'rho_sl_db', 'rho_f_db', 'rho_s_db'}
+        Which ratio of :func:`ratios_at`.
+    target_db, tol_db : float
+        Target value and tolerance (dB).
+    sigma_eta : float
+        Noise standard deviation.
+
+    Returns
+    -------
+    tuple of float
+        ``(lo, hi)``: the smallest and largest grid SNR within the tolerance; NaNs if none is.
+    """
+    snr_db = np.asarray(snr_db, dtype=float)
+    r = ratios_at(snr_db, eps, sigma_eta)[ratio]
+    ok = np.abs(r - target_db) <= tol_db
+    if not ok.any():
+        return float("nan"), float("nan")
+    return float(snr_db[ok].min()), float(snr_db[ok].max())
+
+
+def ratios_without_mean_reversion(snr_db, eps: float, sigma_eta: float = 1.0) -> dict:
+    r"""The ratios (47)-(49) in dB with the mean reversion of (21) removed: a counterfactual for the prior's role.
+
+    For each stationary SNR, :math:`\sigma_z^2` and :math:`E[F_q]` are those of ``eps`` (by (33) and
+    (29)), but the fixed points of (24)/(34) and (27)/(37)-(38) are taken at :math:`\alpha = 1`: the
+    stationary prior information :math:`(1-\alpha^2)/\sigma_z^2`, which the mean reversion supplies,
+    is gone while the information per measurement and per transition stays. Comparing with
+    :func:`ratios_at` at the same SNR isolates the effect of that prior information.
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Stationary SNRs in dB.
+    eps : float
+        ``1 - alpha`` that sets :math:`\sigma_z^2` and :math:`E[F_q]` (> 0).
+    sigma_eta : float
+        Noise standard deviation.
+
+    Returns
+    -------
+    dict of ndarray
+        ``rho_sl_db, rho_f_db, rho_s_db``.
+    """
+    snr_db = np.atleast_1d(np.asarray(snr_db, dtype=float))
+    s = sigma_z2_from_snr(snr_db, eps, sigma_eta, "stationary")
+    Fq = expected_fisher_1bit(stationary_variance(eps, s) / sigma_eta**2) / sigma_eta**2
+    Fi = np.full_like(s, 1.0 / sigma_eta**2)
+    jf_q, jf_i = rw_filtering_fixed_point(Fq, 0.0, s), rw_filtering_fixed_point(Fi, 0.0, s)
+    js_q = jf_q + rw_smoothing_gain_fixed_point(Fq, 0.0, s)
+    js_i = jf_i + rw_smoothing_gain_fixed_point(Fi, 0.0, s)
+    return dict(rho_sl_db=_db(js_q / js_i), rho_f_db=_db(jf_q / jf_i), rho_s_db=_db(js_q / jf_i))

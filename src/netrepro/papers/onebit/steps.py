@@ -64,9 +64,21 @@ import pandas as pd
 
 from scipy.special import ndtri
 
-from .estimators import db_zero_crossing, grid_smoother_at, kalman_rts, paired_ratio_intervals, simulate_block, window_mse
+from .estimators import (
+    bootstrap_ratio_db,
+    db_zero_crossing,
+    downward_root,
+    grid_smoother_at,
+    kalman_rts,
+    local_crossing_fit,
+    paired_ratio_intervals,
+    run_tail_statistics,
+    simulate_block,
+    window_mse,
+)
 from .fisher import expected_fisher_1bit, expected_fisher_1bit_quad
 from .model import sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
+from .runs import ESTIMATOR_KINDS, RATIO_DEFS, estimator_cases, merged_runs
 from .randomwalk import (
     bound_paths,
     estimator_design,
@@ -201,13 +213,6 @@ def convergence_step(params, inputs, outputs):
             "provenance": {"n_filter_steps": int(n_total)}}
 
 
-def _estimator_cases(params):
-    """``(key, eps, snr_db, seed)`` of every simulated (alpha, SNR) pair; alpha ``i``, SNR ``j`` use ``seed + 1000 i + j``."""
-    est = params["estimator"]
-    return [(f"a{i}s{j}", float(eps), float(snr), est["seed"] + 1000 * i + j)
-            for i, eps in enumerate(est["one_minus_alpha"]) for j, snr in enumerate(est["snr_db"])]
-
-
 def _estimator_design(params, eps, snr):
     """Noise variance, 1-bit information and run design (window after >= burn_in_taus time constants)."""
     est, se = params["estimator"], params["sigma_eta"]
@@ -237,47 +242,95 @@ def _estimator_simulator(params, eps, snr):
 
 
 def estimator_shard_step(params, inputs, outputs):
-    """Step: per-run window MSEs of one shard's blocks, for every (alpha, SNR); block ``b`` has its own generator."""
+    """Step: per-run window MSEs of one shard's blocks, for every case; block ``b`` has its own generator."""
     from ...engines.montecarlo import block_rng, shard_blocks
     from ...io import atomic_path
 
     est = params["estimator"]
-    blocks = shard_blocks(est["n_runs"], est["block_size"], params["n_shards"], params["shard"])
-    sizes = [min(est["block_size"], est["n_runs"] - b * est["block_size"]) for b in blocks]
-    arrays = {}
-    for key, eps, snr, seed in _estimator_cases(params):
-        fn = _estimator_simulator(params, eps, snr)
-        per_block = [fn(block_rng(seed, b), n) for b, n in zip(blocks, sizes)]
-        arrays[f"{key}|blocks"] = np.asarray(blocks, dtype=np.int64)
-        arrays[f"{key}|counts"] = np.asarray(sizes, dtype=np.int64)
+    arrays, used = {}, {}
+    for case in estimator_cases(params):
+        blocks = shard_blocks(case.n_runs, est["block_size"], params["n_shards"], params["shard"])
+        sizes = [min(est["block_size"], case.n_runs - b * est["block_size"]) for b in blocks]
+        fn = _estimator_simulator(params, case.eps, case.snr_db)
+        per_block = [fn(block_rng(case.seed, b), n) for b, n in zip(blocks, sizes)]
+        arrays[f"{case.key}|blocks"] = np.asarray(blocks, dtype=np.int64)
+        arrays[f"{case.key}|counts"] = np.asarray(sizes, dtype=np.int64)
+        used[case.key] = [int(b) for b in blocks]
         for kind in ESTIMATOR_KINDS:
-            arrays[f"{key}|{kind}"] = np.concatenate([v[kind] for v in per_block]) if per_block else np.empty(0)
+            arrays[f"{case.key}|{kind}"] = np.concatenate([v[kind] for v in per_block]) if per_block else np.empty(0)
     with atomic_path(outputs["runs"]) as tmp:
         with open(tmp, "wb") as fh:
             np.savez(fh, **arrays)
-    return {"provenance": {"blocks": [int(b) for b in blocks], "seed": est["seed"]}}
+    grid_blocks = next(iter(used.values()), [])
+    return {"provenance": {"blocks": grid_blocks, "seed": est["seed"]}}
 
 
-def _merged_runs(paths, key):
-    """Per-run values of case ``key`` from all shards, in block order (identical for any sharding)."""
-    parts = []
-    for path in paths:
-        with np.load(path) as data:
-            blocks, counts = data[f"{key}|blocks"], data[f"{key}|counts"]
-            offsets = np.concatenate([[0], np.cumsum(counts)])
-            for i, b in enumerate(blocks):
-                parts.append((int(b), {k: data[f"{key}|{k}"][offsets[i]:offsets[i + 1]] for k in ESTIMATOR_KINDS}))
-    parts.sort(key=lambda p: p[0])
-    if len({b for b, _ in parts}) != len(parts):
-        raise ValueError(f"estimator shards: a block of {key} appears twice")
-    return {k: np.concatenate([v[k] for _, v in parts]) for k in ESTIMATOR_KINDS}
+def _half_ratios_db(num, den) -> tuple:
+    """The MSE ratio (dB) on the first and on the second half of the runs (disjoint seed blocks)."""
+    n = len(num) // 2
+    return tuple(float(10.0 * np.log10(num[sl].mean() / den[sl].mean())) for sl in (slice(0, n), slice(n, 2 * n)))
 
 
-ESTIMATOR_KINDS = ("filter_1bit", "smoother_1bit", "kalman_filter", "rts_smoother")
-# rho = MSE of the reference / MSE of the 1-bit estimator (information ratio), (47)-(49)
-RATIO_DEFS = {"rho_F": ("kalman_filter", "filter_1bit", "rho_f_db"),
-              "rho_S": ("kalman_filter", "smoother_1bit", "rho_s_db"),
-              "rho_SL": ("rts_smoother", "smoother_1bit", "rho_sl_db")}
+def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
+    """Rows of ``estimator_crossing.csv`` for every simulated alpha: local fit with a bootstrap interval, and the bound.
+
+    Where the configuration has crossing cases for an alpha, the fit uses those SNRs; otherwise
+    the grid points around the first sign change of the grid estimate (one on each side of the
+    two bracketing points, when they exist). ``fit_degree_<d>`` and ``runs_first_half`` /
+    ``runs_second_half`` are point estimates of the same fit with another degree or on half the runs
+    (sensitivity). ``grid_linear`` is the straight line between the two bracketing grid estimates
+    (the former estimate, for comparison only).
+    """
+    est, se = params["estimator"], params["sigma_eta"]
+    degree = int(est.get("crossing", {}).get("degree", 2))
+    rs = [r for r in ratio_rows if r["quantity"] == "rho_S"]
+    rows = []
+    for eps in est["one_minus_alpha"]:
+        a = 1.0 - float(eps)
+        mine = [r for r in rs if r["alpha"] == a]
+        grid = sorted((r for r in mine if r["case_set"] == "grid"), key=lambda r: r["snr_db"])
+        cross = sorted((r for r in mine if r["case_set"] == "crossing"), key=lambda r: r["snr_db"])
+        gx = np.array([r["snr_db"] for r in grid])
+        gy = np.array([r["estimate_db"] for r in grid])
+        lin = db_zero_crossing(gx, gy)
+        if len(cross) > degree:
+            pts, method = cross, "local fit, crossing SNRs"
+        else:
+            idx = np.flatnonzero((gy[:-1] > 0) & (gy[1:] <= 0))
+            pts, method = [], "local fit, grid SNRs"
+            if len(idx):
+                i = int(idx[0])
+                pts = grid[max(0, i - 1):min(len(grid), i + 3)]
+        base = dict(alpha=a, method=method, degree=degree)
+        if len(pts) > degree:
+            x = np.array([r["snr_db"] for r in pts])
+            y = np.array([r["estimate_db"] for r in pts])
+            yb = np.column_stack([boot[r["key"]] for r in pts])
+            fit = local_crossing_fit(x, y, yb, degree)
+            info = dict(fit_snr_lo=float(x.min()), fit_snr_hi=float(x.max()), n_points=len(x),
+                        n_runs=int(min(r["n_runs"] for r in pts)), n_boot=int(yb.shape[0]),
+                        boot_fail_frac=fit["fail_frac"], fit_residual_rms=fit["residual_rms"])
+            for curve in ("estimate", "lo", "hi"):
+                rows.append(dict(base, curve=curve, snr_db_crossing=fit[curve], **info))
+            # sensitivity (point estimates): the fit's degree, and each half of the runs at the configured degree
+            for deg in sorted({1, 3} - {degree}):
+                if len(x) > deg:
+                    rows.append(dict(base, degree=deg, curve=f"fit_degree_{deg}", **info,
+                                     snr_db_crossing=downward_root(np.polyfit(x, y, deg), x.min(), x.max())))
+            for h, name in enumerate(("runs_first_half", "runs_second_half")):
+                yh = np.array([r["half_db"][h] for r in pts])
+                rows.append(dict(base, curve=name, **dict(info, n_runs=info["n_runs"] // 2),
+                                 snr_db_crossing=downward_root(np.polyfit(x, yh, degree), x.min(), x.max())))
+        else:
+            for curve in ("estimate", "lo", "hi"):
+                rows.append(dict(base, curve=curve, snr_db_crossing=float("nan")))
+        rows.append(dict(alpha=a, curve="grid_linear", snr_db_crossing=lin, method="straight line between the "
+                         "bracketing grid estimates (former estimate; comparison only)", degree=1))
+        rows.append(dict(alpha=a, curve="bound", snr_db_crossing=rho_s_zero_crossing(eps, se, params["snr_definition"]),
+                         method="steady-state bound (49), Brent's method"))
+    cols = ["alpha", "curve", "snr_db_crossing", "method", "degree", "fit_snr_lo", "fit_snr_hi", "n_points", "n_runs",
+            "n_boot", "boot_fail_frac", "fit_residual_rms"]
+    return pd.DataFrame(rows).reindex(columns=cols)
 
 
 def estimator_step(params, inputs, outputs):
@@ -287,15 +340,22 @@ def estimator_step(params, inputs, outputs):
     (34)/(36) or (24)/(26) over the same evaluation steps of the finite record (``bound``) and its
     steady state (``bound_steady``); ``steady_dev`` is the largest relative distance of the
     finite-record bound from its steady state over the evaluation steps (the window is in steady
-    state when it is small). ``estimator_ratios.csv``: rho_F, rho_S, rho_SL from the MSEs with a
-    paired bootstrap interval, next to the bound (49)-(47). ``estimator_crossing.csv``: the SNR at
-    which the achievable rho_S (estimate, lo, hi) and the bound cross 0 dB.
+    state when it is small); ``kurtosis``, ``max_over_mean`` and ``se_ratio`` describe the per-run
+    MSEs' tails and check the normal standard error against the seed blocks as independent
+    replicates (:func:`.estimators.run_tail_statistics`). ``estimator_ratios.csv``: rho_F, rho_S,
+    rho_SL from the MSEs with a paired bootstrap interval, next to the bound (49)-(47).
+    ``case_set`` is ``grid`` or ``crossing`` (:mod:`.runs`). ``estimator_crossing.csv``: the SNR
+    at which the achievable rho_S crosses 0 dB by a local polynomial fit with a bootstrap interval
+    over runs (:func:`.estimators.local_crossing_fit`), the former straight-line estimate, and the
+    bound's crossing.
     """
     est, se = params["estimator"], params["sigma_eta"]
-    mse_rows, ratio_rows, cross_rows = [], [], []
+    mse_rows, ratio_rows, boot = [], [], {}
     z = float(ndtri(0.975))
-    for key, eps, snr, seed in _estimator_cases(params):
-        runs = _merged_runs(inputs["shards"], key)
+    ref_s, onebit_s, _ = RATIO_DEFS["rho_S"]
+    for case in estimator_cases(params):
+        key, eps, snr, seed = case.key, case.eps, case.snr_db, case.seed
+        runs = merged_runs(inputs["shards"], key, with_blocks=True)
         s, Fq, d = _estimator_design(params, eps, snr)
         ev = d["eval_idx"]
         var_inf = float(stationary_variance(eps, s))
@@ -312,25 +372,24 @@ def estimator_step(params, inputs, outputs):
         for kind in ESTIMATOR_KINDS:
             v = runs[kind]
             m, half = float(v.mean()), z * float(v.std(ddof=1)) / math.sqrt(len(v))
+            tails = run_tail_statistics(v, runs["block"])
             mse_rows.append(dict(alpha=1.0 - eps, snr_db=snr, kind=kind, mse=m, mse_lo=m - half, mse_hi=m + half,
                                  bound=bounds[kind], bound_steady=steady[kind], mse_over_bound=m / bounds[kind],
-                                 n_runs=len(v), steady_dev=dev[kind], **design_cols))
+                                 n_runs=len(v), steady_dev=dev[kind], **design_cols, case_set=case.case_set,
+                                 **tails))
         bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
         intervals = paired_ratio_intervals(runs, [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()],
                                            est["n_boot"], seed)   # one resampling per case, shared by the ratios
         for (qty, (ref, onebit, col)), (e, lo, hi) in zip(RATIO_DEFS.items(), intervals):
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
-                                   steady_dev=max(dev[ref], dev[onebit]), **design_cols))
-    ratios = pd.DataFrame(ratio_rows)
-    for eps in est["one_minus_alpha"]:
-        sub = ratios[(ratios["quantity"] == "rho_S") & np.isclose(ratios["alpha"], 1.0 - eps, rtol=0, atol=1e-15)]
-        snr = sub["snr_db"].to_numpy()
-        for curve, col in (("estimate", "estimate_db"), ("lo", "lo_db"), ("hi", "hi_db")):
-            cross_rows.append(dict(alpha=1.0 - eps, curve=curve, snr_db_crossing=db_zero_crossing(snr, sub[col])))
-        cross_rows.append(dict(alpha=1.0 - eps, curve="bound",
-                               snr_db_crossing=rho_s_zero_crossing(eps, se, params["snr_definition"])))
-    return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": pd.DataFrame(cross_rows)}
+                                   steady_dev=max(dev[ref], dev[onebit]), **design_cols, case_set=case.case_set,
+                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit])))
+        # bootstrap replicates of the achievable rho_S for the crossing fit (its own resampling per case)
+        boot[key] = bootstrap_ratio_db(runs[ref_s], runs[onebit_s], est["n_boot"], seed)
+    crossing = _crossing_rows(params, ratio_rows, boot)
+    ratios = pd.DataFrame(ratio_rows).drop(columns=["key", "half_db"])
+    return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": crossing}
 
 
 def run_estimator(params):
