@@ -40,7 +40,7 @@ def test_paper_data_loads():
     data = load_paper_data("onebit")
     ids = {c.claim_id for c in data.claims}
     assert {"same_loss", "rho_sl_fig1", "rho_s_alpha_threshold", "outperform_achievable"} <= ids
-    assert "bound_below_mse" not in ids and "bound_below_mse" in {f["id"] for f in data.findings}
+    assert "bound_below_mse" not in ids and "bound_below_mse" in {f.finding_id for f in data.findings}
     kinds = {e["id"]: e["kind"] for e in data.errata}
     assert kinds["E5"] == "typesetting" and kinds["E6"] == "notation"
 
@@ -107,10 +107,10 @@ def test_evidence_values(tables):
             if label != NOMINAL and not q.startswith("reconstruction."):
                 # a declared range (<key>: / <key>=) or the counterfactual a finding's cause names
                 assert label.split(":")[0].split("=")[0] in keys | {"cause"}, (q, label)
-    causes = [f["cause"]["variant"] for f in load_paper_data("onebit").findings if f.get("cause")]
-    for c in causes:
-        q, label = c.split(" / ", 1)
-        assert label in ev[q], c
+    causes = [(f.quantity, f.cause["variant"]) for f in load_paper_data("onebit").findings if f.cause]
+    assert causes
+    for q, label in causes:  # the cause variant is a variant of the judged quantity
+        assert label in ev[q], (q, label)
     # the break-even lag exists exactly where rho_S > 0 (why it is no separate claim)
     assert ev["break_even_lag"][NOMINAL][0] is True
     # run halves: n = 20 of 40 runs each
@@ -129,7 +129,7 @@ def test_findings_are_judged_like_claims():
     data = load_paper_data("onebit")
     keys = {r["key"] for r in data.reconstructions}
     for f in data.findings:
-        assert f.get("rule", {}).get("reason"), f["id"]
-        assert f.get("evidence_quantities") and f["quantity"] in f["evidence_quantities"], f["id"]
-        assert set(f.get("depends_on", [])) <= keys, f["id"]
-        assert f.get("prior_work"), f["id"]
+        assert f.rule_reason, f.finding_id
+        assert f.evidence_quantities and f.quantity in f.evidence_quantities, f.finding_id
+        assert set(f.depends_on) <= keys, f.finding_id
+        assert f.prior_work, f.finding_id

@@ -32,7 +32,8 @@ import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-from ...verdicts import erratum_evidence, evidence_frame, load_paper_data
+from ...paperdata import load_paper_data
+from ...verdicts import erratum_evidence, evidence_frame
 from .estimators import paired_ratio_interval, pooled_se_ratio
 from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
 from .model import axis_shift_db, prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
@@ -47,7 +48,7 @@ from .randomwalk import (
     snr_shift_deviation,
     variance_sum_check,
 )
-from .runs import RATIO_DEFS, estimator_cases, merged_runs
+from .shards import RATIO_DEFS, estimator_cases, merged_runs
 
 __all__ = [
     "alpha_label",
@@ -342,16 +343,22 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
     # the lag needed to be within tol of the Delta -> infinity limit, across tolerances
     grid_start = float(params["snr_grid_db"]["start"])
     pts = np.array([grid_start] + [float(x) for x in at["lag_needed_tolerance"]["snr_db"]])
-    parts = []
+    parts, lags = [], {}
     for eps in params["one_minus_alpha"]:
         s = sigma_z2_from_snr(pts, eps, se, params["snr_definition"])
         Fq = expected_fisher_1bit(stationary_variance(eps, s) / se**2) / se**2
         for tol in ev["lag_tol_db"]:
             d = rw_lag_needed(Fq, eps, s, tol)
+            lags[(eps, tol)] = np.asarray(d, dtype=float)
             parts.append(f"{alpha_label(eps)}, tol {tol:g} dB: " + ", ".join(
                 f"{x:g} dB: {int(v)}" for x, v in zip(pts, d)))
-    rows.append(dict(quantity="lag_needed_tolerance", value="", note="1-bit smoothing lag within tol of its "
-                     "Delta -> infinity value: " + "; ".join(parts)))
+    # the finding's assertion: the lag grows as the tolerance shrinks and as alpha -> 1, at every SNR
+    tols = sorted(ev["lag_tol_db"], reverse=True)
+    epss = sorted(params["one_minus_alpha"], reverse=True)
+    grows = all(np.all(lags[(e, t2)] > lags[(e, t1)]) for e in epss for t1, t2 in zip(tols, tols[1:]))
+    grows &= all(np.all(lags[(e2, t)] > lags[(e1, t)]) for t in tols for e1, e2 in zip(epss, epss[1:]))
+    rows.append(dict(quantity="lag_needed_tolerance", value=bool(grows), note="1-bit smoothing lag within tol of "
+                     "its Delta -> infinity value: " + "; ".join(parts)))
     # finite alpha: the prior information lifts rho_F and rho_SL back towards 0 dB at very low SNR
     eps5 = float(params["fig1_one_minus_alpha"])
     very_low = np.array(ev["very_low_snr_db"], dtype=float)
@@ -461,7 +468,7 @@ def _paper_side(path) -> tuple:
     """``({id: at}, {claim id: ClaimEntry})`` of the claims and findings files beside ``path`` (default: this package's)."""
     data = load_paper_data("onebit", Path(path).parent if path else None)
     at = {c.claim_id: dict(c.at) for c in data.claims if c.at}
-    at.update({f["id"]: dict(f.get("at") or {}) for f in data.findings if f.get("at")})
+    at.update({f.finding_id: dict(f.at) for f in data.findings if f.at})
     return at, {c.claim_id: c for c in data.claims}
 
 

@@ -78,7 +78,7 @@ from .estimators import (
 )
 from .fisher import expected_fisher_1bit, expected_fisher_1bit_quad
 from .model import sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
-from .runs import ESTIMATOR_KINDS, RATIO_DEFS, estimator_cases, merged_runs
+from .shards import ESTIMATOR_KINDS, RATIO_DEFS, estimator_cases, merged_runs
 from .randomwalk import (
     bound_paths,
     estimator_design,

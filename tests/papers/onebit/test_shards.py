@@ -1,11 +1,11 @@
-"""Tests of netrepro.papers.onebit.runs: case bookkeeping and the merge of shard files."""
+"""Tests of netrepro.papers.onebit.shards: case bookkeeping and the merge of shard files."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from netrepro.papers.onebit import runs
+from netrepro.papers.onebit import shards
 
 
 def _params():
@@ -15,7 +15,7 @@ def _params():
 
 
 def test_cases_keys_seeds_and_sets():
-    cases = runs.estimator_cases(_params())
+    cases = shards.estimator_cases(_params())
     grid = [c for c in cases if c.case_set == "grid"]
     cross = [c for c in cases if c.case_set == "crossing"]
     assert [c.key for c in grid] == ["a0s0", "a0s1", "a1s0", "a1s1"]
@@ -23,13 +23,13 @@ def test_cases_keys_seeds_and_sets():
     assert [(c.key, c.seed, c.n_runs) for c in cross] == [("c0s0", 7, 4), ("c0s1", 8, 4), ("c0s2", 9, 4)]
     p = _params()
     p["estimator"].pop("crossing")
-    assert all(c.case_set == "grid" for c in runs.estimator_cases(p))
+    assert all(c.case_set == "grid" for c in shards.estimator_cases(p))
 
 
 def _shard(path, key, blocks, counts, start):
     arrays = {f"{key}|blocks": np.asarray(blocks), f"{key}|counts": np.asarray(counts)}
     n = int(sum(counts))
-    for j, kind in enumerate(runs.ESTIMATOR_KINDS):
+    for j, kind in enumerate(shards.ESTIMATOR_KINDS):
         arrays[f"{key}|{kind}"] = np.arange(start, start + n, dtype=float) + 100 * j
     np.savez(path, **arrays)
 
@@ -38,9 +38,9 @@ def test_merge_is_in_block_order_whatever_the_shards(tmp_path):
     # blocks 0, 1 (2 runs each) in the second file, block 2 (1 run) in the first
     _shard(tmp_path / "a.npz", "k", [2], [1], 4)
     _shard(tmp_path / "b.npz", "k", [0, 1], [2, 2], 0)
-    out = runs.merged_runs([tmp_path / "a.npz", tmp_path / "b.npz"], "k", with_blocks=True)
+    out = shards.merged_runs([tmp_path / "a.npz", tmp_path / "b.npz"], "k", with_blocks=True)
     np.testing.assert_array_equal(out["filter_1bit"], [0, 1, 2, 3, 4])
     np.testing.assert_array_equal(out["block"], [0, 0, 1, 1, 2])
-    assert "block" not in runs.merged_runs([tmp_path / "b.npz"], "k")
+    assert "block" not in shards.merged_runs([tmp_path / "b.npz"], "k")
     with pytest.raises(ValueError, match="appears twice"):
-        runs.merged_runs([tmp_path / "b.npz", tmp_path / "b.npz"], "k")
+        shards.merged_runs([tmp_path / "b.npz", tmp_path / "b.npz"], "k")

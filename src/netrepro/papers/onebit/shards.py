@@ -1,4 +1,4 @@
-"""Bookkeeping of the Monte Carlo runs of the `onebit` estimators (beyond the paper, issues 17 and 27).
+"""Shards of the Monte Carlo runs of the `onebit` estimators (beyond the paper, issues 17 and 27).
 
 Which (alpha, SNR) cases are simulated, with which seed and how many runs, and how the per-run
 values written by the shards are merged back in block order. Used by the pipeline steps
