@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from netrepro.papers.gainsched.steps import MATRICES, gains_from_table, gains_table
 
@@ -24,7 +25,8 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
     pd.concat([gains_table("paper", paper), gains_table("zero", zero_gains(sys))]).to_csv(tmp_path / "g.csv", index=False)
     pd.DataFrame([{"design": "paper", "method": "printed", "certified_cost": np.nan},
                   {"design": "zero", "method": "x_f = 0", "certified_cost": np.nan}]).to_csv(tmp_path / "d.csv", index=False)
-    out = exact_moments_step(cfg, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
+    params = dict(cfg, simulation=dict(cfg["simulation"], flipped=[]))
+    out = exact_moments_step(params, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
     table, per_k = out["table"], out["per_k"]
     assert list(table.columns) == ["design", "nonlinearity", "initial_state", "sum_mse", "final_mse"]
     assert len(table) == 2 * 3 * 2
@@ -40,3 +42,27 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
     perf = out["performance"].set_index("design")
     assert perf.loc["zero", "sum_mse_gaussian_worst"] == table[(table["design"] == "zero")
                                                               & (table["initial_state"] == "gaussian")]["sum_mse"].max()
+
+
+def test_exact_moments_step_adds_flipped_rows(cfg, sys, paper, tmp_path):
+    """simulation.flipped repeats a design with H -> -H in exact_moments.csv only (not in performance.csv)."""
+    import pandas as pd
+
+    from netrepro.papers.gainsched.model import realisation, zero_gains
+    from netrepro.papers.gainsched.steps import exact_moments_step
+    from netrepro.papers.gainsched.tuning import exact_cost
+
+    pd.concat([gains_table("paper", paper), gains_table("zero", zero_gains(sys))]).to_csv(tmp_path / "g.csv", index=False)
+    pd.DataFrame([{"design": "paper", "method": "printed", "certified_cost": np.nan},
+                  {"design": "zero", "method": "x_f = 0", "certified_cost": np.nan}]).to_csv(tmp_path / "d.csv", index=False)
+    params = dict(cfg, simulation=dict(cfg["simulation"], flipped=["paper"]))
+    out = exact_moments_step(params, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
+    table = out["table"].set_index(["design", "nonlinearity", "initial_state"])["sum_mse"]
+    assert set(out["table"]["design"]) == {"paper", "zero", "paper_flipped"}
+    assert set(out["performance"]["design"]) == {"paper", "zero"}
+    from netrepro.papers.gainsched.model import augmented_initial_moment
+    from netrepro.papers.gainsched.steps import p_sequence
+
+    want = exact_cost(sys, realisation(paper, -np.eye(sys.n)), p_sequence(params, sys), 0.5 * (sys.F1 + sys.F2),
+                      augmented_initial_moment(np.eye(sys.n), sys.n))
+    assert table[("paper_flipped", "mid", "gaussian")] == pytest.approx(want, rel=1e-12)

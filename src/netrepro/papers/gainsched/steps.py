@@ -557,8 +557,9 @@ def scheduling_step(params, inputs, outputs):
       the LMI design itself; the verdict is the engine's check of the point;
     * ``exact_tuned``: the best gains found for the exact sum_k E||e(k)||^2 (f = (F1+F2)/2 z,
       x(0) ~ N(0, I), the configured p(k)) in each family (:func:`.tuning.best_exact_gains`, BFGS
-      from named starts; the scheduled search starts from the fixed optimum too, so it can only
-      improve on it): what scheduling buys in the error itself.
+      from the designs named in ``scheduling.starts``, or from x_f = 0 if none; the scheduled search
+      starts from the fixed optimum too, so it can only improve on it): what scheduling buys in the
+      error itself.
 
     A row ``schedule_size`` gives max(|Gf|, |Hf|) of each LMI design of ``gains.csv`` (is it scheduled?).
     """
@@ -584,7 +585,7 @@ def scheduling_step(params, inputs, outputs):
     mid = 0.5 * (sys.F1 + sys.F2)
     Xg = augmented_initial_moment(np.eye(sys.n), sys.n)
     named = [(d, gains_from_table(table, d, sys)) for d in params["scheduling"]["starts"]]
-    fixed, info_f = best_exact_gains(sys, p_seq, mid, Xg, False, [("zero", zero_gains(sys))] + named)
+    fixed, info_f = best_exact_gains(sys, p_seq, mid, Xg, False, named or [("zero", zero_gains(sys))])
     sched, info_s = best_exact_gains(sys, p_seq, mid, Xg, True, [("best fixed", fixed)] + named)
     for family, info in (("fixed_gain", info_f), ("scheduled", info_s)):
         rows.append({"comparison": "exact_tuned", "family": family, "value": info["cost"], "verdict": "",
