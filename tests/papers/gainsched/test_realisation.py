@@ -88,3 +88,15 @@ def test_eq15_residuals_signs(sys, t3):
     assert corrected < 1e-9 < printed
     with pytest.raises(GainschedError, match="n_states"):
         eq15_residuals(sys, g, c["Q0"], c["Qp"], np.random.default_rng(0), n_states=0)
+
+
+def test_relative_spread_and_rms_ratio():
+    from netrepro.papers.gainsched.verification import relative_spread, rms_ratio
+
+    assert relative_spread([3.6947, 12.419, 2.9671]) == pytest.approx(12.419 / 2.9671 - 1, rel=1e-15)
+    assert relative_spread([2.0]) == 0.0
+    with pytest.raises(GainschedError, match="positive finite"):
+        relative_spread([1.0, 0.0])
+    assert rms_ratio([4.0, 1.0, 0.01]) == pytest.approx(0.05, rel=1e-15)
+    with pytest.raises(GainschedError, match=r"E\|\|e\(0\)\|\|\^2 > 0"):
+        rms_ratio([0.0, 1.0])

@@ -27,6 +27,8 @@ from .verification import (
     missing_fraction,
     ms_stability_index,
     r2_congruence_residuals,
+    relative_spread,
+    rms_ratio,
 )
 
 __all__ = ["evidence_step", "feasible_flag"]
@@ -159,8 +161,7 @@ def evidence_step(params, inputs, outputs):
     K, omega = int(sim["horizon"]), float(sim["sine_omega"])
     rate = convergence_rate(sys, paper, p_seq)
     ep = ex_mse[(ex_mse["design"] == "paper") & (ex_mse["initial_state"] == "x0")]
-    ratios = {f: float(np.sqrt(s.sort_values("k")["mse"].iloc[-1] / s.sort_values("k")["mse"].iloc[0]))
-              for f, s in ep.groupby("nonlinearity")}
+    ratios = {f: rms_ratio(s.sort_values("k")["mse"]) for f, s in ep.groupby("nonlinearity")}
     add({"quantity": "figs_errors_converge", "value": bool(rate < 1.0),
          "note": f"worst per-step growth rate of the exact second moment along p(k) {rate:.4f} (f in F1, F2, mid); "
                  f"exact RMS error ratio at k = {int(ep['k'].max())} (x(0) = x0): "
@@ -330,8 +331,7 @@ def _finding_rows(exact, thm1, vt, limits, lim, sched_tab, at) -> list:
     spread_rule = float(at["D3_gain_recovery_not_unique"]["spread"])
 
     def d3(f, st):
-        vals = [sm[(d, f, st)] for d in reals]
-        return max(vals) / min(vals) - 1.0
+        return relative_spread([sm[(d, f, st)] for d in reals])
 
     add({"quantity": "D3_gain_recovery_not_unique", "value": bool(d3(*nominal) > spread_rule),
          "note": "exact sum_k E||e(k)||^2 of one Theorem 3 solution (f = mid, x(0) ~ N(0, I)): S21 = S22 = R2 "

@@ -63,7 +63,8 @@ def figure_mse(params, inputs, outputs):
     kmax = int(params.get("k_max", sel["k"].max()))
     for d, er in sel.groupby("design", sort=False):
         er = er[er["k"] <= kmax]
-        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(d), label=d, lw=1.2)
+        base = d.removesuffix("_flipped")  # the same filter with H -> -H: its design's colour, dashed
+        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(base), ls="--" if base != d else "-", label=d, lw=1.2)
     ax1.set(xlabel="k", ylabel=r"$E\|e(k)\|^2$ (exact)",
             title=f"exact second moments, f = {f_show}, x(0) {'~ N(0, I)' if start == 'gaussian' else '= x0'}")
     ax1.legend(fontsize=7)

@@ -8,7 +8,8 @@ independent computation of something the paper states or implies:
 * :func:`r2_congruence_residuals`: the relation of R2 to S21, S22 in Theorem 3 / (23);
 * :func:`missing_fraction`: the fraction of missing measurements under (6)-(7);
 * :func:`eq15_residuals`: E ΔV of (14) against the two sign readings of (15);
-* :func:`gap_relative`: the relative gap between two ends of a bracket.
+* :func:`gap_relative`, :func:`relative_spread`, :func:`rms_ratio`: the relative quantities the findings
+  and claims are judged on.
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ __all__ = [
     "missing_fraction",
     "eq15_residuals",
     "gap_relative",
+    "relative_spread",
+    "rms_ratio",
 ]
 
 
@@ -190,3 +193,49 @@ def gap_relative(lower: float, upper: float) -> float:
     if not (np.isfinite(upper) and upper > 0):
         raise GainschedError(f"gap_relative: upper must be positive and finite, got {upper}")
     return float((upper - lower) / upper)
+
+
+def relative_spread(values) -> float:
+    """max / min - 1 of positive values: how much the largest exceeds the smallest, as a fraction.
+
+    Parameters
+    ----------
+    values : array_like
+        Positive numbers (e.g. one design's exact sum_k E||e(k)||^2 under several realisations).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    GainschedError
+        If ``values`` is empty or not all positive and finite.
+    """
+    v = np.asarray(values, dtype=float)
+    if v.size == 0 or not np.all(np.isfinite(v) & (v > 0)):
+        raise GainschedError(f"relative_spread needs positive finite values, got {v.tolist()}")
+    return float(v.max() / v.min() - 1.0)
+
+
+def rms_ratio(mse) -> float:
+    """sqrt(E||e(K)||^2 / E||e(0)||^2): the factor by which the RMS error has shrunk from k = 0 to the last k.
+
+    Parameters
+    ----------
+    mse : array_like (K+1,)
+        E||e(k)||^2 in order of k.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    GainschedError
+        If ``mse`` is empty or E||e(0)||^2 is not positive.
+    """
+    m = np.asarray(mse, dtype=float)
+    if m.size == 0 or not m[0] > 0:
+        raise GainschedError(f"rms_ratio needs E||e(0)||^2 > 0, got {m[:1].tolist()}")
+    return float(np.sqrt(m[-1] / m[0]))
