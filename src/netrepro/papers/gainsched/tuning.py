@@ -156,9 +156,10 @@ def tune_gains_exact(sys: System, p_seq, F, X0, scheduled: bool, maxiter: int, s
 def exact_cost(sys: System, gains: Gains, p_seq, F, X0) -> float:
     """Exact sum_{k=0}^{K} E||e(k)||^2 of (10) for f = F z by the second-moment recursion of :mod:`.moments`.
 
-    The recursion X(k+1) = p M1 X M1^T + (1-p) M0 X M0^T + sigma^2 W X W^T for one system, written
-    with plain matrix products (the cost function of the tuning; :func:`.moments.second_moments`
-    is the batched version).
+    The recursion X(k+1) = p M1 X M1^T + (1-p) M0 X M0^T + sigma^2 W X W^T for one system, on
+    vec(X) with the operators p M1 (x) M1 + (1-p) M0 (x) M0 + sigma^2 W (x) W built for all k at
+    once (the cost function of the tuning; :func:`.moments.second_moments` is the batched matrix
+    form, an independent computation of the same values).
 
     Parameters
     ----------
@@ -174,15 +175,25 @@ def exact_cost(sys: System, gains: Gains, p_seq, F, X0) -> float:
     float
     """
     M1, M0, W = mode_matrices(sys, gains, p_seq, F)
+    p = np.asarray(p_seq, dtype=float)
+    K, d = M1.shape[0], M1.shape[1]
+
+    def kron(A):  # (A X A^T) in row-major vec(X): kron(A, A), for a stack of A
+        return np.einsum("...ij,...lm->...iljm", A, A).reshape(A.shape[:-2] + (d * d, d * d))
+
+    ops = p[:, None, None] * kron(M1) + (1.0 - p)[:, None, None] * kron(M0) + float(sys.sigma2) * kron(W)[None]
     n = sys.n
-    X = np.array(X0, dtype=float)
-    total = 0.0
-    s2W = float(sys.sigma2) * W
-    for k, p in enumerate(np.asarray(p_seq, dtype=float)):  # one system: plain matrix products, no batching
-        total += np.trace(X[:n, :n]) + np.trace(X[n:, n:]) - 2.0 * np.trace(X[:n, n:])
-        A1, A0 = M1[k], M0[k]
-        X = p * (A1 @ X @ A1.T) + (1.0 - p) * (A0 @ X @ A0.T) + s2W @ X @ W.T
-    return float(total + np.trace(X[:n, :n]) + np.trace(X[n:, n:]) - 2.0 * np.trace(X[:n, n:]))
+    c = np.zeros((d, d))  # tr(X_xx) + tr(X_ff) - tr(X_xf) - tr(X_fx) = E||x - x_f||^2 for symmetric X
+    c[np.arange(d), np.arange(d)] = 1.0
+    c[np.arange(n), n + np.arange(n)] = -1.0
+    c[n + np.arange(n), np.arange(n)] = -1.0
+    c = c.ravel()
+    x = np.asarray(X0, dtype=float).ravel()
+    total = float(c @ x)
+    for k in range(K):  # one system: 16 x 16 matrix-vector products, the operators built at once
+        x = ops[k] @ x
+        total += float(c @ x)
+    return total
 
 
 def _pack(gains: Gains, scheduled: bool) -> np.ndarray:
