@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import yaml
@@ -12,7 +14,7 @@ from netrepro.papers.gainsched.model import Gains, gains_from_dict, system_from_
 
 @pytest.fixture(scope="module")
 def cfg():
-    with open("config/test.yaml") as fh:
+    with open(Path(__file__).resolve().parents[3] / "config" / "test.yaml") as fh:
         return yaml.safe_load(fh)["gainsched"]
 
 

@@ -19,8 +19,10 @@ def tables(tmp_path):
     for i, d in enumerate(DESIGNS):
         for k in ks:
             m = 0.5 ** k * (1 + 0.1 * i)
-            rows.append({"design": d, "k": k, "e1_mean": m, "e2_mean": -m, "e1_lo": m - 0.1, "e1_hi": m + 0.1,
-                         "e2_lo": -m - 0.1, "e2_hi": -m + 0.1, "mse": 2 * m * m + 1e-3})
+            for st in ("fixed_x0", "gaussian"):
+                rows.append({"design": d, "initial_state": st, "k": k, "e1_mean": m, "e2_mean": -m, "e1_lo": m - 0.1,
+                             "e1_hi": m + 0.1, "e2_lo": -m - 0.1, "e2_hi": -m + 0.1, "mse": 2 * m * m + 1e-3,
+                             "e1_rms": m, "e2_rms": m})
             paths.append({"design": d, "k": k, "p": 0.5, "e1": m, "e2": -m})
         summary += [{"design": d, "initial_state": s, "sum_mse": 1.0 + i} for s in ("fixed_x0", "gaussian")]
         summary[-1]["sum_mse_se"] = summary[-2]["sum_mse_se"] = 0.1
@@ -34,8 +36,11 @@ def tables(tmp_path):
              "plant_radius": 0.5, "verdict": verdict, "kind": "grid"}
             for v in ("scheduled", "fixed_gain", "zero", "plant")
             for s2, verdict in ((0.5, "feasible"), (1.0, "undecided"), (2.0, "infeasible"))]
-    limits = [{"design": d, "sigma2_max": 3.0, "sigma2_lo": 3.0, "sigma2_hi": 3.1, "certified": True}
-              for d in ("scheduled", "fixed_gain", "zero", "plant")]
+    sens.append({"variant": "plant", "sigma2": 4.0, "status": "not solved", "margin": np.nan, "certified_slack": np.nan,
+                 "plant_radius": 1.1, "verdict": "infeasible", "kind": "grid"})
+    limits = [{"design": d, "sigma2_max": 3.0, "sigma2_lo": 3.0, "sigma2_hi": 3.1, "certified": True, "role": role}
+              for d, role in (("scheduled", "sufficient"), ("fixed_gain", "sufficient"), ("zero", "sufficient"),
+                              ("plant", "sufficient"), ("plant_necessary", "necessary"))]
     out = {}
     for name, frame in (("errors", rows), ("paths", paths), ("summary", summary), ("sensitivity", sens),
                         ("exact", exact), ("exact_k", exact_k), ("limits", limits)):

@@ -33,9 +33,9 @@ def test_kernel_rejects_bad_input():
     sys = _sys()
     p_seq = p_schedule(np.arange(5), sys.p1, sys.p2, 1.0)
     draws = draw_noise(np.random.default_rng(0), 5, 3)
-    with pytest.raises(GainschedError):
+    with pytest.raises(GainschedError, match="nonlinearity kind must be"):
         simulate_draws(sys, None, p_seq, np.zeros((3, 2)), draws, "cubic")
-    with pytest.raises(GainschedError):
+    with pytest.raises(GainschedError, match=r"draws must have shape \(5, 4\)"):
         simulate_draws(sys, None, p_seq, np.zeros((4, 2)), draws)
 
 

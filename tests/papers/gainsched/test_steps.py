@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from netrepro.papers.gainsched.steps import MATRICES, gains_from_table, gains_table
 
@@ -24,7 +25,8 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
     pd.concat([gains_table("paper", paper), gains_table("zero", zero_gains(sys))]).to_csv(tmp_path / "g.csv", index=False)
     pd.DataFrame([{"design": "paper", "method": "printed", "certified_cost": np.nan},
                   {"design": "zero", "method": "x_f = 0", "certified_cost": np.nan}]).to_csv(tmp_path / "d.csv", index=False)
-    out = exact_moments_step(cfg, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
+    params = dict(cfg, simulation=dict(cfg["simulation"], flipped=[]))
+    out = exact_moments_step(params, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
     table, per_k = out["table"], out["per_k"]
     assert list(table.columns) == ["design", "nonlinearity", "initial_state", "sum_mse", "final_mse"]
     assert len(table) == 2 * 3 * 2
@@ -40,3 +42,68 @@ def test_exact_moments_step_columns_and_zero_design(cfg, sys, paper, tmp_path):
     perf = out["performance"].set_index("design")
     assert perf.loc["zero", "sum_mse_gaussian_worst"] == table[(table["design"] == "zero")
                                                               & (table["initial_state"] == "gaussian")]["sum_mse"].max()
+
+
+def test_exact_moments_step_adds_flipped_rows(cfg, sys, paper, tmp_path):
+    """simulation.flipped repeats a design with H -> -H in exact_moments.csv only (not in performance.csv)."""
+    import pandas as pd
+
+    from netrepro.papers.gainsched.model import realisation, zero_gains
+    from netrepro.papers.gainsched.steps import exact_moments_step
+    from netrepro.papers.gainsched.tuning import exact_cost
+
+    pd.concat([gains_table("paper", paper), gains_table("zero", zero_gains(sys))]).to_csv(tmp_path / "g.csv", index=False)
+    pd.DataFrame([{"design": "paper", "method": "printed", "certified_cost": np.nan},
+                  {"design": "zero", "method": "x_f = 0", "certified_cost": np.nan}]).to_csv(tmp_path / "d.csv", index=False)
+    params = dict(cfg, simulation=dict(cfg["simulation"], flipped=["paper"]))
+    out = exact_moments_step(params, {"gains": tmp_path / "g.csv", "designs": tmp_path / "d.csv"}, {})
+    table = out["table"].set_index(["design", "nonlinearity", "initial_state"])["sum_mse"]
+    assert set(out["table"]["design"]) == {"paper", "zero", "paper_flipped"}
+    assert set(out["performance"]["design"]) == {"paper", "zero"}
+    from netrepro.papers.gainsched.model import augmented_initial_moment
+    from netrepro.papers.gainsched.steps import p_sequence
+
+    want = exact_cost(sys, realisation(paper, -np.eye(sys.n)), p_sequence(params, sys), 0.5 * (sys.F1 + sys.F2),
+                      augmented_initial_moment(np.eye(sys.n), sys.n))
+    assert table[("paper_flipped", "mid", "gaussian")] == pytest.approx(want, rel=1e-12)
+
+
+def test_sensitivity_step_brackets_both_classes(cfg, sys):
+    """The plant rows: scalar multiplier (class (3)) below the worst-gain necessary end, below componentwise."""
+    from netrepro.papers.gainsched.feasibility import worst_sector_gain
+    from netrepro.papers.gainsched.steps import sensitivity_step
+
+    params = dict(cfg, sensitivity=dict(cfg["sensitivity"], sigma2_grid=[1.0, 4.5], sigma2_zoom=[], tol=0.05))
+    out = sensitivity_step(params, {}, {})
+    lim = out["limits"].set_index("design")
+    assert set(lim.index) == {"plant", "plant_componentwise", "scheduled", "fixed_gain", "zero", "printed_gains",
+                              "plant_necessary", "plant_componentwise_necessary"}
+    assert lim["certified"].all()
+    assert lim.loc["plant", "sigma2_lo"] <= lim.loc["plant_necessary", "sigma2_hi"]
+    assert lim.loc["plant_necessary", "sigma2_hi"] < lim.loc["plant_componentwise_necessary", "sigma2_lo"]
+    assert lim.loc["plant_componentwise", "sigma2_lo"] <= lim.loc["plant_componentwise_necessary", "sigma2_hi"]
+    assert lim.loc["plant_necessary", "sigma2_hi"] == pytest.approx(worst_sector_gain(sys)["value"], abs=2e-6)
+    assert set(lim["role"]) == {"sufficient", "necessary"}
+    grid = out["table"]
+    beyond = grid[grid["sigma2"] == 4.5]  # above every necessary end: decided without a solve
+    assert (beyond["verdict"] == "infeasible").all() and (beyond["status"] == "not solved").all()
+    assert set(grid.loc[grid["sigma2"] == 1.0, "verdict"]) == {"feasible"}
+
+
+def test_scheduling_step_nests_the_families(cfg, sys, paper, tmp_path):
+    import pandas as pd
+
+    from netrepro.papers.gainsched.model import zero_gains
+    from netrepro.papers.gainsched.steps import scheduling_step
+
+    pd.concat([gains_table("paper", paper), gains_table("performance", zero_gains(sys))]).to_csv(tmp_path / "g.csv",
+                                                                                               index=False)
+    out = scheduling_step(cfg, {"gains": tmp_path / "g.csv"}, {})["table"]
+    gc = out[out["comparison"] == "guaranteed_cost"].set_index("family")
+    assert set(gc["verdict"]) == {"feasible"}
+    # nested families: x_f = 0 within fixed gains within scheduled gains, so the guaranteed costs are ordered
+    assert gc.loc["scheduled", "value"] <= gc.loc["fixed_gain", "value"] * (1 + 1e-6) <= gc.loc["zero", "value"] * (
+        1 + 1e-6)
+    et = out[out["comparison"] == "exact_tuned"].set_index("family")["value"]
+    assert et["scheduled"] <= et["fixed_gain"]
+    assert set(out.loc[out["comparison"] == "schedule_size", "family"]) == {"performance"}

@@ -9,7 +9,9 @@ Modules:
   Theorem 1 (12), second moments, simulation of Algorithm 1;
 * :mod:`.design`: Theorem 3 vertex LMIs (24)-(25), gain recovery (26), performance variant;
 * :mod:`.moments`: exact second moments for linear f (issue 16);
-* :mod:`.feasibility`: certified feasible / infeasible / undecided decisions, plant LMI, brackets;
+* :mod:`.feasibility`: certified feasible / infeasible / undecided decisions, plant LMIs for the paper's
+  class (3) (scalar multiplier) and componentwise sectors (diagonal), worst linear gain in the sector, brackets;
+* :mod:`.verification`: independent checks behind the evidence (stability indices, residuals of the errata);
 * :mod:`.tuning`: gains of form (9) tuned by Monte Carlo or on the exact cost (yardsticks, not the paper's);
 * :mod:`.steps`: pipeline steps (designs, stability, simulation, sensitivity, timing, vertex LMIs);
 * :mod:`.evidence`: the evidence step (our side of ``claims.yaml``, ``errata.yaml``,
@@ -18,4 +20,4 @@ Modules:
 * :mod:`.checks`: configuration checks; ``figures.yaml``: the figure list.
 """
 
-__all__ = ["model", "moments", "design", "feasibility", "tuning", "steps", "evidence", "figures", "checks"]
+__all__ = ["model", "moments", "design", "feasibility", "verification", "tuning", "steps", "evidence", "figures", "checks"]

@@ -853,7 +853,8 @@ class FixedGainsVertexLMI:
 
         Infeasibility is certified by a checked dual certificate or by the necessary condition that
         (24) implies mean-square stability of (10): the frozen second-moment radius of (10) at the
-        sector vertices and p in {p1, p2}, and the plant's (:mod:`.feasibility`), must be < 1.
+        sector vertices and p in {p1, p2}, and the plant's for the worst linear gain of class (3)
+        (:func:`.feasibility.sector_class_radius`), must be < 1.
 
         Parameters
         ----------
@@ -864,7 +865,7 @@ class FixedGainsVertexLMI:
         tuple
             ``(Verdict, status, margin)``.
         """
-        from .feasibility import RADIUS_MARGIN, plant_vertex_radius, with_sigma2
+        from .feasibility import RADIUS_MARGIN, sector_class_radius, with_sigma2
         from .model import frozen_radius, sector_cases
 
         self.sigma2.value = float(sigma2)
@@ -877,7 +878,7 @@ class FixedGainsVertexLMI:
 
         def necessary():
             rho = max([frozen_radius(sys2, self.gains, p, F) for p in (sys2.p1, sys2.p2)
-                       for F in sector_cases(sys2).values()] + [plant_vertex_radius(sys2, sigma2)])
+                       for F in sector_cases(sys2).values()] + [sector_class_radius(sys2, sigma2)])
             return rho >= 1.0 + RADIUS_MARGIN, f"second-moment radius of (10) {rho:.12g} at sigma2 = {sigma2:.12g}"
 
         verdict = self.certifier.certify(status, necessary=necessary)

@@ -14,8 +14,9 @@ _COLORS = {"paper": "C3", "theorem3": "C0", "theorem3_S21I": "C9", "fixed_gain":
 
 
 def figure_errors(params, inputs, outputs):
-    """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper), and the Monte Carlo mean with a band
-    for the configured x0 and for x(0) ~ N(0, I); cut at ``k_max`` where the errors have decayed."""
+    """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper), the Monte Carlo mean with a band
+    for the configured x0, and the Monte Carlo RMS error sqrt(E e_i(k)^2) for x(0) ~ N(0, I) (whose mean
+    error is zero by symmetry); cut at ``k_max`` where the errors have decayed."""
     from ...plotting import new_figure, save_figure
 
     comp = int(params["component"])
@@ -31,15 +32,18 @@ def figure_errors(params, inputs, outputs):
     for d in show:
         pth = paths[paths["design"] == d]
         ax1.plot(pth["k"], pth[f"e{comp}"], marker=".", ms=3, lw=1, color=_COLORS.get(d), label=d)
-        for ax, start in ((ax2, "fixed_x0"), (ax3, "gaussian")):
-            er = errors[(errors["design"] == d) & (errors["initial_state"] == start)]
-            if er.empty:
-                continue
-            ax.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), label=f"{d} mean")
-            ax.fill_between(er["k"], er[f"e{comp}_lo"], er[f"e{comp}_hi"], color=_COLORS.get(d), alpha=0.15)
+        er = errors[(errors["design"] == d) & (errors["initial_state"] == "fixed_x0")]
+        if not er.empty:
+            ax2.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), label=f"{d} mean")
+            ax2.fill_between(er["k"], er[f"e{comp}_lo"], er[f"e{comp}_hi"], color=_COLORS.get(d), alpha=0.15)
+        # x(0) ~ N(0, I): the mean error is zero for every design by symmetry; the RMS error is what differs
+        er = errors[(errors["design"] == d) & (errors["initial_state"] == "gaussian")]
+        if not er.empty:
+            ax3.plot(er["k"], er[f"e{comp}_rms"], lw=1.5, color=_COLORS.get(d), label=d)
     ax1.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title="one sample path, configured $x_0$")
     ax2.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"configured $x_0$: mean, central {params['band']:.0%} band")
-    ax3.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"$x(0)\\sim N(0, I)$: mean, central {params['band']:.0%} band")
+    ax3.set(xlabel="k", ylabel=f"$\\sqrt{{E\\,e_{comp}(k)^2}}$",
+            title="$x(0)\\sim N(0, I)$: RMS error (the mean is 0 by symmetry)")
     ax1.legend(fontsize=8)
     ax3.legend(fontsize=8)
     save_figure(fig, outputs["figure"])
@@ -59,7 +63,8 @@ def figure_mse(params, inputs, outputs):
     kmax = int(params.get("k_max", sel["k"].max()))
     for d, er in sel.groupby("design", sort=False):
         er = er[er["k"] <= kmax]
-        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(d), label=d, lw=1.2)
+        base = d.removesuffix("_flipped")  # the same filter with H -> -H: its design's colour, dashed
+        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(base), ls="--" if base != d else "-", label=d, lw=1.2)
     ax1.set(xlabel="k", ylabel=r"$E\|e(k)\|^2$ (exact)",
             title=f"exact second moments, f = {f_show}, x(0) {'~ N(0, I)' if start == 'gaussian' else '= x0'}")
     ax1.legend(fontsize=7)
@@ -85,26 +90,43 @@ def figure_mse(params, inputs, outputs):
 
 
 def figure_sensitivity(params, inputs, outputs):
-    """Fig S2: certified feasibility against sigma^2 per design, with the certified brackets of the limits."""
+    """Fig S2: certified feasibility against sigma^2 per design, with the certified brackets of the limits.
+
+    Left: the solver margin per grid point (information only; points not solved because the
+    class's necessary condition fails are drawn at the clip level -0.1). Right: the certified
+    brackets, sufficient (LMI) and necessary (worst linear gain of the class) ends, for the
+    paper's class (3) and for componentwise sectors.
+    """
     from ...plotting import new_figure, save_figure
 
     sens = read_table(inputs["sensitivity"])
     limits = read_table(inputs["limits"]).set_index("design")
-    fig, (ax, ax2) = new_figure(1, 2, figsize=(11, 4.2), layout="constrained")
-    styles = {"scheduled": ("C0", "o"), "fixed_gain": ("C1", "s"), "zero": ("k", "^"), "plant": ("0.4", "D")}
+    fig, (ax, ax2) = new_figure(1, 2, figsize=(12, 4.4), layout="constrained")
+    styles = {"scheduled": ("C0", "o"), "fixed_gain": ("C1", "s"), "zero": ("k", "^"), "printed_gains": ("C3", "v"),
+              "plant": ("0.4", "D"), "plant_necessary": ("0.4", "P"), "plant_componentwise": ("C5", "D"),
+              "plant_componentwise_necessary": ("C5", "P")}
     fill = {"feasible": "full", "undecided": "none", "infeasible": "none"}
     for d, (col, mk) in styles.items():
-        g = sens[(sens["variant"] == d) & (sens["kind"] == "grid")]
+        g = sens[(sens["variant"] == d) & (sens["kind"] == "grid")].sort_values("sigma2")
         if g.empty:
             continue
-        ax.plot(g["sigma2"], g["margin"].clip(lower=-0.1), "-", color=col, lw=0.8, alpha=0.6)
-        for verdict, sub in g.groupby("verdict"):
-            ax.plot(sub["sigma2"], sub["margin"].clip(lower=-0.1), ls="none", marker="x" if verdict == "infeasible"
-                    else mk, fillstyle=fill.get(verdict, "none"), color=col, label=f"{d}: {verdict}")
+        margin = g["margin"].clip(lower=-0.1).fillna(-0.1)
+        ax.plot(g["sigma2"], margin, "-", color=col, lw=0.8, alpha=0.6)
+        for verdict, idx in g.groupby("verdict").groups.items():
+            ax.plot(g.loc[idx, "sigma2"], margin.loc[idx], ls="none", marker="x" if verdict == "infeasible" else mk,
+                    fillstyle=fill.get(verdict, "none"), color=col, label=f"{d}: {verdict}")
     ax.axhline(0, color="k", lw=0.6)
-    ax.axvline(params["sigma2"], color="C3", lw=1, label=r"reconstructed $\sigma^2$")
-    ax.set(xlabel=r"$\sigma^2$", ylabel="solver margin t (capped; information only)",
-           title="our verdict per point (filled feasible, open undecided, x infeasible)")
+    zoom = float(params.get("zoom_from", 0.0))
+    below = sens[(sens["kind"] == "grid") & (sens["sigma2"] < zoom)]
+    if zoom > 0 and not below.empty:  # the limit region; the points below are summarised in the title
+        ax.set_xlim(zoom, float(sens["sigma2"].max()) + 0.05)
+        n_ok = int((below["verdict"] == "feasible").sum())
+        where = f"$\\sigma^2$ < {zoom:g}: {n_ok} of {len(below)} grid points feasible (incl. the reconstructed {params['sigma2']:g})"
+    else:
+        ax.axvline(params["sigma2"], color="C3", lw=1, label=r"reconstructed $\sigma^2$")
+        where = "filled feasible, open undecided, x infeasible"
+    ax.set(xlabel=r"$\sigma^2$", ylabel="solver margin t (information only)",
+           title=f"verdict per grid point (filled feasible, x infeasible)\n{where}")
     ax.legend(fontsize=6, ncol=2)
     names = [d for d in styles if d in limits.index]
     y = np.arange(len(names))
@@ -114,9 +136,12 @@ def figure_sensitivity(params, inputs, outputs):
         ax2.plot([lo, hi], [yi, yi], "-", color=col, lw=4, alpha=0.4)
         ax2.plot([lo], [yi], "o", color=col)
         ax2.plot([hi], [yi], "x", color=col, ms=8)
-        ax2.annotate(f"[{lo:.5g}, {hi:.5g}]", (lo, yi), textcoords="offset points", xytext=(-70, 6), fontsize=7)
-    ax2.set_yticks(y, names)
+        ax2.annotate(f"[{lo:.6g}, {hi:.6g}]", (hi, yi), textcoords="offset points", xytext=(6, -3), fontsize=7)
+    ax2.set_yticks(y, [f"{d} ({limits.loc[d, 'role']})" if "role" in limits else d for d in names])
     ax2.invert_yaxis()
-    ax2.set(xlabel=r"$\sigma^2$", title=r"certified bracket of the largest $\sigma^2$")
+    ends = limits.loc[names, ["sigma2_lo", "sigma2_hi"]].to_numpy(dtype=float)
+    lo_all, hi_all = np.nanmin(ends), np.nanmax(ends)
+    ax2.set_xlim(lo_all - 0.1 * (hi_all - lo_all), hi_all + 0.6 * (hi_all - lo_all))
+    ax2.set(xlabel=r"$\sigma^2$", title=r"certified brackets of the largest $\sigma^2$ (o feasible end, x infeasible end)")
     save_figure(fig, outputs["figure"])
     return {}

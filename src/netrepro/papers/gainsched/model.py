@@ -44,6 +44,7 @@ __all__ = [
     "simulate_draws",
     "Theorem1Result",
     "zero_gains",
+    "realisation",
     "augmented_initial_moment",
     "plant_ms_radius",
     "lyapunov_difference_bounds",
@@ -843,6 +844,41 @@ def zero_gains(sys: System) -> Gains:
     """
     return Gains(np.zeros((sys.n, sys.n)), np.zeros((sys.n, sys.n)), np.zeros((sys.n, sys.m)),
                  np.zeros((sys.n, sys.m)))
+
+
+def realisation(gains: Gains, J) -> Gains:
+    """The filter (9) in the state coordinates x_f' = J x_f: G' = J G J^{-1}, H' = J H.
+
+    Algorithm 1 recovers the gains by (26) with any nonsingular S21, S22; two choices differ by
+    such a J (= S22^{-1} S21 relative to S21 = S22), with the same Lyapunov certificate of (24)
+    after the congruence diag(I, J^{-T}) of Q. Stability is unchanged, but the estimate
+    x_f' differs, so the estimation error e = x - x_f' does. J = -I (H -> -H, G unchanged) is
+    the opposite sign of the filter state.
+
+    Parameters
+    ----------
+    gains : Gains
+    J : array_like (n, n)
+        Nonsingular.
+
+    Returns
+    -------
+    Gains
+
+    Raises
+    ------
+    GainschedError
+        If J is not square of the filter's order or is singular.
+    """
+    J = np.asarray(J, dtype=float)
+    n = gains.G0.shape[0]
+    if J.shape != (n, n):
+        raise GainschedError(f"realisation: J must be {n}x{n}, got shape {J.shape}")
+    cond = np.linalg.cond(J)
+    if not np.isfinite(cond) or cond > 1e12:
+        raise GainschedError(f"realisation: J is singular (condition number {cond:.3g})")
+    Jinv = np.linalg.inv(J)
+    return Gains(J @ gains.G0 @ Jinv, J @ gains.Gf @ Jinv, J @ gains.H0, J @ gains.Hf)
 
 
 def augmented_initial_moment(cov, n: int):

@@ -41,6 +41,7 @@ from .model import (
     frozen_radius,
     gains_from_dict,
     p_schedule,
+    realisation,
     scheduled_growth_rate,
     sector_cases,
     simulate,
@@ -63,6 +64,7 @@ __all__ = [
     "simulation_step",
     "exact_moments_step",
     "sensitivity_step",
+    "scheduling_step",
     "timing_step",
     "vertex_lmi_step",
 ]
@@ -301,8 +303,10 @@ def simulation_step(params, inputs, outputs):
 
     Runs are vectorised, time is looped; the same random numbers (seed) for
     every design. ``errors``: mean over runs of e1, e2 with a 95% band (2.5 and
-    97.5 percentiles over runs) and mse(k) = E||e(k)||^2 for the fixed initial
-    state with its standard error ``mse_se``; ``error_summary``: sum_k mse(k) for the fixed x0
+    97.5 percentiles over runs), the per-component RMS error ``e1_rms``, ``e2_rms``
+    (sqrt of the mean of e_i(k)^2 over runs; for x(0) ~ N(0, I) the mean error is zero for every
+    design by symmetry, so the RMS is the informative quantity) and mse(k) = E||e(k)||^2 with
+    its standard error ``mse_se``; ``error_summary``: sum_k mse(k) for the fixed x0
     and for x0 ~ N(0, initial_cov), with the standard error of the per-run sum.
 
     This Monte Carlo is for the configured (nonlinear) f only; for linear f the exact
@@ -329,11 +333,13 @@ def simulation_step(params, inputs, outputs):
         lo, hi = np.percentile(e, q_lo, axis=0), np.percentile(e, q_hi, axis=0)
         sq = (e ** 2).sum(-1)
         mse = sq.mean(0)
+        rms = np.sqrt((e ** 2).mean(0))
         mse_se = sq.std(0, ddof=1) / np.sqrt(R)
         for k in ks:
             erows.append({"design": d, "initial_state": "fixed_x0", "k": int(k), "e1_mean": mean[k, 0],
                           "e2_mean": mean[k, 1], "e1_lo": lo[k, 0], "e1_hi": hi[k, 0], "e2_lo": lo[k, 1],
-                          "e2_hi": hi[k, 1], "mse": mse[k], "mse_se": mse_se[k]})
+                          "e2_hi": hi[k, 1], "mse": mse[k], "mse_se": mse_se[k], "e1_rms": rms[k, 0],
+                          "e2_rms": rms[k, 1]})
             prow.append({"design": d, "k": int(k), "p": float(p_seq[k]) if k < len(p_seq) else np.nan,
                          "e1": e[0, k, 0], "e2": e[0, k, 1]})
         srows.append({"design": d, "initial_state": "fixed_x0", "sum_mse": float(mse.sum()),
@@ -343,10 +349,12 @@ def simulation_step(params, inputs, outputs):
         gmean = er.mean(0)
         glo, ghi = np.percentile(er, q_lo, axis=0), np.percentile(er, q_hi, axis=0)
         gse = sr.std(0, ddof=1) / np.sqrt(R)
+        grms = np.sqrt((er ** 2).mean(0))
         for k in ks:
             erows.append({"design": d, "initial_state": "gaussian", "k": int(k), "e1_mean": gmean[k, 0],
                           "e2_mean": gmean[k, 1], "e1_lo": glo[k, 0], "e1_hi": ghi[k, 0], "e2_lo": glo[k, 1],
-                          "e2_hi": ghi[k, 1], "mse": sr.mean(0)[k], "mse_se": gse[k]})
+                          "e2_hi": ghi[k, 1], "mse": sr.mean(0)[k], "mse_se": gse[k], "e1_rms": grms[k, 0],
+                          "e2_rms": grms[k, 1]})
         srows.append({"design": d, "initial_state": "gaussian", "sum_mse": float(sr.mean(0).sum()),
                       "sum_mse_se": float(sr.sum(1).std(ddof=1) / np.sqrt(R))})
     return {"errors": pd.DataFrame(erows), "error_summary": pd.DataFrame(srows), "paths": pd.DataFrame(prow)}
@@ -358,7 +366,9 @@ def exact_moments_step(params, inputs, outputs):
     Initial states: ``gaussian`` (x(0) ~ N(0, I), x_f(0) = 0) and ``x0`` (the configured x0 and
     x_f(0) = xf0; the ``zero`` design keeps x_f = 0 throughout). ``exact_moments``: design,
     nonlinearity, initial_state, sum_mse (k = 0..K), final_mse (k = K); ``exact_mse``: the same
-    per k.
+    per k. The designs named in ``simulation.flipped`` are repeated as ``<design>_flipped``: the
+    same filter with the opposite sign of its state (H -> -H, :func:`.model.realisation` with
+    J = -I); ``performance`` (performance.csv) keeps the designs of the gains table.
     """
     sys = _sys(params)
     sim = params["simulation"]
@@ -371,8 +381,11 @@ def exact_moments_step(params, inputs, outputs):
     starts = {"gaussian": lambda d: initial_moment(np.zeros(n), np.eye(n), np.zeros(n)),
               "x0": lambda d: initial_moment(x0, np.zeros((n, n)), np.zeros(n) if d == "zero" else xf0)}
     keys, M1s, M0s, X0s = [], [], [], []
-    for d in designs:
-        gains = gains_from_table(table, d, sys)
+    # the opposite sign of the filter state (J = -I, an equally valid realisation of Algorithm 1)
+    flipped = {f"{d}_flipped": realisation(gains_from_table(table, d, sys), -np.eye(n))
+               for d in sim.get("flipped", []) if d in designs}
+    for d in designs + list(flipped):
+        gains = flipped[d] if d in flipped else gains_from_table(table, d, sys)
         for fname, F in linear_gains(sys).items():
             M1, M0, W = mode_matrices(sys, gains, p_seq, F)
             for sname, start in starts.items():
@@ -406,40 +419,56 @@ def exact_moments_step(params, inputs, outputs):
 
 
 def sensitivity_step(params, inputs, outputs):
-    """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter) and the plant.
+    """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter), the printed
+    gains' vertex LMIs, and the plant's own limit for the paper's class (3) and for componentwise sectors.
 
     Every decision comes from the shared engine (:mod:`netrepro.engines.certify`): ``feasible``
-    (its eigenvalue check of the returned point), ``infeasible`` (the plant's vertex
-    second-moment radius >= 1, a necessary condition of every criterion, or a checked dual
-    certificate) or ``undecided``; the solver status and margin are information.
-    ``table``: the sigma^2 grid per design. ``limits`` (feasibility_limit.csv): per design the
-    certified-feasible end ``sigma2_lo`` (= ``sigma2_max``) and certified-infeasible end
-    ``sigma2_hi`` of the engine's certified bisection, the undecided points between them, and
-    whether both ends are certified.
+    (its eigenvalue check of the returned point), ``infeasible`` (the plant's second-moment
+    radius >= 1 for a linear gain of the class, a necessary condition of every criterion, or a
+    checked dual certificate) or ``undecided``; the solver status and margin are information.
+    ``table``: the sigma^2 grid (``sigma2_grid`` and the finer ``sigma2_zoom`` near the limit)
+    per design; at and beyond the class's necessary end the verdict is the necessary condition's
+    and no LMI is solved (status ``not solved``, margin NaN). ``limits`` (feasibility_limit.csv): per criterion the certified-feasible end
+    ``sigma2_lo`` (= ``sigma2_max``) and certified-infeasible end ``sigma2_hi`` of the engine's
+    certified bisection, the undecided points between them, and whether both ends are
+    certified; ``sector_class`` (condition (3) or componentwise sectors) and ``role``
+    (``sufficient``: an LMI; ``necessary``: the sigma^2 at which the worst linear gain of the class
+    makes the plant's second-moment radius reach 1, :func:`.feasibility.worst_sector_gain`).
+    For class (3) the plant's limit lies between the ``plant`` row's feasible end and the
+    ``plant_necessary`` row's infeasible end.
     """
     from ...engines.certify import bisect_certified
 
-    from .design import Theorem3
-    from .feasibility import PlantLMI, necessary_limit
+    from .design import FixedGainsVertexLMI, Theorem3
+    from .feasibility import PlantLMI, necessary_condition, necessary_limit, worst_sector_gain
 
     base = _sys(params)
     lmi = params["lmi"]
     sens = params["sensitivity"]
-    grid = np.asarray(sens["sigma2_grid"], dtype=float)
+    grid = np.array(sorted({float(s) for s in sens["sigma2_grid"]} | {float(s) for s in sens.get("sigma2_zoom", [])}))
     lo0, hi0, tol = float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), float(sens["tol"])
-    _, nec_above = necessary_limit(base, lo0, hi0)
+    nec = {c: necessary_limit(base, lo0, hi0, sector=c) for c in ("condition3", "componentwise")}
     common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
                   margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
     problems = {"scheduled": Theorem3(base, scheduled=True, **common),
                 "fixed_gain": Theorem3(base, scheduled=False, **common),
                 "zero": Theorem3(base, zero_filter=True, **common)}
-    plant = PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]))
+    printed = FixedGainsVertexLMI(base, gains_from_dict(params["paper_gains"], base), eps=float(lmi["eps"]),
+                                  bound=float(lmi["bound"]), margin_cap=float(lmi["margin_cap"]))
+    plants = {"plant": PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]),
+                                multiplier="scalar"),
+              "plant_componentwise": PlantLMI(base, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]),
+                                              multiplier="diagonal")}
 
     def decider(name):
-        if name == "plant":
-            def decide(s2):
+        if name in plants:
+            def decide(s2, plant=plants[name]):
                 v = plant.certify(s2)
                 return v, (float(plant.t.value) if plant.t.value is not None else np.nan)
+        elif name == "printed_gains":
+            def decide(s2):
+                v, _, margin = printed.certify(s2)
+                return v, margin
         else:
             def decide(s2, prob=problems[name]):
                 v, sol = prob.certify(s2)
@@ -447,28 +476,128 @@ def sensitivity_step(params, inputs, outputs):
         return decide
 
     methods = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
-               "zero": "Theorem 3 with all gains 0 (x_f = 0)", "plant": "plant Lyapunov + S-procedure LMI"}
+               "zero": "Theorem 3 with all gains 0 (x_f = 0)",
+               "printed_gains": "vertex LMIs (24) with the printed gains, general slack S",
+               "plant": "plant Lyapunov + S-procedure LMI, scalar multiplier (lossless for one quadratic constraint)",
+               "plant_componentwise": "plant Lyapunov + S-procedure LMI, diagonal multiplier"}
+    classes = {"plant_componentwise": "componentwise sectors"}
     rows, limits = [], []
-    top = nec_above if np.isfinite(nec_above) else hi0
-    guess = None  # the previous design's threshold: a guess changes the number of solves, never the answer
-    for name in ("scheduled", "fixed_gain", "zero", "plant"):
+
+    def limit_row(name, lo, hi, certified, between, n_solves, infeasible_by, role="sufficient"):
+        return {"design": name, "sigma2_max": lo, "sigma2_lo": lo, "sigma2_hi": hi, "certified": bool(certified),
+                "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
+                "n_solves": n_solves, "method": methods[name], "infeasible_by": infeasible_by,
+                "sector_class": classes.get(name, "condition (3)"), "role": role}
+
+    # the plants first (small LMIs): the class-(3) plant's threshold is then the guess of the Theorem 3
+    # bisections (a guess changes the number of solves, never the answer)
+    guesses = {}
+    for name in ("plant", "plant_componentwise", "scheduled", "fixed_gain", "zero"):
         decide = decider(name)
+        sector = "componentwise" if name == "plant_componentwise" else "condition3"
+        top = nec[sector][1] if np.isfinite(nec[sector][1]) else hi0
         for s2 in grid:
+            if s2 >= nec[sector][1]:  # certified infeasible without a solve: the class's necessary condition fails
+                violated, text = necessary_condition(base, float(s2), sector)()
+                assert violated, text  # necessary_limit's bisection guarantees it (radius monotone in sigma^2)
+                rows.append({"variant": name, "sigma2": float(s2), "status": "not solved", "margin": np.nan,
+                             "certified_slack": np.nan, "verdict": "infeasible",
+                             "evidence": f"necessary condition violated: {text}", "kind": "grid"})
+                continue
             v, margin = decide(float(s2))
             rows.append({"variant": name, "sigma2": float(s2), "status": v.solver_status, "margin": margin,
                          "certified_slack": v.point.slack if v.point is not None else np.nan,
                          "verdict": v.verdict, "evidence": v.evidence, "kind": "grid"})
         b = bisect_certified(lambda s2, decide=decide: decide(s2)[0], lo0, top, tol=tol, feasible_above=False,
-                             guess=guess, width=2 * tol)
-        guess = b.feasible_end if b.certified else None
+                             guess=guesses.get(sector), width=2 * tol)
+        if b.certified:
+            guesses.setdefault(sector, b.feasible_end)
         ends = (b.feasible_end, b.infeasible_end)
         between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
-        limits.append({"design": name, "sigma2_max": b.feasible_end, "sigma2_lo": b.feasible_end,
-                       "sigma2_hi": b.infeasible_end, "certified": bool(b.certified),
-                       "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
-                       "n_solves": b.n_evals, "method": methods[name],
-                       "infeasible_by": b.verdicts[b.infeasible_end].evidence if b.certified else ""})
+        limits.append(limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
+                                b.verdicts[b.infeasible_end].evidence if b.certified else ""))
+    # the printed gains (grid in vertex_lmis.csv): certified feasible at the plant's feasible end, infeasible from
+    # the class-(3) necessary end on ((24) implies mean-square stability of the plant); feasibility of (24) is
+    # monotone in sigma^2 > 0 (sigma^2 enters through sigma^2 S^T D̄ N Λ^{-1} N^T D̄^T S >= 0 by a Schur complement)
+    s2_ok = guesses.get("condition3", np.nan)
+    v_ok = decider("printed_gains")(s2_ok)[0] if np.isfinite(s2_ok) else None
+    ok = v_ok is not None and v_ok.feasible and np.isfinite(nec["condition3"][1])
+    limits.append(limit_row("printed_gains", s2_ok if ok else np.nan, nec["condition3"][1], ok, [], 1,
+                            "necessary condition: the plant for the worst linear gain of class (3) (plant_necessary)"))
+    # the necessary ends: the worst linear gain of each class (closed-form limit, radius checked at both ends)
+    worst = worst_sector_gain(base)
+    for name, sector, text in (
+            ("plant_necessary", "condition3",
+             f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal ({'reflection' if worst['reflect'] else 'rotation'}"
+             f" by {worst['theta']:.6f} rad; K = [" + "; ".join(", ".join(f"{x:.5g}" for x in r) for r in worst["K"])
+             + "]), "
+             f"closed-form limit {worst['value']:.9g}"),
+            ("plant_componentwise_necessary", "componentwise", "diagonal sector vertices F = diag(F1_ii or F2_ii)")):
+        below, above = nec[sector]
+        ok = bool(np.isfinite(above))  # necessary_limit's bisection keeps radius >= 1 + RADIUS_MARGIN at `above`
+        limits.append({"design": name, "sigma2_max": np.nan, "sigma2_lo": below, "sigma2_hi": above,
+                       "certified": ok, "undecided_from": np.nan, "n_undecided": 0, "n_solves": 0,
+                       "method": text,
+                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
+                                        "gain of the class (not mean-square stable for that f)",
+                       "sector_class": "condition (3)" if sector == "condition3" else "componentwise sectors",
+                       "role": "necessary"})
     return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
+
+
+def scheduling_step(params, inputs, outputs):
+    """What gain scheduling buys over fixed gains (claim ``less_conservative``; issue 27).
+
+    Two comparisons that can tell the families apart (``scheduling.csv``, one row per family and
+    comparison):
+
+    * ``guaranteed_cost``: the certified cost gamma of the performance LMI (Theorem 3 plus the bound
+      sum_k E||e(k)||^2 <= gamma, full slack, :class:`.design.Theorem3` ``output_slack``) for the
+      scheduled family, fixed gains (Gf = Hf = 0) and the zero filter (x_f = 0): the conservatism of
+      the LMI design itself; the verdict is the engine's check of the point;
+    * ``exact_tuned``: the best gains found for the exact sum_k E||e(k)||^2 (f = (F1+F2)/2 z,
+      x(0) ~ N(0, I), the configured p(k)) in each family (:func:`.tuning.best_exact_gains`, BFGS
+      from the designs named in ``scheduling.starts``, or from x_f = 0 if none; the scheduled search
+      starts from the fixed optimum too, so it can only improve on it): what scheduling buys in the
+      error itself.
+
+    A row ``schedule_size`` gives max(|Gf|, |Hf|) of each LMI design of ``gains.csv`` (is it scheduled?).
+    """
+    from .design import Theorem3, certified_cost
+    from .tuning import best_exact_gains
+
+    sys = _sys(params)
+    lmi = params["lmi"]
+    X0 = augmented_initial_moment(params["performance"]["initial_cov"], sys.n)
+    common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
+                  margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
+    rows = []
+    for family, opts in (("scheduled", dict(scheduled=True)), ("fixed_gain", dict(scheduled=False)),
+                         ("zero", dict(zero_filter=True))):
+        prob = Theorem3(sys, X0=X0, performance=True, output_slack=True, **opts, **common)
+        sol = prob.solve()
+        verdict, slack = decide_point(prob, sol, sys)
+        cost = certified_cost(sol.values, X0, sys.p1, sys.p2) if verdict == "feasible" else np.nan
+        rows.append({"comparison": "guaranteed_cost", "family": family, "value": cost, "verdict": verdict,
+                     "certified_slack": slack, "status": sol.status, "start": "", "n_evaluations": np.nan})
+    table = read_table(inputs["gains"])
+    p_seq = p_sequence(params, sys)
+    mid = 0.5 * (sys.F1 + sys.F2)
+    Xg = augmented_initial_moment(np.eye(sys.n), sys.n)
+    named = [(d, gains_from_table(table, d, sys)) for d in params["scheduling"]["starts"]]
+    fixed, info_f = best_exact_gains(sys, p_seq, mid, Xg, False, named or [("zero", zero_gains(sys))])
+    sched, info_s = best_exact_gains(sys, p_seq, mid, Xg, True, [("best fixed", fixed)] + named)
+    for family, info in (("fixed_gain", info_f), ("scheduled", info_s)):
+        rows.append({"comparison": "exact_tuned", "family": family, "value": info["cost"], "verdict": "",
+                     "certified_slack": np.nan, "status": "local minimum (BFGS)", "start": info["start"],
+                     "n_evaluations": info["n_eval"]})
+    for d in dict.fromkeys(table["design"]):
+        if d in ("theorem3", "fixed_gain", "performance", "performance_tied"):
+            g = gains_from_table(table, d, sys)
+            rows.append({"comparison": "schedule_size", "family": d,
+                         "value": float(max(np.abs(g.Gf).max(), np.abs(g.Hf).max())), "verdict": "",
+                         "certified_slack": np.nan, "status": "", "start": "", "n_evaluations": np.nan})
+    return {"table": pd.DataFrame(rows)}
 
 
 def timing_step(params, inputs, outputs):

@@ -11,7 +11,7 @@ import numpy as np
 from .model import Gains, System, draw_noise, simulate_draws
 from .moments import error_mse, mode_matrices, second_moments
 
-__all__ = ["tune_gains", "tune_gains_exact", "sum_mse"]
+__all__ = ["tune_gains", "tune_gains_exact", "sum_mse", "exact_cost", "best_exact_gains"]
 
 
 def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, scheduled: bool, maxiter: int,
@@ -151,3 +151,117 @@ def tune_gains_exact(sys: System, p_seq, F, X0, scheduled: bool, maxiter: int, s
     c0 = cost(v0)
     best = res.x if res.fun <= c0 else v0
     return unpack(best), {"cost": float(min(res.fun, c0)), "n_eval": int(res.nfev), "start_cost": c0}
+
+
+def exact_cost(sys: System, gains: Gains, p_seq, F, X0) -> float:
+    """Exact sum_{k=0}^{K} E||e(k)||^2 of (10) for f = F z by the second-moment recursion of :mod:`.moments`.
+
+    The recursion X(k+1) = p M1 X M1^T + (1-p) M0 X M0^T + sigma^2 W X W^T for one system, on
+    vec(X) with the operators p M1 (x) M1 + (1-p) M0 (x) M0 + sigma^2 W (x) W built for all k at
+    once (the cost function of the tuning; :func:`.moments.second_moments` is the batched matrix
+    form, an independent computation of the same values).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p_seq : array_like (K,)
+    F : ndarray (nz, nz)
+    X0 : ndarray (2n, 2n)
+        E z̄(0) z̄(0)^T.
+
+    Returns
+    -------
+    float
+    """
+    M1, M0, W = mode_matrices(sys, gains, p_seq, F)
+    p = np.asarray(p_seq, dtype=float)
+    K, d = M1.shape[0], M1.shape[1]
+
+    def kron(A):  # (A X A^T) in row-major vec(X): kron(A, A), for a stack of A
+        return np.einsum("...ij,...lm->...iljm", A, A).reshape(A.shape[:-2] + (d * d, d * d))
+
+    ops = p[:, None, None] * kron(M1) + (1.0 - p)[:, None, None] * kron(M0) + float(sys.sigma2) * kron(W)[None]
+    n = sys.n
+    c = np.zeros((d, d))  # tr(X_xx) + tr(X_ff) - tr(X_xf) - tr(X_fx) = E||x - x_f||^2 for symmetric X
+    c[np.arange(d), np.arange(d)] = 1.0
+    c[np.arange(n), n + np.arange(n)] = -1.0
+    c[n + np.arange(n), np.arange(n)] = -1.0
+    c = c.ravel()
+    x = np.asarray(X0, dtype=float).ravel()
+    total = float(c @ x)
+    for k in range(K):  # one system: 16 x 16 matrix-vector products, the operators built at once
+        x = ops[k] @ x
+        total += float(c @ x)
+    return total
+
+
+def _pack(gains: Gains, scheduled: bool) -> np.ndarray:
+    parts = [gains.G0.ravel(), gains.H0.ravel()] + ([gains.Gf.ravel(), gains.Hf.ravel()] if scheduled else [])
+    return np.concatenate(parts)
+
+
+def _unpack(v, n: int, m: int, scheduled: bool) -> Gains:
+    G0 = v[: n * n].reshape(n, n)
+    H0 = v[n * n: n * n + n * m].reshape(n, m)
+    if scheduled:
+        off = n * n + n * m
+        return Gains(G0, v[off: off + n * n].reshape(n, n), H0, v[off + n * n:].reshape(n, m))
+    return Gains(G0, np.zeros((n, n)), H0, np.zeros((n, m)))
+
+
+def best_exact_gains(sys: System, p_seq, F, X0, scheduled: bool, starts, gtol: float = 1e-9):
+    """The best gains of form (9) found for the exact sum_k E||e(k)||^2, BFGS from several starts.
+
+    The exact cost (:func:`exact_cost`) is a smooth function of the gains, so a quasi-Newton
+    method converges to a local minimum from each start; the best over the starts is returned
+    (a local search: an upper bound on the family's optimum, not the optimum itself). With
+    ``scheduled`` False, Gf = Hf = 0 (fixed gains; a start's Gf, Hf are ignored).
+
+    Parameters
+    ----------
+    sys : System
+    p_seq : array_like (K,)
+    F : ndarray (nz, nz)
+        Linear gain of f.
+    X0 : ndarray (2n, 2n)
+    scheduled : bool
+    starts : sequence of (str, Gains)
+        Named starting gains.
+    gtol : float
+        BFGS gradient tolerance.
+
+    Returns
+    -------
+    tuple
+        ``(gains, {"cost", "start", "n_eval", "costs"})``: the best gains, their cost, the name of
+        the start that reached them, the total number of cost evaluations and the cost per start.
+
+    Raises
+    ------
+    GainschedError
+        Without starts.
+    """
+    from scipy.optimize import minimize
+
+    from .model import GainschedError
+
+    if not starts:
+        raise GainschedError("best_exact_gains needs at least one start")
+    n, m = sys.n, sys.m
+
+    def cost(v):
+        return exact_cost(sys, _unpack(v, n, m, scheduled), p_seq, F, X0)
+
+    best, n_eval, costs = None, 0, {}
+    for name, start in starts:
+        v0 = _pack(start, scheduled)
+        res = minimize(cost, v0, method="BFGS", options={"gtol": float(gtol)})
+        n_eval += int(res.nfev)
+        c0 = cost(v0)
+        x, c = (res.x, float(res.fun)) if res.fun <= c0 else (v0, c0)
+        costs[name] = c
+        if best is None or c < best[1]:
+            best = (x, c, name)
+    x, c, name = best
+    return _unpack(x, n, m, scheduled), {"cost": c, "start": name, "n_eval": n_eval, "costs": costs}

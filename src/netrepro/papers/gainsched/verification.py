@@ -1,0 +1,241 @@
+"""Independent checks of the paper's statements: the mathematics behind the evidence of `gainsched`.
+
+Moved out of :mod:`.evidence` (issue 29: the evidence step only assembles). Each function is an
+independent computation of something the paper states or implies:
+
+* :func:`ms_stability_index`, :func:`convergence_rate`: exponential mean-square stability of the
+  error dynamics (10) (Definition 1) with given gains, from second-moment operators;
+* :func:`r2_congruence_residuals`: the relation of R2 to S21, S22 in Theorem 3 / (23);
+* :func:`missing_fraction`: the fraction of missing measurements under (6)-(7);
+* :func:`eq15_residuals`: E ΔV of (14) against the two sign readings of (15);
+* :func:`gap_relative`, :func:`relative_spread`, :func:`rms_ratio`: the relative quantities the findings
+  and claims are judged on.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import (
+    GainschedError,
+    Gains,
+    System,
+    frozen_radius,
+    lyapunov_difference_bounds,
+    scheduled_growth_rate,
+    sector_cases,
+    sector_nonlinearity,
+)
+from .moments import linear_gains
+
+__all__ = [
+    "ms_stability_index",
+    "convergence_rate",
+    "r2_congruence_residuals",
+    "missing_fraction",
+    "eq15_residuals",
+    "gap_relative",
+    "relative_spread",
+    "rms_ratio",
+]
+
+
+def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
+    """Largest frozen second-moment radius of (10) and growth rate along ``p_seq`` (the MS stability index).
+
+    Frozen radii at p in ``ps`` with f = F z at the diagonal sector vertices; growth along the
+    scheduled ``p_seq``. (10) is exponentially mean-square stable for these linear f iff this is
+    below 1 (Definition 1).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    ps : array_like
+        Frozen probabilities.
+    p_seq : array_like
+        The scheduled p(k) of Section IV.
+
+    Returns
+    -------
+    float
+    """
+    cases = sector_cases(sys).values()
+    rho = max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases)
+    growth = max(scheduled_growth_rate(sys, gains, p_seq, F) for F in cases)
+    return float(max(rho, growth))
+
+
+def convergence_rate(sys: System, gains: Gains, p_seq) -> float:
+    """Worst per-step growth rate of E z̄ z̄^T of (10) along ``p_seq`` over f = F z, F in {F1, F2, (F1+F2)/2}.
+
+    Below 1 iff E||e(k)||^2 -> 0 for every initial second moment (the errors of Figs 1-2 converge).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    p_seq : array_like
+
+    Returns
+    -------
+    float
+    """
+    return float(max(scheduled_growth_rate(sys, gains, p_seq, F) for F in linear_gains(sys).values()))
+
+
+def r2_congruence_residuals(values: dict) -> dict:
+    """||T^T S T - [[S11, R1], [R2, R2]]||_F with S21 = I and S22 from each reading of R2 (Theorem 3, (23)).
+
+    ``corrected``: R2 = S21^T S22^{-T} S21, so S22 = R2^{-T}; ``printed``: R2 = S21^T S22^{-1} S21,
+    S22 = R2^{-1}. S12 = R1 S22 (R1 = S12 S22^{-1} S21), T = diag(I, S22^{-1} S21).
+
+    Parameters
+    ----------
+    values : dict
+        A Theorem 3 solution (S11, R1, R2).
+
+    Returns
+    -------
+    dict
+        ``{"printed": float, "corrected": float}``.
+    """
+    n = values["R2"].shape[0]
+    S21 = np.eye(n)
+    out = {}
+    for reading, S22 in (("corrected", np.linalg.inv(values["R2"]).T), ("printed", np.linalg.inv(values["R2"]))):
+        S = np.block([[values["S11"], values["R1"] @ S22], [S21, S22]])
+        T = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), np.linalg.solve(S22, S21)]])
+        target = np.block([[values["S11"], values["R1"]], [values["R2"], values["R2"]]])
+        out[reading] = float(np.linalg.norm(T.T @ S @ T - target))
+    return out
+
+
+def missing_fraction(p_seq, n_runs: int, seed: int) -> tuple:
+    """Fraction of missing measurements (xi(k) = 0) of (6)-(7) in ``n_runs`` simulated runs, and its standard error.
+
+    Parameters
+    ----------
+    p_seq : array_like
+        Prob{xi(k) = 1} (7).
+    n_runs : int
+    seed : int
+
+    Returns
+    -------
+    tuple of float
+        ``(fraction, standard error)``.
+    """
+    p_seq = np.asarray(p_seq, dtype=float)
+    xi = np.random.default_rng(seed).random((n_runs, p_seq.size)) < p_seq
+    frac = 1.0 - xi.mean()
+    se = float(np.sqrt(np.mean(p_seq * (1 - p_seq)) / xi.size))
+    return float(frac), se
+
+
+def eq15_residuals(sys: System, gains: Gains, Q0, Qp, rng: np.random.Generator, n_states: int = 4000,
+                   scale: float = 3.0) -> tuple:
+    """max of E ΔV (14) minus each reading of the right side of (15), over random states and nonlinearities.
+
+    Over ``n_states`` random z̄, the nonlinearities sine_mid, lower and upper (as f(scale z)/scale,
+    which stays in the sector and is far from linear) and the (p, p+) pairs (p1, p2), (p2, p1),
+    (p1, p1). (15) bounds E ΔV from above, so a correct reading gives a value <= 0 (to rounding).
+
+    Parameters
+    ----------
+    sys : System
+    gains : Gains
+    Q0, Qp : ndarray (2n, 2n)
+        The Lyapunov matrix Q(p) = Q0 + p Qp of (27).
+    rng : numpy.random.Generator
+    n_states : int
+    scale : float
+
+    Returns
+    -------
+    tuple of float
+        ``(printed, corrected)``: the largest excess with '+' (printed) and '-' (corrected) in (15).
+
+    Raises
+    ------
+    GainschedError
+        If ``n_states < 1``.
+    """
+    if n_states < 1:
+        raise GainschedError(f"eq15_residuals: n_states must be >= 1, got {n_states}")
+    zbar = rng.standard_normal((int(n_states), 2 * sys.n))
+    worst_c, worst_p = -np.inf, -np.inf
+    for kind in ("sine_mid", "lower", "upper"):
+        f = sector_nonlinearity(zbar @ (sys.Z @ sys.N).T * scale, sys.F1, sys.F2, kind) / scale
+        for p, pn in ((sys.p1, sys.p2), (sys.p2, sys.p1), (sys.p1, sys.p1)):
+            dv, corr, prin = lyapunov_difference_bounds(sys, gains, Q0, Qp, p, pn, zbar, f)
+            worst_c = max(worst_c, float(np.max(dv - corr)))
+            worst_p = max(worst_p, float(np.max(dv - prin)))
+    return worst_p, worst_c
+
+
+def gap_relative(lower: float, upper: float) -> float:
+    """(upper - lower) / upper: how far below ``upper`` the end ``lower`` lies, as a fraction of ``upper``.
+
+    Parameters
+    ----------
+    lower, upper : float
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    GainschedError
+        If ``upper`` is not positive and finite.
+    """
+    if not (np.isfinite(upper) and upper > 0):
+        raise GainschedError(f"gap_relative: upper must be positive and finite, got {upper}")
+    return float((upper - lower) / upper)
+
+
+def relative_spread(values) -> float:
+    """max / min - 1 of positive values: how much the largest exceeds the smallest, as a fraction.
+
+    Parameters
+    ----------
+    values : array_like
+        Positive numbers (e.g. one design's exact sum_k E||e(k)||^2 under several realisations).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    GainschedError
+        If ``values`` is empty or not all positive and finite.
+    """
+    v = np.asarray(values, dtype=float)
+    if v.size == 0 or not np.all(np.isfinite(v) & (v > 0)):
+        raise GainschedError(f"relative_spread needs positive finite values, got {v.tolist()}")
+    return float(v.max() / v.min() - 1.0)
+
+
+def rms_ratio(mse) -> float:
+    """sqrt(E||e(K)||^2 / E||e(0)||^2): the factor by which the RMS error has shrunk from k = 0 to the last k.
+
+    Parameters
+    ----------
+    mse : array_like (K+1,)
+        E||e(k)||^2 in order of k.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    GainschedError
+        If ``mse`` is empty or E||e(0)||^2 is not positive.
+    """
+    m = np.asarray(mse, dtype=float)
+    if m.size == 0 or not m[0] > 0:
+        raise GainschedError(f"rms_ratio needs E||e(0)||^2 > 0, got {m[:1].tolist()}")
+    return float(np.sqrt(m[-1] / m[0]))
