@@ -39,7 +39,7 @@ def test_paper_data_loads_and_covers_section5():
     assert ids["remark2_missing_bound"].erratum_id == "E6_remark2_example"
     assert {"paper_gains_vertex_lmi", "vertex_combination", "less_conservative"} <= set(ids)
     assert "gamma3_rows" in {r["key"] for r in data.reconstructions}
-    assert {"D1_trivial_filter_passes", "D4_noise_free_case"} <= {f["id"] for f in data.findings}
+    assert {"D1_trivial_filter_passes", "D4_noise_free_case"} <= {f.finding_id for f in data.findings}
     assert ids["remark2_missing_bound"].at == {"bound": 0.5}  # the paper's setting reaches the evidence from here
     assert len(ids["vertex_combination"].at["pairs"]) == 3
     assert not any(e["id"].startswith(("D", "E4")) for e in data.errata)
@@ -154,13 +154,13 @@ def test_every_finding_is_judged_like_a_claim():
     data = load_paper_data("gainsched")
     keys = {r["key"] for r in data.reconstructions}
     for f in data.findings:
-        assert f.get("kind") in ("boolean", "numeric"), f["id"]
-        assert f["rule"]["reason"].strip(), f["id"]
-        assert f["quantity"] in f["evidence_quantities"], f["id"]
-        assert set(f["depends_on"]) <= keys, f["id"]
-        assert f["prior_work"].strip(), f["id"]
-        if f["kind"] == "numeric":
-            assert f["rule"]["value"] > 0, f["id"]
+        assert f.kind in ("boolean", "numeric"), f.finding_id
+        assert f.rule_reason.strip(), f.finding_id
+        assert f.quantity in f.evidence_quantities, f.finding_id
+        assert set(f.depends_on) <= keys, f.finding_id
+        assert f.prior_work.strip(), f.finding_id
+        if f.kind == "numeric":
+            assert f.tolerance > 0, f.finding_id
 
 
 def test_claim_variants_are_declared_ranges():
@@ -174,7 +174,7 @@ def test_claim_variants_are_declared_ranges():
     ev = pd.read_csv(path, keep_default_na=False)
     data = load_paper_data("gainsched")
     deps = {c.ours.get("quantity"): set(c.depends_on) for c in data.claims if c.ours.get("quantity")}
-    deps.update({f["quantity"]: set(f.get("depends_on", ())) for f in data.findings})
+    deps.update({f.quantity: set(f.depends_on) for f in data.findings})
     for row in ev[ev["variant"] != "nominal"].itertuples():
         if row.quantity not in deps:
             continue

@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from ...io import read_table
-from ...verdicts import erratum_evidence, evidence_frame, load_paper_data
+from ...paperdata import load_paper_data
+from ...verdicts import erratum_evidence, evidence_frame
 from .feasibility import plant_vertex_radius, with_sigma2
 from .model import gains_from_dict, p_schedule, system_from_config
 from .steps import MATRICES, gains_from_table, load_solutions, p_sequence
@@ -73,7 +74,7 @@ def _settings_at(claims_path) -> dict:
 
     data = load_paper_data("gainsched", Path(claims_path).parent)
     out = {c.claim_id: c.at for c in data.claims}
-    out.update({f["id"]: dict(f.get("at") or {}) for f in data.findings})
+    out.update({f.finding_id: dict(f.at) for f in data.findings})
     return out
 
 

@@ -576,7 +576,7 @@ def scheduling_step(params, inputs, outputs):
                          ("zero", dict(zero_filter=True))):
         prob = Theorem3(sys, X0=X0, performance=True, output_slack=True, **opts, **common)
         sol = prob.solve()
-        verdict, slack = decide_point(prob, sol, sys)
+        verdict, slack = _decide_point(prob, sol, sys)
         cost = certified_cost(sol.values, X0, sys.p1, sys.p2) if verdict == "feasible" else np.nan
         rows.append({"comparison": "guaranteed_cost", "family": family, "value": cost, "verdict": verdict,
                      "certified_slack": slack, "status": sol.status, "start": "", "n_evaluations": np.nan})
