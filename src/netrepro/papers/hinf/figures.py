@@ -164,7 +164,8 @@ def figure_fig2(params, inputs, outputs):
     for filt, color in (("local", "C0"), ("decentralized", "C3")):
         s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
         axes[0].plot(s["k"], s["error"], color=color, lw=1, label=filt)
-    axes[0].set_title(f"one run (run {int(single['run'].iloc[0])}), agent {int(single['agent'].iloc[0])} (end of the path)")
+    axes[0].set_title(f"one run (run {int(single['run'].iloc[0])}), agent {int(single['agent'].iloc[0])} (end of the "
+                      f"path: the agent where the choice matters most)", fontsize=9)
     sub = series[series["scenario"] == scen]
     for (agent, filt), g in sub.groupby(["agent", "filter"]):
         color = "C0" if filt == "local" else "C3"
@@ -177,15 +178,20 @@ def figure_fig2(params, inputs, outputs):
         ax.set_ylabel("estimation error |x_hat - x|")
         ax.legend(fontsize=7)
     hs = sorted(per["horizon"].unique())
+    n_agents = int(per["agent"].max()) + 1
     for j, (variant, marker) in enumerate(((scen, "o"), (scen + "_ki0", "s"))):
         for i, h in enumerate(hs):
             g = per[(per["scenario"] == variant) & (per["horizon"] == h)].sort_values("agent")
             if len(g):
                 ki = g["K_i"].iloc[0]
-                axes[2].plot(g["agent"], g["ratio"], marker=marker, ls="-" if j == 0 else ":", color=f"C{i}",
-                             label=f"H = {h}, K_i = {ki:g}")
+                # agent -1 (the mean over agents) is drawn at x = n_agents; error bars: +- 2 paired SE / local error
+                x = np.where(g["agent"] < 0, n_agents + 0.3 * (j - 0.5), g["agent"] + 0.15 * (i - 1))
+                axes[2].errorbar(x, g["ratio"], yerr=2 * g["se"] / g["local"], marker=marker, ls="none", capsize=2,
+                                 color=f"C{i}", mfc="none" if j else None, label=f"H = {h}, K_i = {ki:g}")
     axes[2].axhline(1.0, color="k", lw=0.8)
-    axes[2].set_xlabel("agent (0 and 9: ends of the path)")
+    axes[2].set_xticks(list(range(n_agents)) + [n_agents])
+    axes[2].set_xticklabels([str(a) for a in range(n_agents)] + ["mean"])
+    axes[2].set_xlabel("agent (0 and 9: ends of the path); mean over agents (the paper's reading)")
     axes[2].set_ylabel("decentralized / local error (window late_start..H)")
     axes[2].set_title("below 1: decentralized better")
     axes[2].legend(fontsize=7, ncol=2)
@@ -217,7 +223,8 @@ def figure_network(params, inputs, outputs):
             ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=7,
                     label="target" if is_t else f"agent {who}")
             gm = g[g["k"].isin(marks)]
-            ax.plot(gm["x"], gm["y"], "+" if is_t else ".", color=color, ms=8)
+            ax.plot(gm["x"], gm["y"], "+" if is_t else ".", color=color, ms=8,
+                    label=("target / agents at the time marks" if is_t else None))
             if is_t:
                 for k, x, y in zip(gm["k"], gm["x"], gm["y"]):
                     ax.annotate(f"k={k}", (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
@@ -227,12 +234,14 @@ def figure_network(params, inputs, outputs):
             ax.plot([x1, x2], [y1, y2], "-", color="0.5", lw=0.8, alpha=0.8)
         c = conn[(conn["scenario"] == scen) & (conn["run"] == run)]
         frac = float(c["connected_fraction"].iloc[0]) if len(c) else float("nan")
-        ax.set_title(f"run {run}: connected {frac:.0%} of steps", fontsize=9)
+        nchg = int(c["topology_changes"].iloc[0]) if len(c) and "topology_changes" in c else -1
+        ax.set_title(f"run {run}: connected {frac:.0%} of steps, {nchg} topology changes", fontsize=9)
         ax.set_aspect("equal")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
     axes[0][0].legend(fontsize=7)
-    fig.suptitle(params["title"] + " (open: start, filled: end; grey: links at the time marks)")
+    fig.suptitle(params["title"] + " (open: start, large filled: end; small dots (+ for the target): positions at the "
+                 "time marks; grey: links at the time marks)", fontsize=9)
     save_figure(fig, outputs["figure"])
     return {}
 

@@ -27,7 +27,8 @@ from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
 
 __all__ = ["FILTER_KINDS", "SCENARIOS", "KINDS", "layout_positions", "resolve_scenario", "simulate",
-           "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired", "bonferroni_z", "tag_z"]
+           "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired", "bonferroni_z", "tag_z",
+           "settle_step", "advantage"]
 
 KINDS = ("local", "decentralized", "centralized")
 
@@ -503,3 +504,41 @@ def tag_z(z: float, z_crit: float) -> str:
     if not np.isfinite(z):
         return "not significant"
     return "holds" if z < -z_crit else ("reversed" if z > z_crit else "not significant")
+
+
+def settle_step(error_mean, threshold: float) -> int:
+    """First step after which the series stays below ``threshold`` (``-1``: never).
+
+    Parameters
+    ----------
+    error_mean : array_like
+        A (Monte Carlo mean) error series over ``k = 0..K``.
+    threshold : float
+
+    Returns
+    -------
+    int
+        The smallest ``k`` with ``error_mean[j] < threshold`` for every ``j >= k``; 0 if the whole series
+        is below, -1 if the last value is not.
+    """
+    e = np.asarray(error_mean, dtype=float)
+    above = np.flatnonzero(e >= threshold)
+    if len(above) == 0:
+        return 0
+    k = int(above[-1]) + 1
+    return k if k < len(e) else -1
+
+
+def advantage(local, decentralized):
+    """The decentralized filter's advantage: local / decentralized late error (> 1: decentralized better).
+
+    Parameters
+    ----------
+    local, decentralized : array_like
+        Late-window errors of the two filters.
+
+    Returns
+    -------
+    ndarray
+    """
+    return np.asarray(local, dtype=float) / np.asarray(decentralized, dtype=float)

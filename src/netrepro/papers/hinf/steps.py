@@ -49,8 +49,10 @@ Tables (all under ``results/hinf/``)
     frac_a_better, error_a, error_b`` — every filter on the same target, agents and measurements;
     ``mean_diff`` = error of a minus error of b over ``late_start <= k <= horizon`` (paired per run).
 ``per_agent.csv`` (issue 17)
-    ``scenario, agent, horizon, local, decentralized, ratio, z, K_i`` — Fig 2-3 per agent and horizon
-    (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``; ``ratio`` = decentralized / local.
+    ``scenario, agent, horizon, local, decentralized, ratio, z, se, K_i, gamma_c, K_p, tag`` — Fig 2-3 per agent and
+    horizon (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``, ``<scenario>_gamma_c<v>`` /
+    ``<scenario>_K_p<v>`` with that consensus gain (mean over agents only); ``agent = -1`` is the mean over the
+    agents; ``ratio`` = decentralized / local; ``se`` the paired standard error of decentralized minus local; ``tag`` holds / not significant / reversed at ``|z| > claims.z_significant``.
 ``per_agent_errors.csv``
     ``scenario, agent, filter, k, error_mean`` — Monte Carlo mean error of the end and an interior agent.
 ``consensus_modes.csv``
@@ -72,9 +74,14 @@ Tables (all under ``results/hinf/``)
     ``target, run, connected_fraction, local, decentralized`` — the Fig-6 setting (``paired.scenario``) against each
     target model, ``paired.network_runs`` runs, seed ``paired.seed``: per run, the fraction of steps of the late window
     with a connected graph (25) and the late-window mean errors of the local and decentralized H-infinity filters.
+``loop_variants.csv``, ``loop_variants_runs.csv`` (issue 28)
+    closed-loop consensus variants of the evasive comparison, see :func:`loop_variants_merge_step`.
+``kalman_best.csv`` (issue 28)
+    H-infinity against Kalman filters at their best, see :func:`kalman_best_merge_step`.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
-    connected_fraction, min_lambda2`` per trajectory run.
+    connected_fraction, min_lambda2, topology_changes`` per trajectory run (steps at which a link appears or
+    disappears).
 """
 
 from __future__ import annotations
@@ -86,7 +93,7 @@ import pandas as pd
 
 from .algebra import rotation
 from .consensus import (adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius,
-                        pi_consensus_time_constants, run_pi_consensus)
+                        pi_consensus_time_constants, run_pi_consensus, topology_changed)
 from .evader import evader_decisions
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
 from .model import (FILTER_KINDS, KINDS, FilterDoesNotExist, bonferroni_z, layout_positions, paired_z, resolve_scenario,
@@ -430,24 +437,35 @@ def fig2_horizon_step(params, inputs, outputs):
     from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, fh = params, params["fig2_horizon"]
     start = int(cfg["claims"]["late_start"])
+    z_sig = float(cfg["claims"]["z_significant"])
     K = max(int(h) for h in fh["horizons"])
     rows, series, modes = [], [], []
     interior = int(fh["interior_agent"])
+    # issue 28: the consensus gains gamma_c and K_p over their declared ranges (sensitivity), mean over agents only
+    gain_variants = [(f"_{key}{float(v):g}", {"consensus": {key: float(v)}}, False)
+                     for key in ("gamma_c", "K_p") for v in cfg["sensitivity"][key]
+                     if float(v) != float(cfg["consensus"][key])]
     for scen in fh["scenarios"]:
-        for suffix, over in (("", {}), ("_ki0", {"consensus": {"K_i": 0.0}})):
+        for suffix, over, per_agent in [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants:
             sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]), **over)
             sc["filters"] = ["local", "decentralized"]
             out = simulate(sc)
             e_loc, e_dec = out["errors"]["local"], out["errors"]["decentralized"]
+            c = sc["consensus"]
             for H in fh["horizons"]:
                 H = int(H)
-                for agent in range(e_loc.shape[1]):
-                    a = e_dec[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
-                    b = e_loc[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
-                    _, _, z = paired_z(a, b)
+                agents = list(range(e_loc.shape[1])) if per_agent else []
+                for agent in agents + [-1]:  # -1: the mean over the agents (the paper's reading)
+                    sl = slice(None) if agent < 0 else slice(agent, agent + 1)
+                    a = e_dec[:, sl, start:H + 1].mean(axis=(1, 2))
+                    b = e_loc[:, sl, start:H + 1].mean(axis=(1, 2))
+                    _, se, z = paired_z(a, b)
                     rows.append({"scenario": scen + suffix, "agent": agent, "horizon": H, "local": b.mean(),
-                                 "decentralized": a.mean(), "ratio": a.mean() / b.mean(), "z": z,
-                                 "K_i": sc["consensus"]["K_i"]})
+                                 "decentralized": a.mean(), "ratio": a.mean() / b.mean(), "z": z, "se": se,
+                                 "K_i": c["K_i"], "gamma_c": c["gamma_c"], "K_p": c["K_p"],
+                                 "tag": tag_z(z, z_sig)})
+            if not per_agent:
+                continue
             for agent in sorted({0, min(interior, e_loc.shape[1] - 1)}):
                 for fname, e in (("local", e_loc), ("decentralized", e_dec)):
                     series.append(pd.DataFrame({"scenario": scen + suffix, "agent": agent, "filter": fname,
@@ -544,7 +562,8 @@ def network_step(params, inputs, outputs):
         adj = adjacency(pos, radius)
         lam2 = np.linalg.eigvalsh(laplacian(adj))[:, 1]
         conn.append({"scenario": scen, "run": int(run), "steps": K + 1, "connected_fraction": float(np.mean(lam2 > 1e-9)),
-                     "min_lambda2": float(lam2.min())})
+                     "min_lambda2": float(lam2.min()),
+                     "topology_changes": int(topology_changed(adj[:-1], adj[1:]).sum())})
         for k in [m for m in marks if m <= K]:
             for i, j in zip(*np.nonzero(np.triu(adj[k]))):
                 links.append({"scenario": scen, "run": int(run), "k": k, "i": ids[i], "j": ids[j]})
@@ -601,12 +620,19 @@ def evasive_network_step(params, inputs, outputs):
 # --------------------------------------------------------------------------- issue 28: causes and baselines at their best
 def _loop_tasks(lv) -> list[tuple[str, str]]:
     """(target, loop) tasks of the closed-loop consensus variants, in a fixed order (shards split this list)."""
-    return [(t, loop) for t in lv["targets"] for loop in list(lv["designs"]) + ["local_loop"]]
+    tasks = [(t, loop) for t in lv["targets"] for loop in list(lv["designs"]) + ["local_loop"]]
+    # untested reconstructions varied (evasive target, configured PI consensus): loop "pi|<key>=<label>"
+    return tasks + [("evasive", f"pi|{r['key']}={r['label']}") for r in lv.get("reconstructions", [])]
 
 
 def _loop_scenario(cfg, lv, target, loop):
     """The closed loop of one task: agents moved by the filter judged (``local_loop``: by the local filters)."""
     over = {}
+    if "|" in loop:  # a reconstruction's other value: the configuration with that key replaced
+        rec = next(r for r in lv["reconstructions"] if loop == f"pi|{r['key']}={r['label']}")
+        section, name = rec["key"].split(".")
+        cfg = {**cfg, section: {**cfg[section], name: rec["value"]}}
+        loop = "pi"
     if loop == "p_only":
         over = {"consensus": {"K_i": 0.0, "design": "pi"}}
     elif loop != "local_loop":
@@ -672,10 +698,10 @@ def loop_variants_merge_step(params, inputs, outputs):
     runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
     runs = runs.sort_values(["task", "run"]).drop(columns="task").reset_index(drop=True)
     lv = params["loop_variants"]
-    order = list(lv["designs"]) + ["local_loop"]
     rows = []
     for target in lv["targets"]:
         g = runs[runs["target"] == target]
+        order = list(dict.fromkeys(g["loop"]))
         base = g[g["loop"] == "local_loop"].set_index("run")["local"]
         for loop in order:
             r = g[g["loop"] == loop].set_index("run")
@@ -685,7 +711,7 @@ def loop_variants_merge_step(params, inputs, outputs):
                           topology_changes_min=int(r["topology_changes"].min()),
                           topology_changes_max=int(r["topology_changes"].max()))
             comps = [("same_paths", r["decentralized"], r["local"])]
-            if loop != "local_loop":
+            if loop != "local_loop" and "|" not in loop:
                 comps.append(("vs_local_loop", r["decentralized"], base.reindex(r.index)))
             for comp, a, b in comps:
                 m, se, z = paired_z(a.to_numpy(), b.to_numpy())
