@@ -369,6 +369,7 @@ rule hinf_network:
 rule hinf_evidence:
     input:
         code=code("netrepro.papers.hinf.evidence:evidence_step"),
+        claims="src/netrepro/papers/hinf/claims.yaml",
         consensus=rules.hinf_consensus_check.output.table,
         attenuation=rules.hinf_attenuation.output.table,
         checks=rules.hinf_attenuation.output.checks,
