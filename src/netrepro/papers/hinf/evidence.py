@@ -618,7 +618,7 @@ def evidence_step(params, inputs, outputs):
     """
     cfg = params
     z_sig = float(cfg["claims"]["z_significant"])
-    at = {c.id: c.at for c in load_claims(inputs["claims"])}  # the claims' settings (their YAML 'at' fields)
+    at = {c.claim_id: c.at for c in load_claims(inputs["claims"])}  # the claims' settings (their YAML 'at' fields)
     rows = _errata_rows(cfg)
     # consensus (5)
     cc = pd.read_csv(inputs["consensus"])
