@@ -94,7 +94,11 @@ def hinf_run(tmp_path_factory):
     for name, shard_step, merge_step in (("loop_variants", steps.loop_variants_shard_step, steps.loop_variants_merge_step),
                                          ("kalman_best", steps.kalman_best_shard_step, steps.kalman_best_merge_step)):
         files[name] = d / f"{name}.csv"
-        run_sharded(shard_step, merge_step, cfg, 2, d, name)["table"].to_csv(files[name], index=False)
+        merged = run_sharded(shard_step, merge_step, cfg, 2, d, name)
+        merged["table"].to_csv(files[name], index=False)
+        if "runs" in merged:
+            files[f"{name}_runs"] = d / f"{name}_runs.csv"
+            merged["runs"].to_csv(files[f"{name}_runs"], index=False)
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

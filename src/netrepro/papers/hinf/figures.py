@@ -13,7 +13,8 @@ import pandas as pd
 from ...plotting import new_figure, save_figure
 
 __all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
-           "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired"]
+           "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired",
+           "figure_loop_variants", "figure_kalman_best"]
 
 
 def figure_noise(params, inputs, outputs):
