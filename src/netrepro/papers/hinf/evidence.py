@@ -483,8 +483,9 @@ def _loop_rows(lv: pd.DataFrame) -> list[dict]:
     loc = ev.loc[("local_loop", "same_paths")]
     rows = [{"quantity": "loop.dec_vs_local_same_paths", "value": float(ev.loc[("pi", "same_paths"), "z"]),
              "note": f"{head}; decentralized minus local filter on each loop's own paths, evasive target: " + "; ".join(same)
-                     + f"; random target: " + ", ".join(f"{d} {rnd.loc[(d, 'same_paths'), 'tag']} "
-                                                       f"(z = {rnd.loc[(d, 'same_paths'), 'z']:+.1f})" for d in designs)}]
+                     + ("; random target: " + ", ".join(f"{d} {rnd.loc[(d, 'same_paths'), 'tag']} "
+                                                        f"(z = {rnd.loc[(d, 'same_paths'), 'z']:+.1f})" for d in designs)
+                        if len(rnd) else "")}]
     for d in designs:
         if d != "pi":
             rows.append({"quantity": "loop.dec_vs_local_same_paths", "variant": f"consensus.design={d}",
