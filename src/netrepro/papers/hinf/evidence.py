@@ -520,6 +520,8 @@ def _loop_rows(lv: pd.DataFrame) -> list[dict]:
         rows.append({"quantity": "loop.dec_vs_local_same_paths", "variant": label, "value": float(r["z"]),
                      "note": desc(ev, d, "same_paths")})
         rows.append({"quantity": "fig6.topology_changes", "variant": label, "value": float(r["topology_changes"])})
+        rows.append({"quantity": "fig6.connectivity", "variant": label, "value": float(r["connected_fraction"]),
+                     "note": f"connected fraction of the late steps, {int(r['runs'])} closed-loop runs"})
         if label.startswith("layouts.four"):
             rows.append({"quantity": "r20.connected", "variant": f"{label} (Fig 6, late steps, {int(r['runs'])} runs)",
                          "value": bool(r["connected_fraction"] == 1.0),
