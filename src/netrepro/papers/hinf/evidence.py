@@ -345,8 +345,8 @@ def _connectivity_rows(summ, conn):
     for s, v in frac.items():
         rows.append({"quantity": "r20.connected", "variant": f"scenario {s}", "value": bool(v == 1.0)})
     ev = conn[conn["scenario"].str.startswith("evasive")]
-    note = ("Fig 6 runs (connectivity.csv): " + ", ".join(f"{r.scenario} run {r.run} {r.connected_fraction:.2f}"
-                                                         for r in ev.itertuples()))
+    note = ("Fig 6 runs (connectivity.csv): connected fraction and topology changes " + ", ".join(
+        f"{r.scenario} run {r.run} {r.connected_fraction:.2f} ({int(r.topology_changes)} changes)" for r in ev.itertuples()))
     return rows, float(frac[[s for s in frac.index if s.startswith("evasive")]].mean()), note
 
 
