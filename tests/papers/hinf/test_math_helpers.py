@@ -94,3 +94,15 @@ def test_topology_changed_per_run():
     b = a.copy()
     b[1, 0, 2] = b[1, 2, 0] = 1.0
     np.testing.assert_array_equal(topology_changed(a, b), [False, True])
+
+
+def test_range_derivative_reading_of_eq17_against_finite_differences():
+    from netrepro.papers.hinf.noise import NoiseModel, dinfo_dr_reading, noise_information
+
+    model = NoiseModel(a0=0.3528, a1=15.625, a2=0.0008, alpha=5.0)
+    for r in (5.0, 27.0, 45.0):
+        fd = central_difference(lambda z: noise_information(z, 0.7, model), r, eps=1e-5)
+        np.testing.assert_allclose(dinfo_dr_reading(r, 0.7, model, "variances"), fd, rtol=1e-6, atol=1e-12)
+        assert np.linalg.norm(dinfo_dr_reading(r, 0.7, model, "square_roots") - fd) > 0.1 * np.linalg.norm(fd)
+    with pytest.raises(ValueError, match="unknown reading"):
+        dinfo_dr_reading(5.0, 0.7, model, "sqrt")

@@ -24,8 +24,8 @@ from .algebra import central_difference, rotation
 from .filters import gain_norms, steady_state_prior
 from .model import advantage, paired_z, settle_step
 from .motion import control_law, printed_control_law, printed_sigma_gradient, sigma_gradient
-from .noise import (NoiseModel, geometry, noise_covariance, noise_information, noise_variances, printed_dinfo_dtheta,
-                    sample_noise)
+from .noise import (NoiseModel, dinfo_dr_reading, geometry, noise_covariance, noise_information, noise_variances,
+                    printed_dinfo_dtheta, sample_noise)
 
 __all__ = ["evidence_step", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS"]
 
@@ -196,13 +196,8 @@ def _errata_rows(cfg) -> list[dict]:
     res_right, res_other = [], []
     for rr in (5.0, 27.0, 45.0):
         fdr = central_difference(lambda z: noise_information(z, th0, model), rr)
-        f_r, f_b = noise_variances(rr, model)
-        T = rotation(th0)
-        pre = -2 * model.a2 * (rr - model.a1)
-        right = pre * T @ np.diag([f_r ** -2, f_b ** -2]) @ np.diag([1.0, model.alpha]) @ T.T
-        other = pre * T @ np.diag([1 / f_r, 1 / f_b]) @ np.diag([1.0, model.alpha]) @ T.T
-        res_right.append(_rel(right, fdr))
-        res_other.append(_rel(other, fdr))
+        res_right.append(_rel(dinfo_dr_reading(rr, th0, model, "variances"), fdr))
+        res_other.append(_rel(dinfo_dr_reading(rr, th0, model, "square_roots"), fdr))
     add("E9", max(res_other), max(res_right), "max over r in {5, 27, 45} of the relative distance of the range "
         "derivative (17) to the finite difference of M^-1: 'printed' = R read as diag(sqrt f_r, sqrt f_b) of eq (3), "
         "'corrected' = R = diag(f_r, f_b), V = M_i")
