@@ -43,7 +43,9 @@ def test_evidence_matches_independent_reads_of_the_tables(evidence_table):
     z_sig = cfg["claims"]["z_significant"]
     for r in pa[pa["scenario"] == "fig2"].itertuples():
         who = "mean over agents" if r.agent < 0 else f"agent {r.agent}"
-        assert ev["fig2.decentralized_beats_local"][f"fig2_horizon: {who}, H={r.horizon}"][0] == bool(r.z < -z_sig)
+        suffix = "" if r.tag == "holds" else f" ({r.tag})"
+        assert ev["fig2.decentralized_beats_local"][f"fig2_horizon: {who}, H={r.horizon}{suffix}"][0] == bool(r.z < -z_sig)
+        assert r.tag == ("holds" if r.z < -z_sig else "reversed" if r.z > z_sig else "not significant")
     # the loop comparison's z (PI design, evasive target, same paths) is scipy's paired t on the per-run table
     runs = pd.read_csv(files["loop_variants_runs"])
     pi = runs[(runs["target"] == "evasive") & (runs["loop"] == "pi")].sort_values("run")

@@ -222,12 +222,19 @@ def _fig_comparison_rows(scen, paired, summ, pa, z_sig, cfg):
                      f"{summ.loc[(scen, 'decentralized'), 'late_mean']:.4f} (paired z = {z:.1f})"}]
     for r in pa[pa["scenario"] == scen].itertuples():
         who = "mean over agents" if r.agent < 0 else f"agent {r.agent}"
-        rows.append({"quantity": q, "variant": f"fig2_horizon: {who}, H={r.horizon}", "value": _z_rule(r.z, z_sig),
-                     "note": f"{r.tag} (ratio {r.ratio:.3f}, z = {r.z:+.1f})"})
+        rows.append({"quantity": q, "variant": f"fig2_horizon: {who}, H={r.horizon}{_tag_suffix(r.tag)}",
+                     "value": _z_rule(r.z, z_sig), "note": f"{r.tag} (ratio {r.ratio:.3f}, z = {r.z:+.1f})"})
     for key in ("gamma_c", "K_p"):
         for r in pa[pa["scenario"].str.startswith(f"{scen}_{key}") & (pa["agent"] < 0)].itertuples():
-            rows.append({"quantity": q, "variant": f"consensus.{key}={getattr(r, key):g}: mean over agents, H={r.horizon}",
+            rows.append({"quantity": q, "variant": f"consensus.{key}={getattr(r, key):g}: mean over agents, "
+                                                   f"H={r.horizon}{_tag_suffix(r.tag)}",
                          "value": _z_rule(r.z, z_sig), "note": f"{r.tag} (ratio {r.ratio:.3f}, z = {r.z:+.1f})"})
+    judged = pa[(pa["scenario"] == scen) | (pa["scenario"].str.match(f"{scen}_(gamma_c|K_p)") & (pa["agent"] < 0))]
+    counts = judged["tag"].value_counts()
+    rows[0]["note"] += (f"; settings (100 runs each, |z| > {z_sig:g}): " + ", ".join(
+        f"{counts.get(t, 0)} {t}" for t in ("holds", "not significant", "reversed"))
+        + "; mean over agents: " + ", ".join(f"H={r.horizon} ratio {r.ratio:.3f} {r.tag}" for r in
+                                             pa[(pa["scenario"] == scen) & (pa["agent"] < 0)].itertuples()))
     ki0 = pa[(pa["scenario"] == f"{scen}_ki0") & (pa["agent"] >= 0)]
     rows.append({"quantity": f"{scen}.ki0_every_agent", "value": bool(len(ki0) and (ki0["z"] < -z_sig).all()),
                  "note": f"K_i = 0 (proportional consensus only, not the paper's PI estimator): decentralized better at "
@@ -240,6 +247,12 @@ def _fig_comparison_rows(scen, paired, summ, pa, z_sig, cfg):
                                      f"{g.loc[g['agent'] < 0, 'tag'].iloc[0]})"
                                    for h, g in tags.groupby("horizon"))})
     return rows
+
+
+def _tag_suffix(tag: str) -> str:
+    """`` (not significant)`` / `` (reversed)`` for a setting where the claim does not hold, so a claim's
+    condition tells the two apart; nothing where it holds."""
+    return "" if tag == "holds" else f" ({tag})"
 
 
 def _agent_summary(pa, scen, z_sig) -> str:
