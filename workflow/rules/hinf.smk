@@ -248,6 +248,105 @@ rule hinf_evasive_network:
         step("netrepro.papers.hinf.steps:evasive_network_step")
 
 
+rule hinf_loop_variants_shard:
+    input:
+        code=code("netrepro.papers.hinf.steps:loop_variants_shard_step"),
+    output:
+        table="results/hinf/shards/loop_variants_{shard}.csv",
+    log:
+        "logs/hinf/loop_variants_{shard}.log",
+    wildcard_constraints:
+        shard=r"\d+",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        cfg=lambda w: as_json(
+            {
+                "cfg": HCFG,
+                "shard": int(w.shard),
+                "n_shards": HCFG["loop_variants"]["n_shards"],
+            }
+        ),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:loop_variants_shard_step")
+
+
+rule hinf_loop_variants:
+    input:
+        code=code("netrepro.papers.hinf.steps:loop_variants_merge_step"),
+        shards=expand(
+            rules.hinf_loop_variants_shard.output.table,
+            shard=range(HCFG.get("loop_variants", {}).get("n_shards", 1)),
+        ),
+    output:
+        table="results/hinf/loop_variants.csv",
+        runs="results/hinf/loop_variants_runs.csv",
+    log:
+        "logs/hinf/loop_variants.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:loop_variants_merge_step")
+
+
+rule hinf_kalman_best_shard:
+    input:
+        code=code("netrepro.papers.hinf.steps:kalman_best_shard_step"),
+    output:
+        table="results/hinf/shards/kalman_best_{shard}.csv",
+    log:
+        "logs/hinf/kalman_best_{shard}.log",
+    wildcard_constraints:
+        shard=r"\d+",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        cfg=lambda w: as_json(
+            {
+                "cfg": HCFG,
+                "shard": int(w.shard),
+                "n_shards": HCFG["kalman_best"]["n_shards"],
+            }
+        ),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:kalman_best_shard_step")
+
+
+rule hinf_kalman_best:
+    input:
+        code=code("netrepro.papers.hinf.steps:kalman_best_merge_step"),
+        shards=expand(
+            rules.hinf_kalman_best_shard.output.table,
+            shard=range(HCFG.get("kalman_best", {}).get("n_shards", 1)),
+        ),
+    output:
+        table="results/hinf/kalman_best.csv",
+    log:
+        "logs/hinf/kalman_best.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(HCFG),
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:kalman_best_merge_step")
+
+
 rule hinf_network:
     input:
         code=code("netrepro.papers.hinf.steps:network_step"),
@@ -270,6 +369,7 @@ rule hinf_network:
 rule hinf_evidence:
     input:
         code=code("netrepro.papers.hinf.evidence:evidence_step"),
+        claims="src/netrepro/papers/hinf/claims.yaml",
         consensus=rules.hinf_consensus_check.output.table,
         attenuation=rules.hinf_attenuation.output.table,
         checks=rules.hinf_attenuation.output.checks,
@@ -291,6 +391,8 @@ rule hinf_evidence:
         evader_paired=rules.hinf_evader_check.output.paired,
         fig5_control=rules.hinf_fig5_control.output.table,
         evasive_network=rules.hinf_evasive_network.output.table,
+        loop_variants=rules.hinf_loop_variants.output.table,
+        kalman_best=rules.hinf_kalman_best.output.table,
     output:
         table="results/evidence/hinf.csv",
     log:
@@ -333,5 +435,7 @@ if enabled("hinf"):
         rules.hinf_network.output.connectivity,
         rules.hinf_fig5_control.output.table,
         rules.hinf_evasive_network.output.table,
+        rules.hinf_loop_variants.output.table,
+        rules.hinf_kalman_best.output.table,
         rules.hinf_evidence.output.table,
     ]

@@ -28,7 +28,19 @@ def tiny_section() -> dict:
     sec["claims"]["late_start"] = 20
     sec["paired"].update(runs=6)
     sec["fig2_horizon"].update(runs=4, horizons=[30, 40], scenarios=["fig2", "fig3"])
+    sec["loop_variants"].update(runs=4, reconstructions=sec["loop_variants"]["reconstructions"][::2])
+    sec["kalman_best"].update(select_runs=3, judge_runs=4, W_factors=[1.0, 2.0], gamma_factors=[1.05])
     return sec
+
+
+def run_sharded(shard_step, merge_step, cfg, n_shards, d, name):
+    """The shards of a sharded step and its merge; returns the merge's tables."""
+    paths = []
+    for shard in range(n_shards):
+        path = d / f"{name}_shard{shard}of{n_shards}.csv"
+        shard_step({"cfg": cfg, "shard": shard, "n_shards": n_shards}, {}, {})["table"].to_csv(path, index=False)
+        paths.append(path)
+    return merge_step(cfg, {"shards": paths}, {})
 
 
 def _write(tables: dict, outputs: dict) -> None:
@@ -79,6 +91,14 @@ def hinf_run(tmp_path_factory):
     files["fig5_control"] = files.pop("table")
     run(steps.evasive_network_step, cfg, {}, ["table"])
     files["evasive_network"] = files.pop("table")
+    for name, shard_step, merge_step in (("loop_variants", steps.loop_variants_shard_step, steps.loop_variants_merge_step),
+                                         ("kalman_best", steps.kalman_best_shard_step, steps.kalman_best_merge_step)):
+        files[name] = d / f"{name}.csv"
+        merged = run_sharded(shard_step, merge_step, cfg, 2, d, name)
+        merged["table"].to_csv(files[name], index=False)
+        if "runs" in merged:
+            files[f"{name}_runs"] = d / f"{name}_runs.csv"
+            merged["runs"].to_csv(files[f"{name}_runs"], index=False)
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
     return cfg, files

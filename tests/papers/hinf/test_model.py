@@ -217,7 +217,7 @@ def test_below_gamma0_filter_reported_as_not_existing():
     K = 60
     g0 = minimum_attenuation(np.broadcast_to(Mi, (K,) + Mi.shape), 4 * I2, I2, 0.01 * I2, I2)
     assert 1.5 < g0 < 2.5  # set by the worst cross-range information 1/f_b(40)
-    with pytest.raises(FilterDoesNotExist):
+    with pytest.raises(FilterDoesNotExist, match="gamma below gamma_0"):
         simulate(_scenario(gamma=0.9 * g0, horizon=K, filters=["local"]))
     out = simulate(_scenario(gamma=1.2 * g0, horizon=K, filters=["local"]))
     assert np.all(np.isfinite(out["errors"]["local"]))

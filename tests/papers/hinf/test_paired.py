@@ -60,7 +60,7 @@ def test_gamma0_levels_are_existence_thresholds():
         copy = {"filters": ["decentralized", "copy"], "filter_base": {"copy": kind}}  # the driver keeps its gamma
         out = simulate({**base, **copy, "filter_gamma": {"copy": 1.01 * g0}})
         np.testing.assert_array_equal(out["agents"], res["out"]["agents"])
-        with pytest.raises(FilterDoesNotExist):
+        with pytest.raises(FilterDoesNotExist, match="gamma below gamma_0"):
             simulate({**base, **copy, "filter_gamma": {"copy": 0.97 * g0}})
 
 

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled", "kernel_operand"]
+__all__ = ["I2", "det2", "inv2", "sym2", "min_eig2", "rotation", "use_compiled", "kernel_operand", "central_difference"]
 
 I2 = np.eye(2)
 
@@ -149,3 +149,23 @@ def rotation(theta):
     theta = np.asarray(theta, dtype=float)
     c, s = np.cos(theta), np.sin(theta)
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def central_difference(fun, z: float, eps: float = 1e-6):
+    """Central finite difference ``(f(z + eps) - f(z - eps)) / (2 eps)`` of a scalar- or matrix-valued ``fun``.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(z)`` returning a number or an array.
+    z : float
+        Point of the derivative.
+    eps : float
+        Half step.
+
+    Returns
+    -------
+    float or ndarray
+        The derivative estimate, error ``O(eps^2)`` (exact for quadratics up to rounding).
+    """
+    return (fun(z + eps) - fun(z - eps)) / (2 * eps)

@@ -10,8 +10,14 @@ import numpy as np
 
 __all__ = [
     "adjacency", "laplacian", "pi_consensus_step", "pi_consensus_modes", "pi_consensus_spectral_radius",
-    "consensus_h_max", "run_pi_consensus", "pi_consensus_time_constants",
+    "consensus_h_max", "run_pi_consensus", "pi_consensus_time_constants", "CONSENSUS_DESIGNS",
+    "complete_laplacian", "component_membership", "component_sums", "topology_changed",
 ]
+
+# how the decentralized filter's averages (7)-(8) are formed (issue 28): the paper's PI consensus (5) whose
+# integral states carry over topology changes; the same with the integral states reset at each change; exact
+# sums over each agent's connected piece of the graph (25); the PI consensus (5) on a complete graph
+CONSENSUS_DESIGNS = ("pi", "pi_reset", "exact_component", "complete")
 
 
 def adjacency(positions, radius: float):
@@ -245,3 +251,74 @@ def pi_consensus_time_constants(lam, gamma_c: float, h: float, K_p: float, K_i: 
     with np.errstate(divide="ignore"):
         tau = np.where(rho < 1.0, -1.0 / np.log(np.minimum(rho, 1.0)), np.inf)
     return rho, tau
+
+
+def complete_laplacian(n: int):
+    """Laplacian ``n I - 1 1^T`` of the complete graph on ``n`` agents.
+
+    Parameters
+    ----------
+    n : int
+
+    Returns
+    -------
+    ndarray, shape ``(n, n)``
+    """
+    return n * np.eye(n) - np.ones((n, n))
+
+
+def component_membership(adj):
+    """Which agents share a connected piece of the graph: ``m_ij = 1`` iff ``j`` is reachable from ``i``.
+
+    Computed by repeated boolean squaring of ``I + adj`` (paths of length up to ``N - 1``).
+
+    Parameters
+    ----------
+    adj : ndarray, shape ``(..., N, N)``
+        0/1 adjacency of eq (25).
+
+    Returns
+    -------
+    ndarray, shape ``(..., N, N)``
+        0/1 floats, ones on the diagonal.
+    """
+    a = np.asarray(adj, dtype=float)
+    n = a.shape[-1]
+    reach = ((a + np.eye(n)) > 0).astype(float)
+    steps = 1
+    while steps < n - 1:
+        reach = ((reach @ reach) > 0).astype(float)
+        steps *= 2
+    return reach
+
+
+def component_sums(u, adj):
+    """Exact sums of the agents' inputs over each agent's connected piece: ``sum_{j ~ i} u_j``.
+
+    With exact sums over the whole (connected) graph, eq (9) with ``N C~ = sum_j u_j`` is the
+    centralized filter (6); over a piece it is the centralized filter of that piece.
+
+    Parameters
+    ----------
+    u : ndarray, shape ``(..., N, d)``
+    adj : ndarray, shape ``(..., N, N)``
+
+    Returns
+    -------
+    ndarray, shape ``(..., N, d)``
+    """
+    return component_membership(adj) @ np.asarray(u, dtype=float)
+
+
+def topology_changed(adj_old, adj_new):
+    """Whether the graph (25) changed between two steps (any link added or lost), per run.
+
+    Parameters
+    ----------
+    adj_old, adj_new : ndarray, shape ``(..., N, N)``
+
+    Returns
+    -------
+    ndarray of bool, shape ``adj.shape[:-2]``
+    """
+    return np.any(np.asarray(adj_old) != np.asarray(adj_new), axis=(-2, -1))

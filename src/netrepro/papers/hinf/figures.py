@@ -13,7 +13,8 @@ import pandas as pd
 from ...plotting import new_figure, save_figure
 
 __all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
-           "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired"]
+           "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired",
+           "figure_loop_variants", "figure_kalman_best"]
 
 
 def figure_noise(params, inputs, outputs):
@@ -164,7 +165,8 @@ def figure_fig2(params, inputs, outputs):
     for filt, color in (("local", "C0"), ("decentralized", "C3")):
         s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
         axes[0].plot(s["k"], s["error"], color=color, lw=1, label=filt)
-    axes[0].set_title(f"one run (run {int(single['run'].iloc[0])}), agent {int(single['agent'].iloc[0])} (end of the path)")
+    axes[0].set_title(f"run {int(single['run'].iloc[0])}, agent {int(single['agent'].iloc[0])} (an end of the path, where "
+                      "the choice matters most)", fontsize=8)
     sub = series[series["scenario"] == scen]
     for (agent, filt), g in sub.groupby(["agent", "filter"]):
         color = "C0" if filt == "local" else "C3"
@@ -177,15 +179,20 @@ def figure_fig2(params, inputs, outputs):
         ax.set_ylabel("estimation error |x_hat - x|")
         ax.legend(fontsize=7)
     hs = sorted(per["horizon"].unique())
+    n_agents = int(per["agent"].max()) + 1
     for j, (variant, marker) in enumerate(((scen, "o"), (scen + "_ki0", "s"))):
         for i, h in enumerate(hs):
             g = per[(per["scenario"] == variant) & (per["horizon"] == h)].sort_values("agent")
             if len(g):
                 ki = g["K_i"].iloc[0]
-                axes[2].plot(g["agent"], g["ratio"], marker=marker, ls="-" if j == 0 else ":", color=f"C{i}",
-                             label=f"H = {h}, K_i = {ki:g}")
+                # agent -1 (the mean over agents) is drawn at x = n_agents; error bars: +- 2 paired SE / local error
+                x = np.where(g["agent"] < 0, n_agents + 0.3 * (j - 0.5), g["agent"] + 0.15 * (i - 1))
+                axes[2].errorbar(x, g["ratio"], yerr=2 * g["se"] / g["local"], marker=marker, ls="none", capsize=2,
+                                 color=f"C{i}", mfc="none" if j else None, label=f"H = {h}, K_i = {ki:g}")
     axes[2].axhline(1.0, color="k", lw=0.8)
-    axes[2].set_xlabel("agent (0 and 9: ends of the path)")
+    axes[2].set_xticks(list(range(n_agents)) + [n_agents])
+    axes[2].set_xticklabels([str(a) for a in range(n_agents)] + ["mean"])
+    axes[2].set_xlabel("agent (0 and 9: ends of the path); mean over agents (the paper's reading)")
     axes[2].set_ylabel("decentralized / local error (window late_start..H)")
     axes[2].set_title("below 1: decentralized better")
     axes[2].legend(fontsize=7, ncol=2)
@@ -217,7 +224,8 @@ def figure_network(params, inputs, outputs):
             ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=7,
                     label="target" if is_t else f"agent {who}")
             gm = g[g["k"].isin(marks)]
-            ax.plot(gm["x"], gm["y"], "+" if is_t else ".", color=color, ms=8)
+            ax.plot(gm["x"], gm["y"], "+" if is_t else ".", color=color, ms=8,
+                    label=("target / agents at the time marks" if is_t else None))
             if is_t:
                 for k, x, y in zip(gm["k"], gm["x"], gm["y"]):
                     ax.annotate(f"k={k}", (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
@@ -227,12 +235,15 @@ def figure_network(params, inputs, outputs):
             ax.plot([x1, x2], [y1, y2], "-", color="0.5", lw=0.8, alpha=0.8)
         c = conn[(conn["scenario"] == scen) & (conn["run"] == run)]
         frac = float(c["connected_fraction"].iloc[0]) if len(c) else float("nan")
-        ax.set_title(f"run {run}: connected {frac:.0%} of steps", fontsize=9)
+        nchg = int(c["topology_changes"].iloc[0]) if len(c) and "topology_changes" in c else -1
+        ax.set_title(f"run {run}: connected {frac:.0%} of steps, {nchg} topology changes", fontsize=9)
         ax.set_aspect("equal")
         ax.set_xlabel("x")
         ax.set_ylabel("y")
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(params["title"] + " (open: start, filled: end; grey: links at the time marks)")
+    fig.legend(*axes[0][0].get_legend_handles_labels(), loc="lower center", ncol=6, fontsize=7, frameon=False)
+    fig.subplots_adjust(bottom=0.14)
+    fig.suptitle(params["title"] + " (open: start, large filled: end; small dots (+ for the target): positions at the "
+                 "time marks; grey: links at the time marks)", fontsize=9)
     save_figure(fig, outputs["figure"])
     return {}
 
@@ -254,5 +265,62 @@ def figure_paired(params, inputs, outputs):
         ax.set_ylabel("error(H-inf) - error(Kalman), +- 2 SE")
         ax.set_title(f"{target} target, {int(pe['runs'].iloc[0])} paired runs (below 0: H-inf better)", fontsize=9)
         ax.legend(fontsize=7)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_loop_variants(params, inputs, outputs):
+    """Fig S5: the closed-loop consensus variants (issue 28): decentralized minus local, by design and target."""
+    lv = pd.read_csv(inputs["table"])
+    zc = float(lv["z_crit"].iloc[0])
+    comps = (("same_paths", "decentralized minus local filter, same paths"),
+             ("vs_local_loop", "decentralized loop minus local-steered loop (paired by seed)"))
+    fig, axes = new_figure(1, 2, figsize=(15, 4.8), squeeze=False)
+    for ax, (comp, title) in zip(axes[0], comps):
+        sub = lv[lv["comparison"] == comp]
+        loops = list(dict.fromkeys(sub["loop"]))
+        for j, (target, g) in enumerate(sub.groupby("target", sort=False)):
+            g = g.set_index("loop").reindex(loops)
+            x = np.arange(len(loops)) + 0.38 * (j - 0.5)
+            ax.bar(x, g["mean_diff"], width=0.36, yerr=2 * g["se"], capsize=2, color=f"C{j}", label=f"{target} target")
+            if comp == "same_paths":
+                for xi, (cf, tc) in zip(x, zip(g["connected_fraction"], g["topology_changes"])):
+                    if np.isfinite(cf):
+                        ax.annotate(f"{cf:.0%}\n{tc:.0f}", (xi, 0), fontsize=6, ha="center", va="top",
+                                    xytext=(0, -2), textcoords="offset points")
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xticks(np.arange(len(loops)))
+        ax.set_xticklabels([lp.split("|")[-1].replace("evader.step_scale", "pi, evader step").replace("layouts.four", "pi, layout")
+                            for lp in loops], fontsize=7, rotation=30, ha="right")
+        ax.set_ylabel("late-error difference, +- 2 SE (below 0: decentralized better)")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"Closed loops (agents moved by the filter judged), {int(lv['runs'].iloc[0])} runs; tags at Bonferroni "
+                 f"|z| > {zc:.2f}; numbers under the bars: connected fraction / topology changes per run", fontsize=9)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_kalman_best(params, inputs, outputs):
+    """Fig S6: H-infinity (gamma = 3) minus Kalman against the Kalman filter's design W, by target (issue 28)."""
+    kb = pd.read_csv(inputs["table"])
+    targets = list(dict.fromkeys(kb["target"]))
+    fig, axes = new_figure(1, len(targets), figsize=(4.6 * len(targets), 4.2), squeeze=False)
+    for ax, target in zip(axes[0], targets):
+        sub = kb[kb["target"] == target]
+        for i, (kind, g) in enumerate(sub.groupby("kind", sort=False)):
+            w = g[~g["comparison"].str.startswith("best")].sort_values("W_factor_b")
+            ax.errorbar(w["W_factor_b"], w["mean_diff"], yerr=2 * w["se"], fmt="o-", color=f"C{i}", capsize=3,
+                        label=f"{kind}: gamma = 3 vs Kalman(W_f)")
+            b = g[g["comparison"].str.startswith("best")].iloc[0]
+            ax.errorbar([b["W_factor_b"]], [b["mean_diff"]], yerr=[2 * b["se"]], fmt="*", ms=11, color=f"C{i}",
+                        capsize=3, label=f"{kind}: best vs best ({b['label_a']} vs W_f = {b['W_factor_b']:g})")
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xlabel("Kalman design W_f / W")
+        ax.set_ylabel("error(H-inf) - error(Kalman), +- 2 SE")
+        ax.set_title(f"{target} target (20-step displacement {sub['displacement'].iloc[0]:.2f})", fontsize=9)
+        ax.legend(fontsize=6)
+    fig.suptitle(f"Kalman at its best: {int(kb['runs'].iloc[0])} judged runs, best settings chosen on separate runs "
+                 "(below 0: H-infinity better)", fontsize=9)
     save_figure(fig, outputs["figure"])
     return {}

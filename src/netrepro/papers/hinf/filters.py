@@ -13,7 +13,7 @@ from .algebra import I2, inv2, kernel_operand, min_eig2, sym2, use_compiled
 
 __all__ = [
     "FilterDoesNotExist", "hinf_information", "hinf_update", "decentralized_update", "kalman_update",
-    "minimum_attenuation",
+    "minimum_attenuation", "steady_state_prior", "gain_norms",
 ]
 
 
@@ -277,3 +277,59 @@ def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6, 
         else:
             a = m
     return float(np.exp(b))
+
+
+def steady_state_prior(S, W: float, gamma_inv2: float, Lbar, n_iter: int = 3000):
+    """Steady-state prior ``Delta`` of the Riccati recursion of eq (6) with ``A = B = I`` (fixed-point iteration).
+
+    Iterates ``Sigma = Delta (I - gamma^-2 Lbar Delta + S Delta)^-1``, ``Delta = Sigma + W I``.
+
+    Parameters
+    ----------
+    S : ndarray, shape ``(..., 2, 2)``
+        ``C^T M^-1 C`` (one per filter).
+    W : float
+        Design process noise (``W I``).
+    gamma_inv2 : float
+        ``gamma^-2`` (0: Kalman filter).
+    Lbar : ndarray, shape ``(2, 2)``
+        ``L^T Q L``.
+    n_iter : int
+        Iterations from ``Delta = W I``.
+
+    Returns
+    -------
+    ndarray, shape ``(..., 2, 2)``
+    """
+    S = np.asarray(S, dtype=float)
+    eye = np.broadcast_to(np.eye(2), S.shape)
+    Delta = W * eye.copy()
+    for _ in range(n_iter):
+        Sigma = Delta @ np.linalg.inv(eye - gamma_inv2 * Lbar @ Delta + S @ Delta)
+        Delta = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+    return Delta
+
+
+def gain_norms(Delta, S, Minv):
+    """Spectral norms of the gain ``K_k = Delta (I + S Delta)^-1 C^T M^-1`` of eq (6) and of ``K~_k`` of eq (9).
+
+    For a filter whose measurement is ``y`` with information ``Minv = C^T M^-1`` (``C = I``),
+    ``K_k = Delta (I + S Delta)^-1 Minv``; with exact averages ``N C~ = S``, eq (9)'s
+    ``K~_k = Delta (I + N C~ Delta)^-1 = Delta (I + S Delta)^-1``.
+
+    Parameters
+    ----------
+    Delta : ndarray, shape ``(..., 2, 2)``
+        Prior covariance (e.g. :func:`steady_state_prior`).
+    S : ndarray, shape ``(..., 2, 2)``
+        Information ``C^T M^-1 C`` of the filter (``N C~`` for eq (9)).
+    Minv : ndarray, shape ``(..., 2, 2)``
+        Information of the measurement the gain multiplies.
+
+    Returns
+    -------
+    K, K_tilde : ndarray
+        Spectral norms, shape ``S.shape[:-2]``.
+    """
+    G = Delta @ np.linalg.inv(np.eye(2) + S @ Delta)
+    return np.linalg.norm(G @ Minv, ord=2, axis=(-2, -1)), np.linalg.norm(G, ord=2, axis=(-2, -1))

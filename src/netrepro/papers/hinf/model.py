@@ -19,14 +19,16 @@ import numpy as np
 
 from ...errors import InputError, ModelError
 from .algebra import I2, min_eig2, sym2
-from .consensus import adjacency, laplacian, pi_consensus_step
+from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, component_sums, laplacian,
+                        pi_consensus_step, topology_changed)
 from .evader import SOLVERS, evader_move
 from .filters import FilterDoesNotExist, decentralized_update, hinf_update, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
 
 __all__ = ["FILTER_KINDS", "SCENARIOS", "KINDS", "layout_positions", "resolve_scenario", "simulate",
-           "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired"]
+           "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired", "bonferroni_z", "tag_z",
+           "settle_step", "advantage"]
 
 KINDS = ("local", "decentralized", "centralized")
 
@@ -116,13 +118,17 @@ def simulate(sc: dict) -> dict:
     ----------
     sc : dict
         Resolved scenario: ``agents0 (N, 2)``, ``target0 (2,)``, ``target`` in
-        {``random``, ``stationary``, ``evasive``, ``replay``} (``replay``: the path ``target_path (R, K+1, 2)``),
+        {``random``, ``stationary``, ``evasive``, ``evasive_noise``, ``drift``, ``replay``} (``evasive_noise``: the
+        evader's move plus white noise ``W_true``; ``drift``: a non-reactive target moving by the evader's step
+        length in a heading fixed per run, drawn uniformly; ``replay``: the path ``target_path (R, K+1, 2)``),
         ``W_true``, ``W_filter``, ``A`` (2x2),
         ``gamma``, ``Lbar`` (= L^T Q L), ``P0``, ``model`` (:class:`NoiseModel`), ``radius``,
-        ``consensus`` (``gamma_c, h, K_p, K_i, iters``), ``mobile``, ``driver``, ``control``
+        ``consensus`` (``gamma_c, h, K_p, K_i, iters``, optional ``design`` of
+        :data:`~netrepro.papers.hinf.consensus.CONSENSUS_DESIGNS`, default ``pi``), ``mobile``, ``driver``, ``control``
         (``Gamma, v_max, recursion``), ``evader`` (``n_headings, n_iter, step``, optional ``solver``), ``filters``,
         ``horizon``, ``runs``, ``seed``, ``psd_floor``. Optional: ``filter_base`` (label -> filter
         name, to run several copies of one filter), ``filter_gamma`` (label -> its own gamma),
+        ``filter_W_factor`` (label -> its design process noise as a multiple of ``W_filter``),
         ``record_information``. Every filter sees the same target, agents and measurements; the
         agents are moved by ``driver`` alone (a paired design).
 
@@ -136,7 +142,8 @@ def simulate(sc: dict) -> dict:
         ``trace_sigma[name] (runs, K+1)`` mean over agents of ``tr Sigma``; ``n_psd_fix``;
         ``connected_runs (runs, K+1)`` whether each run's graph is connected; ``information``: with
         ``record_information``, ``{"local": C^T M_k^{-1} C, "decentralized": N C~_k}`` of shape
-        ``(K, runs, N, 2, 2)`` (the S sequences of eqs (6) and (9), for gamma_0), else None.
+        ``(K, runs, N, 2, 2)`` (the S sequences of eqs (6) and (9), for gamma_0), else None;
+        ``topology_changes (runs,)`` number of steps at which the graph (25) changed.
 
     Raises
     ------
@@ -165,6 +172,11 @@ def simulate(sc: dict) -> dict:
     kind_of = {n: FILTER_KINDS[base.get(n, n)] for n in names}
     own_gamma = sc.get("filter_gamma", {})  # label -> its own H-infinity gamma (default sc['gamma'])
     gi_of = {n: 0.0 if kind_of[n][1] else (float(own_gamma[n]) ** -2.0 if n in own_gamma else g2) for n in names}
+    own_W = sc.get("filter_W_factor", {})  # label -> its own design W as a multiple of W_filter
+    bwb_of = {n: float(own_W[n]) * BWB if n in own_W else BWB for n in names}
+    design = cons.get("design", "pi")
+    if design not in CONSENSUS_DESIGNS:
+        raise InputError(f"unknown consensus design {design!r}; expected one of {CONSENSUS_DESIGNS}")
     record = bool(sc.get("record_information", False))
     mobile = bool(sc.get("mobile", False))
     driver = sc.get("driver", "decentralized")
@@ -172,6 +184,9 @@ def simulate(sc: dict) -> dict:
         raise InputError(f"driver filter {driver!r} must be among the filters {names}")
     ss = np.random.SeedSequence(int(sc["seed"]))
     rng0, rng_t, rng_m = (np.random.default_rng(s) for s in ss.spawn(3))
+    if sc["target"] == "drift":
+        heading = rng_t.uniform(0.0, 2 * np.pi, size=R)
+        drift = float(ev["step"]) * np.stack([np.cos(heading), np.sin(heading)], -1)
 
     x = np.broadcast_to(np.asarray(sc["target0"], dtype=float), (R, 2)).copy()
     x0hat = x + np.sqrt(float(sc["P0"])) * rng0.standard_normal((R, 2))
@@ -201,6 +216,9 @@ def simulate(sc: dict) -> dict:
     connected[0] = conn_runs[:, 0].mean()
     info_hist = {"local": np.empty((K, R, N, 2, 2)), "decentralized": np.empty((K, R, N, 2, 2))} if record else None
     max_degree = int(adj.sum(-1).max())
+    changes = np.zeros(R, dtype=int)
+    reset = np.zeros(R, dtype=bool)
+    lap_complete = np.broadcast_to(complete_laplacian(N), (R, N, N)) if design == "complete" else None
     need_cons = any(kind_of[n][0] == "decentralized" for n in names)
     v = w = None
     dsig = np.zeros((2, R, N, 2, 2))  # local copies of Sigma^r_i, Sigma^theta_i (eq (14))
@@ -213,6 +231,13 @@ def simulate(sc: dict) -> dict:
             x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
                                 ev.get("solver", "mirror"))
             fused[:, k] = fz
+        elif sc["target"] == "evasive_noise":
+            x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
+                                ev.get("solver", "mirror"))
+            fused[:, k] = fz
+            x = x + rng_t.multivariate_normal(np.zeros(2), Wt, size=R)
+        elif sc["target"] == "drift":
+            x = x + drift
         elif sc["target"] == "replay":  # a recorded path (the other streams of random numbers are unaffected)
             x = np.asarray(sc["target_path"], dtype=float)[:, k]
         elif sc["target"] != "stationary":
@@ -225,10 +250,16 @@ def simulate(sc: dict) -> dict:
         # 3. PI consensus (5) on u_i = (C_i^T M_i^-1 C_i, C_i^T M_i^-1 y_i), eqs (7)-(8)
         if need_cons:
             u = np.concatenate([Minv.reshape(R, N, 4), yinfo], -1)
-            if v is None:
-                v, w = u.copy(), np.zeros_like(u)
-            for _ in range(int(cons["iters"])):
-                v, w = pi_consensus_step(v, w, u, lap, cons["gamma_c"], cons["h"], cons["K_p"], cons["K_i"])
+            if design == "exact_component":  # exact sums over each agent's connected piece, divided by N for (9)
+                v = component_sums(u, adj) / N
+            else:
+                if v is None:
+                    v, w = u.copy(), np.zeros_like(u)
+                if design == "pi_reset" and reset.any():
+                    w[reset] = 0.0
+                lap_c = lap_complete if design == "complete" else lap
+                for _ in range(int(cons["iters"])):
+                    v, w = pi_consensus_step(v, w, u, lap_c, cons["gamma_c"], cons["h"], cons["K_p"], cons["K_i"])
             Ct, nfix = _psd_floor(v[..., :4].reshape(R, N, 2, 2), float(sc.get("psd_floor", 1e-9)))
             n_psd_fix += nfix
             yt = v[..., 4:]
@@ -242,11 +273,11 @@ def simulate(sc: dict) -> dict:
             kind, _ = kind_of[n]
             gi = gi_of[n]
             if kind == "local":
-                out = hinf_update(est[n], cov[n], yinfo, Minv, A, BWB, gi, Lbar)
+                out = hinf_update(est[n], cov[n], yinfo, Minv, A, bwb_of[n], gi, Lbar)
             elif kind == "centralized":
-                out = hinf_update(est[n], cov[n], yinfo.sum(1), Minv.sum(1), A, BWB, gi, Lbar)
+                out = hinf_update(est[n], cov[n], yinfo.sum(1), Minv.sum(1), A, bwb_of[n], gi, Lbar)
             else:
-                out = decentralized_update(est[n], cov[n], yt, Ct, N, A, BWB, gi, Lbar)
+                out = decentralized_update(est[n], cov[n], yt, Ct, N, A, bwb_of[n], gi, Lbar)
             est[n], cov[n], deltas[n] = out[0], out[1], out[2]
             if kind == "centralized":
                 errors[n][:, 0, k] = np.linalg.norm(est[n] - x, axis=-1)
@@ -271,7 +302,10 @@ def simulate(sc: dict) -> dict:
                 dsig[z] = dS
                 grads.append(dS[..., 0, 0] + dS[..., 1, 1])
             P = P + control_law(grads[0], grads[1], rh, thh, float(ctrl["Gamma"]), float(ctrl["v_max"]))
-            adj = adjacency(P, sc["radius"])
+            adj_new = adjacency(P, sc["radius"])
+            reset = topology_changed(adj, adj_new)
+            changes += reset
+            adj = adj_new
             lap = laplacian(adj)
             max_degree = max(max_degree, int(adj.sum(-1).max()))
         conn_runs[:, k] = _connected(adj) if mobile else conn_runs[:, 0]
@@ -287,7 +321,7 @@ def simulate(sc: dict) -> dict:
         fused[:, 0] = inner(noise_information(r, th, model), int(ev.get("n_iter", 40)), **kw)[0]
     return {"errors": errors, "target": tgt, "agents": ags, "connected": connected, "max_degree": max_degree,
             "fused_trace": fused, "trace_sigma": trace_sigma, "n_psd_fix": n_psd_fix, "connected_runs": conn_runs,
-            "information": info_hist}
+            "information": info_hist, "topology_changes": changes}
 
 
 def attenuation_levels(information, P0: float, A, BWB, Lbar) -> dict:
@@ -356,7 +390,7 @@ def paired_z(a, b):
     return float(d.mean()), float(se), float(d.mean() / se) if se > 0 else np.nan
 
 
-def run_paired(sc: dict, factors) -> dict:
+def run_paired(sc: dict, factors, w_factors=()) -> dict:
     """Every filter on the same target, agents and measurements, with gamma swept relative to each gamma_0.
 
     Pass 1 runs the driver alone (it alone moves the agents) and records the informations; gamma_0 of
@@ -373,11 +407,15 @@ def run_paired(sc: dict, factors) -> dict:
         Resolved scenario (see :func:`simulate`); ``driver`` must be one of the six filter names.
     factors : sequence of float
         Multiples of gamma_0 (each > 1).
+    w_factors : sequence of float, optional
+        Design process noises of extra Kalman copies of each kind, as multiples of ``W_filter``
+        (labels ``"kalman_<kind>@W<f>"``; a factor 1 is the plain Kalman filter and adds no copy).
 
     Returns
     -------
     dict
         ``gamma0 {kind: float}``, ``gammas {label: gamma or inf}``, ``base {label: filter name}``,
+        ``w_factor {label: design-W factor}`` of the extra Kalman copies,
         ``out``: the pass-2 output of :func:`simulate`.
 
     Raises
@@ -396,14 +434,111 @@ def run_paired(sc: dict, factors) -> dict:
             label = f"{kind}@{c:g}"
             base[label], gammas[label] = kind, float(c) * gamma0[kind]
             names.append(label)
+    wf = {}
+    for kind in KINDS:
+        for f in w_factors:
+            if float(f) == 1.0:
+                continue
+            label = f"kalman_{kind}@W{float(f):g}"
+            base[label], gammas[label], wf[label] = "kalman_" + kind, np.inf, float(f)
+            names.append(label)
     own = {n: g for n, g in gammas.items() if np.isfinite(g)}
     # the target's path is replayed (the evader's moves depend only on the target and the agents, which the
     # driver alone moves); the measurement noise has its own stream of random numbers
-    out = simulate({**sc, "filters": names, "filter_base": base, "filter_gamma": own, "target": "replay",
+    out = simulate({**sc, "filters": names, "filter_base": base, "filter_gamma": own, "filter_W_factor": wf,
+                    "target": "replay",
                     "target_path": first["target"]})
     same = (np.array_equal(out["target"], first["target"]) and np.array_equal(out["agents"], first["agents"])
             and np.array_equal(out["errors"][sc["driver"]], first["errors"][sc["driver"]]))
     if not same:
         raise ModelError("paired design broken: trajectories or measurements depend on the set of filters")
     out["fused_trace"] = first["fused_trace"]
-    return {"gamma0": gamma0, "gammas": gammas, "base": base, "out": out}
+    out["topology_changes"] = first["topology_changes"]
+    return {"gamma0": gamma0, "gammas": gammas, "base": base, "w_factor": wf, "out": out}
+
+
+def bonferroni_z(alpha: float, m: int) -> float:
+    """Two-sided critical |z| of one of ``m`` comparisons at family-wise level ``alpha`` (Bonferroni).
+
+    Each comparison is two-sided at level ``alpha / m``, so the probability that any of the ``m``
+    rejects a true null is at most ``alpha`` (union bound), whatever their dependence.
+
+    Parameters
+    ----------
+    alpha : float
+        Family-wise significance level, ``0 < alpha < 1``.
+    m : int
+        Number of comparisons in the family (>= 1).
+
+    Returns
+    -------
+    float
+        ``Phi^-1(1 - alpha / (2 m))``.
+
+    Raises
+    ------
+    InputError
+        If ``alpha`` or ``m`` is out of range.
+    """
+    from scipy.stats import norm
+
+    if not 0.0 < float(alpha) < 1.0 or int(m) < 1:
+        raise InputError(f"need 0 < alpha < 1 and m >= 1, got alpha={alpha!r}, m={m!r}")
+    return float(norm.ppf(1.0 - float(alpha) / (2 * int(m))))
+
+
+def tag_z(z: float, z_crit: float) -> str:
+    """``holds`` (z < -z_crit: arm a significantly smaller), ``reversed`` (z > z_crit) or ``not significant``.
+
+    Parameters
+    ----------
+    z : float
+        Paired z of ``a - b``.
+    z_crit : float
+        Critical |z| (e.g. :func:`bonferroni_z`).
+
+    Returns
+    -------
+    str
+    """
+    if not np.isfinite(z):
+        return "not significant"
+    return "holds" if z < -z_crit else ("reversed" if z > z_crit else "not significant")
+
+
+def settle_step(error_mean, threshold: float) -> int:
+    """First step after which the series stays below ``threshold`` (``-1``: never).
+
+    Parameters
+    ----------
+    error_mean : array_like
+        A (Monte Carlo mean) error series over ``k = 0..K``.
+    threshold : float
+
+    Returns
+    -------
+    int
+        The smallest ``k`` with ``error_mean[j] < threshold`` for every ``j >= k``; 0 if the whole series
+        is below, -1 if the last value is not.
+    """
+    e = np.asarray(error_mean, dtype=float)
+    above = np.flatnonzero(e >= threshold)
+    if len(above) == 0:
+        return 0
+    k = int(above[-1]) + 1
+    return k if k < len(e) else -1
+
+
+def advantage(local, decentralized):
+    """The decentralized filter's advantage: local / decentralized late error (> 1: decentralized better).
+
+    Parameters
+    ----------
+    local, decentralized : array_like
+        Late-window errors of the two filters.
+
+    Returns
+    -------
+    ndarray
+    """
+    return np.asarray(local, dtype=float) / np.asarray(decentralized, dtype=float)

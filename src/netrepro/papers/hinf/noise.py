@@ -17,7 +17,7 @@ from .algebra import rotation, use_compiled
 
 __all__ = [
     "NoiseModel", "geometry", "noise_variances", "noise_covariance", "noise_information",
-    "printed_dinfo_dtheta", "sample_noise", "fit_noise_model",
+    "printed_dinfo_dtheta", "dinfo_dr_reading", "sample_noise", "fit_noise_model",
 ]
 
 _J = np.array([[0.0, -1.0], [1.0, 0.0]])
@@ -195,6 +195,40 @@ def printed_dinfo_dtheta(r, theta, model: NoiseModel):
     Minv = noise_information(r, theta, model)
     psi = _J @ Minv
     return Minv @ (psi + np.swapaxes(psi, -1, -2)) @ Minv
+
+
+def dinfo_dr_reading(r, theta, model: NoiseModel, reading: str = "variances"):
+    """Range derivative of ``M^{-1}`` by eq (17), under a reading of its undefined ``R`` (erratum E9).
+
+    Eq (17) reads ``d V^{-1}/d r = -2 a2 (r - a1) T R^{-2} diag(1, alpha) T^T`` (``V = M_i``). With
+    ``R = diag(f_r, f_b)`` (``reading="variances"``) this is the derivative of :func:`noise_information`;
+    with ``R = diag(sqrt f_r, sqrt f_b)``, the matrix of eq (3) (``reading="square_roots"``), it is not.
+
+    Parameters
+    ----------
+    r, theta : float
+        Range and bearing.
+    model : NoiseModel
+    reading : {"variances", "square_roots"}
+
+    Returns
+    -------
+    ndarray, shape ``(2, 2)``
+
+    Raises
+    ------
+    ValueError
+        If ``reading`` is unknown.
+    """
+    f_r, f_b = noise_variances(r, model)
+    if reading == "variances":
+        inv_r2 = np.diag([f_r ** -2, f_b ** -2])
+    elif reading == "square_roots":
+        inv_r2 = np.diag([1 / f_r, 1 / f_b])
+    else:
+        raise ValueError(f"unknown reading {reading!r}; expected 'variances' or 'square_roots'")
+    T = rotation(theta)
+    return -2 * model.a2 * (r - model.a1) * T @ inv_r2 @ np.diag([1.0, model.alpha]) @ T.T
 
 
 def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel):

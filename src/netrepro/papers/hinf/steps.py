@@ -49,8 +49,10 @@ Tables (all under ``results/hinf/``)
     frac_a_better, error_a, error_b`` — every filter on the same target, agents and measurements;
     ``mean_diff`` = error of a minus error of b over ``late_start <= k <= horizon`` (paired per run).
 ``per_agent.csv`` (issue 17)
-    ``scenario, agent, horizon, local, decentralized, ratio, z, K_i`` — Fig 2-3 per agent and horizon
-    (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``; ``ratio`` = decentralized / local.
+    ``scenario, agent, horizon, local, decentralized, ratio, z, se, K_i, gamma_c, K_p, tag`` — Fig 2-3 per agent and
+    horizon (window ``late_start..horizon``), ``<scenario>_ki0`` with ``K_i = 0``, ``<scenario>_gamma_c<v>`` /
+    ``<scenario>_K_p<v>`` with that consensus gain (mean over agents only); ``agent = -1`` is the mean over the
+    agents; ``ratio`` = decentralized / local; ``se`` the paired standard error of decentralized minus local; ``tag`` holds / not significant / reversed at ``|z| > claims.z_significant``.
 ``per_agent_errors.csv``
     ``scenario, agent, filter, k, error_mean`` — Monte Carlo mean error of the end and an interior agent.
 ``consensus_modes.csv``
@@ -72,9 +74,14 @@ Tables (all under ``results/hinf/``)
     ``target, run, connected_fraction, local, decentralized`` — the Fig-6 setting (``paired.scenario``) against each
     target model, ``paired.network_runs`` runs, seed ``paired.seed``: per run, the fraction of steps of the late window
     with a connected graph (25) and the late-window mean errors of the local and decentralized H-infinity filters.
+``loop_variants.csv``, ``loop_variants_runs.csv`` (issue 28)
+    closed-loop consensus variants of the evasive comparison, see :func:`loop_variants_merge_step`.
+``kalman_best.csv`` (issue 28)
+    H-infinity against Kalman filters at their best, see :func:`kalman_best_merge_step`.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
-    connected_fraction, min_lambda2`` per trajectory run.
+    connected_fraction, min_lambda2, topology_changes`` per trajectory run (steps at which a link appears or
+    disappears).
 """
 
 from __future__ import annotations
@@ -86,17 +93,18 @@ import pandas as pd
 
 from .algebra import rotation
 from .consensus import (adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius,
-                        pi_consensus_time_constants, run_pi_consensus)
+                        pi_consensus_time_constants, run_pi_consensus, topology_changed)
 from .evader import evader_decisions
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
-from .model import (KINDS, FilterDoesNotExist, layout_positions, paired_z, resolve_scenario, run_paired, simulate,
-                    window_means)
+from .model import (FILTER_KINDS, KINDS, FilterDoesNotExist, bonferroni_z, layout_positions, paired_z, resolve_scenario,
+                    run_paired, simulate, tag_z, window_means)
 from .noise import NoiseModel, geometry, noise_covariance, noise_information, noise_variances, sample_noise
 
 __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
-    "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step",
+    "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step", "loop_variants_shard_step",
+    "loop_variants_merge_step", "kalman_best_shard_step", "kalman_best_merge_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
@@ -429,24 +437,35 @@ def fig2_horizon_step(params, inputs, outputs):
     from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, fh = params, params["fig2_horizon"]
     start = int(cfg["claims"]["late_start"])
+    z_sig = float(cfg["claims"]["z_significant"])
     K = max(int(h) for h in fh["horizons"])
     rows, series, modes = [], [], []
     interior = int(fh["interior_agent"])
+    # issue 28: the consensus gains gamma_c and K_p over their declared ranges (sensitivity), mean over agents only
+    gain_variants = [(f"_{key}{float(v):g}", {"consensus": {key: float(v)}}, False)
+                     for key in ("gamma_c", "K_p") for v in cfg["sensitivity"][key]
+                     if float(v) != float(cfg["consensus"][key])]
     for scen in fh["scenarios"]:
-        for suffix, over in (("", {}), ("_ki0", {"consensus": {"K_i": 0.0}})):
+        for suffix, over, per_agent in [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants:
             sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]), **over)
             sc["filters"] = ["local", "decentralized"]
             out = simulate(sc)
             e_loc, e_dec = out["errors"]["local"], out["errors"]["decentralized"]
+            c = sc["consensus"]
             for H in fh["horizons"]:
                 H = int(H)
-                for agent in range(e_loc.shape[1]):
-                    a = e_dec[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
-                    b = e_loc[:, agent:agent + 1, start:H + 1].mean(axis=(1, 2))
-                    _, _, z = paired_z(a, b)
+                agents = list(range(e_loc.shape[1])) if per_agent else []
+                for agent in agents + [-1]:  # -1: the mean over the agents (the paper's reading)
+                    sl = slice(None) if agent < 0 else slice(agent, agent + 1)
+                    a = e_dec[:, sl, start:H + 1].mean(axis=(1, 2))
+                    b = e_loc[:, sl, start:H + 1].mean(axis=(1, 2))
+                    _, se, z = paired_z(a, b)
                     rows.append({"scenario": scen + suffix, "agent": agent, "horizon": H, "local": b.mean(),
-                                 "decentralized": a.mean(), "ratio": a.mean() / b.mean(), "z": z,
-                                 "K_i": sc["consensus"]["K_i"]})
+                                 "decentralized": a.mean(), "ratio": a.mean() / b.mean(), "z": z, "se": se,
+                                 "K_i": c["K_i"], "gamma_c": c["gamma_c"], "K_p": c["K_p"],
+                                 "tag": tag_z(z, z_sig)})
+            if not per_agent:
+                continue
             for agent in sorted({0, min(interior, e_loc.shape[1] - 1)}):
                 for fname, e in (("local", e_loc), ("decentralized", e_dec)):
                     series.append(pd.DataFrame({"scenario": scen + suffix, "agent": agent, "filter": fname,
@@ -543,7 +562,8 @@ def network_step(params, inputs, outputs):
         adj = adjacency(pos, radius)
         lam2 = np.linalg.eigvalsh(laplacian(adj))[:, 1]
         conn.append({"scenario": scen, "run": int(run), "steps": K + 1, "connected_fraction": float(np.mean(lam2 > 1e-9)),
-                     "min_lambda2": float(lam2.min())})
+                     "min_lambda2": float(lam2.min()),
+                     "topology_changes": int(topology_changed(adj[:-1], adj[1:]).sum())})
         for k in [m for m in marks if m <= K]:
             for i, j in zip(*np.nonzero(np.triu(adj[k]))):
                 links.append({"scenario": scen, "run": int(run), "k": k, "i": ids[i], "j": ids[j]})
@@ -595,3 +615,203 @@ def evasive_network_step(params, inputs, outputs):
         rows.append(pd.DataFrame({"target": target, "run": np.arange(len(conn)), "connected_fraction": conn,
                                   "local": loc, "decentralized": dec}))
     return {"table": pd.concat(rows, ignore_index=True)}
+
+
+# --------------------------------------------------------------------------- issue 28: causes and baselines at their best
+def _loop_tasks(lv) -> list[tuple[str, str]]:
+    """(target, loop) tasks of the closed-loop consensus variants, in a fixed order (shards split this list)."""
+    tasks = [(t, loop) for t in lv["targets"] for loop in list(lv["designs"]) + ["local_loop"]]
+    # untested reconstructions varied (evasive target, configured PI consensus): loop "pi|<key>=<label>"
+    return tasks + [("evasive", f"pi|{r['key']}={r['label']}") for r in lv.get("reconstructions", [])]
+
+
+def _loop_scenario(cfg, lv, target, loop):
+    """The closed loop of one task: agents moved by the filter judged (``local_loop``: by the local filters)."""
+    over = {}
+    if "|" in loop:  # a reconstruction's other value: the configuration with that key replaced
+        rec = next(r for r in lv["reconstructions"] if loop == f"pi|{r['key']}={r['label']}")
+        section, name = rec["key"].split(".")
+        cfg = {**cfg, section: {**cfg[section], name: rec["value"]}}
+        loop = "pi"
+    if loop == "p_only":
+        over = {"consensus": {"K_i": 0.0, "design": "pi"}}
+    elif loop != "local_loop":
+        over = {"consensus": {"design": loop}}
+    sc = resolve_scenario(cfg, lv["scenario"], runs=int(lv["runs"]), seed=int(lv["seed"]), **over)
+    sc["target"] = target
+    sc["filters"] = ["local", "decentralized"]
+    sc["driver"] = "local" if loop == "local_loop" else "decentralized"
+    return sc
+
+
+def loop_variants_shard_step(params, inputs, outputs):
+    """Step: per-run late errors of the closed-loop consensus variants (issue 28, part 1), one shard of tasks.
+
+    A task is (target, loop): ``loop`` is a consensus design of ``loop_variants.designs`` (``pi`` the
+    configured PI consensus (5), ``pi_reset`` its integral states reset at each topology change, ``p_only``
+    K_i = 0, ``exact_component`` exact sums over each connected piece, ``complete`` the PI consensus on a
+    complete graph), whose decentralized filter moves the agents, or ``local_loop``, where the local filters
+    move them. Every task uses seed ``loop_variants.seed``: same target start, measurement-noise stream and
+    initial estimates in every loop, so the loops are paired by run. Tasks are split over
+    ``n_shards`` contiguous shards (:func:`netrepro.engines.montecarlo.shard_blocks`); each task is computed
+    the same way in any shard, so the merged table does not depend on the shard count.
+    """
+    from netrepro.engines.montecarlo import shard_blocks
+
+    from . import filter_kernels  # noqa: F401  numba: enough filter updates to pay its load
+    cfg, lv = params["cfg"], params["cfg"]["loop_variants"]
+    start = int(cfg["claims"]["late_start"])
+    tasks = _loop_tasks(lv)
+    mine = shard_blocks(len(tasks), 1, int(params["n_shards"]), int(params["shard"]))
+    frames = []
+    for t in mine:
+        target, loop = tasks[int(t)]
+        sc = _loop_scenario(cfg, lv, target, loop)
+        out = simulate(sc)
+        conn = np.asarray(out["connected_runs"], dtype=float)[:, start:].mean(1)
+        frames.append(pd.DataFrame({
+            "task": int(t), "target": target, "loop": loop, "driver": sc["driver"], "run": np.arange(sc["runs"]),
+            "local": window_means(out["errors"]["local"], start),
+            "decentralized": window_means(out["errors"]["decentralized"], start),
+            "connected_fraction": conn, "topology_changes": out["topology_changes"]}))
+    cols = ["task", "target", "loop", "driver", "run", "local", "decentralized", "connected_fraction",
+            "topology_changes"]
+    table = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
+    return {"table": table, "provenance": {"tasks": [int(t) for t in mine]}}
+
+
+def loop_variants_merge_step(params, inputs, outputs):
+    """Step: the closed-loop consensus variants' comparisons (``loop_variants.csv``) from the shards.
+
+    Per target and loop: the connected fraction and the number of topology changes (per run, over the
+    horizon), and two paired comparisons, each tagged ``holds`` / ``not significant`` / ``reversed`` at the
+    Bonferroni-corrected two-sided level ``tests.alpha`` over every comparison of the table (fixed before
+    the runs):
+
+    - ``same_paths``: decentralized minus local filter on the loop's own paths (exact pairing: same target,
+      agents and measurements);
+    - ``vs_local_loop``: the loop's decentralized filter minus the local filter of the loop steered by the
+      local filters (the abstract's "system using only local estimates"); the paths differ, so the pairing is
+      by seed (same run index: same target start, noise stream and initial estimate), a paired test on the run
+      means.
+    """
+    runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
+    runs = runs.sort_values(["task", "run"]).drop(columns="task").reset_index(drop=True)
+    lv = params["loop_variants"]
+    rows = []
+    for target in lv["targets"]:
+        g = runs[runs["target"] == target]
+        order = list(dict.fromkeys(g["loop"]))
+        base = g[g["loop"] == "local_loop"].set_index("run")["local"]
+        for loop in order:
+            r = g[g["loop"] == loop].set_index("run")
+            common = dict(target=target, loop=loop, driver=r["driver"].iloc[0], runs=len(r),
+                          connected_fraction=float(r["connected_fraction"].mean()),
+                          topology_changes=float(r["topology_changes"].mean()),
+                          topology_changes_min=int(r["topology_changes"].min()),
+                          topology_changes_max=int(r["topology_changes"].max()))
+            comps = [("same_paths", r["decentralized"], r["local"])]
+            if loop != "local_loop" and "|" not in loop:
+                comps.append(("vs_local_loop", r["decentralized"], base.reindex(r.index)))
+            for comp, a, b in comps:
+                m, se, z = paired_z(a.to_numpy(), b.to_numpy())
+                rows.append({**common, "comparison": comp, "error_a": float(a.mean()), "error_b": float(b.mean()),
+                             "mean_diff": m, "se": se, "z": z, "frac_a_better": float(np.mean(a < b))})
+    table = pd.DataFrame(rows)
+    zc = bonferroni_z(float(params["tests"]["alpha"]), len(table))
+    table["z_crit"] = zc
+    table["tag"] = [tag_z(z, zc) for z in table["z"]]
+    return {"table": table, "runs": runs}
+
+
+def _kalman_tasks(kb) -> list[tuple[str, str]]:
+    """(target, phase) tasks of the Kalman-at-its-best comparison; phase ``select`` or ``judge``."""
+    return [(t, ph) for t in kb["targets"] for ph in ("select", "judge")]
+
+
+def _displacement(path, lag: int) -> float:
+    """Mean distance the target moves in ``lag`` steps, over runs and start steps."""
+    p = np.asarray(path, dtype=float)
+    return float(np.linalg.norm(p[:, lag:] - p[:, :-lag], axis=-1).mean()) if p.shape[1] > lag else np.nan
+
+
+def kalman_best_shard_step(params, inputs, outputs):
+    """Step: per-run late errors of H-infinity filters (several gamma) and Kalman filters (several design W)
+    on the same trajectories, for each target model and phase (issue 28, part 2); one shard of tasks.
+
+    Phase ``select`` (``kalman_best.select_runs`` runs, seed ``select_seed``) picks each family's best setting;
+    phase ``judge`` (``judge_runs``, seed ``judge_seed``, separate runs) is where they are compared.
+    Targets: ``evasive`` (eqs (19)-(24)), ``drift`` (non-reactive, the evader's step length in a fixed
+    heading), ``evasive_noise`` (the evader plus white noise W) and ``random``. Shards as in
+    :func:`loop_variants_shard_step`.
+    """
+    from netrepro.engines.montecarlo import shard_blocks
+
+    from . import filter_kernels  # noqa: F401
+    cfg, kb = params["cfg"], params["cfg"]["kalman_best"]
+    start = int(cfg["claims"]["late_start"])
+    tasks = _kalman_tasks(kb)
+    mine = shard_blocks(len(tasks), 1, int(params["n_shards"]), int(params["shard"]))
+    frames = []
+    for t in mine:
+        target, phase = tasks[int(t)]
+        runs, seed = (int(kb["select_runs"]), int(kb["select_seed"])) if phase == "select" else \
+            (int(kb["judge_runs"]), int(kb["judge_seed"]))
+        sc = resolve_scenario(cfg, kb["scenario"], runs=runs, seed=seed)
+        sc["target"] = target
+        res = run_paired(sc, [float(c) for c in kb["gamma_factors"]], [float(f) for f in kb["W_factors"]])
+        disp = _displacement(res["out"]["target"], int(kb["displacement_lag"]))
+        for lab, e in res["out"]["errors"].items():
+            base = res["base"][lab]
+            frames.append(pd.DataFrame({
+                "task": int(t), "target": target, "phase": phase, "label": lab, "family": "kalman" if FILTER_KINDS[base][1] else "hinf",
+                "kind": FILTER_KINDS[base][0], "gamma": res["gammas"][lab],
+                "W_factor": res["w_factor"].get(lab, 1.0), "run": np.arange(runs), "error": window_means(e, start),
+                "displacement": disp}))
+    cols = ["task", "target", "phase", "label", "family", "kind", "gamma", "W_factor", "run", "error", "displacement"]
+    table = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
+    return {"table": table, "provenance": {"tasks": [int(t) for t in mine]}}
+
+
+def kalman_best_merge_step(params, inputs, outputs):
+    """Step: H-infinity against Kalman filters at their best (``kalman_best.csv``) from the shards.
+
+    For each target and filter kind of ``kalman_best.kinds`` (judge runs, paired per run: same
+    trajectories and measurements): the configured H-infinity filter (gamma = ``filter.gamma``) against the
+    Kalman filter at each design W (``W_factor`` x W), and the best H-infinity setting against the best
+    Kalman setting, both chosen on the ``select`` runs (smallest mean late error; the judge runs never
+    choose). Each row is tagged at the Bonferroni-corrected two-sided level ``tests.alpha`` over every
+    row of the table. ``displacement`` is the target's mean ``lag``-step displacement (judge runs).
+    """
+    runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
+    runs = runs.sort_values(["task", "label", "run"], kind="stable").drop(columns="task").reset_index(drop=True)
+    cfg, kb = params, params["kalman_best"]
+    gamma = float(cfg["filter"]["gamma"])
+    rows = []
+    for target in kb["targets"]:
+        for kind in kb["kinds"]:
+            sel = runs[(runs["target"] == target) & (runs["phase"] == "select") & (runs["kind"] == kind)]
+            jud = runs[(runs["target"] == target) & (runs["phase"] == "judge") & (runs["kind"] == kind)]
+            means = sel.groupby(["family", "label"])["error"].mean()
+            best = {fam: means[fam].idxmin() for fam in ("hinf", "kalman")}
+            per = {lab: g.sort_values("run")["error"].to_numpy() for lab, g in jud.groupby("label")}
+            info = jud.drop_duplicates("label").set_index("label")
+            disp = float(jud["displacement"].iloc[0])
+
+            def row(comp, a, b):
+                m, se, z = paired_z(per[a], per[b])
+                return {"target": target, "kind": kind, "comparison": comp, "label_a": a, "label_b": b,
+                        "gamma_a": float(info.loc[a, "gamma"]), "W_factor_b": float(info.loc[b, "W_factor"]),
+                        "runs": len(per[a]), "error_a": float(per[a].mean()), "error_b": float(per[b].mean()),
+                        "mean_diff": m, "se": se, "z": z, "frac_a_better": float(np.mean(per[a] < per[b])),
+                        "displacement": disp}
+
+            kal = info[info["family"] == "kalman"].sort_values("W_factor")
+            for lab in kal.index:
+                rows.append(row(f"gamma={gamma:g} vs W_f={kal.loc[lab, 'W_factor']:g}", kind, lab))
+            rows.append(row("best vs best", best["hinf"], best["kalman"]))
+    table = pd.DataFrame(rows)
+    zc = bonferroni_z(float(params["tests"]["alpha"]), len(table))
+    table["z_crit"] = zc
+    table["tag"] = [tag_z(z, zc) for z in table["z"]]
+    return {"table": table}
