@@ -534,6 +534,14 @@ def _fmt_rule(entry: FindingEntry) -> str:
     return f"{entry.asserted:.15g} within {within}: {entry.rule_reason}"
 
 
+def _names_evidence(cause: str, evidence: dict, rows_q: dict) -> bool:
+    """Whether ``cause`` names an evidence quantity, a variant of the judged quantity, or ``<quantity>: <variant>``."""
+    if cause in evidence or cause in rows_q:
+        return True
+    quantity, sep, variant = cause.partition(": ")
+    return bool(sep) and variant in evidence.get(quantity, {})
+
+
 def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
     """Table ``results/findings/<slug>.csv``: our findings, judged by :func:`judge` like claims.
 
@@ -566,9 +574,9 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
                 raise InputError(f"finding {data.slug}/{f.finding_id}: evidence quantity {name!r} is not in "
                                  f"results/evidence/{data.slug}.csv (the paper's evidence step must produce it)")
         cause = f.cause.get("variant", "")
-        if cause and cause not in evidence and cause not in rows_q:
+        if cause and not _names_evidence(cause, evidence, rows_q):
             raise InputError(f"finding {data.slug}/{f.finding_id}: cause variant {cause!r} is neither an evidence "
-                             f"quantity nor a variant of {f.quantity!r}")
+                             f"quantity, a variant of {f.quantity!r}, nor '<quantity>: <variant>' of the evidence table")
         value, note = rows_q[NOMINAL]
         variants = {label: v for label, (v, _) in rows_q.items() if label != NOMINAL}
         problems.append(_undeclared("finding", data.slug, f.finding_id, f.depends_on, variants))

@@ -19,7 +19,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...verdicts import erratum_evidence, evidence_frame, load_claims
+from ...paperdata import load_claims
+from ...verdicts import erratum_evidence, evidence_frame
 from .algebra import central_difference, rotation
 from .filters import gain_norms, steady_state_prior
 from .model import advantage, paired_z, settle_step
