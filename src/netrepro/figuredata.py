@@ -9,10 +9,9 @@ images (their array), and texts. :func:`netrepro.plotting.save_figure` writes it
 as ``<name>.data.json`` for every figure of the project, so a figure is checked by what it
 shows, not only by its pixels.
 
-:func:`compare_figure_data` compares two such descriptions with the tolerances of the result
-tables (:data:`netrepro.regression.RTOL`, :data:`netrepro.regression.ATOL`): strings exactly
-(numbers printed inside them with the numeric tolerance), arrays element-wise. Each difference
-names the axes, the artist and the largest difference.
+The comparison lives in :mod:`netrepro.figurecheck`. This module imports nothing of the
+project but :mod:`netrepro.io`: it is a code dependency of every figure rule, so an edit to the
+comparison must not rerun the figures.
 """
 
 from __future__ import annotations
@@ -22,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["SUFFIX", "FORMAT", "data_path", "describe_figure", "write_figure_data", "compare_figure_data"]
+__all__ = ["SUFFIX", "FORMAT", "data_path", "describe_figure", "write_figure_data"]
 
 SUFFIX = ".data.json"
 FORMAT = 1
@@ -77,7 +76,8 @@ def _text(t) -> dict:
 def _line(line) -> dict:
     return {"kind": "line", "label": _label(line), "xy": _array(line.get_xydata()),
             "color": _color(line.get_color()), "linestyle": str(line.get_linestyle()),
-            "marker": str(line.get_marker()), "visible": bool(line.get_visible())}
+            "marker": str(line.get_marker()), "linewidth": float(line.get_linewidth()),
+            "markersize": float(line.get_markersize()), "visible": bool(line.get_visible())}
 
 
 def _collection(coll) -> dict:
@@ -184,110 +184,3 @@ def write_figure_data(fig, png) -> Path:
     with atomic_path(target) as tmp:
         Path(tmp).write_text(text + "\n")
     return target
-
-
-def _as_float(values) -> np.ndarray:
-    """Nested lists of numbers (and "nan"/"inf" strings) as a float array; TypeError/ValueError if not numbers."""
-    if isinstance(values, (list, tuple)) and any(isinstance(v, (dict, bool)) or v is None for v in values):
-        raise TypeError("not numbers")
-    a = np.asarray(values, dtype=object)
-    if a.dtype != object or not a.size:
-        return a.astype(float)
-    flat = [float(v) for v in a.ravel().tolist()]  # "nan"/"inf" parse; other words raise ValueError
-    return np.asarray(flat, dtype=float).reshape(a.shape)
-
-
-def _name(ax_index: int, ax: dict) -> str:
-    title = ax.get("title") or ax.get("ylabel") or ""
-    return f"axes {ax_index}" + (f" ({title!r})" if title else "")
-
-
-def _artist_name(i: int, artist: dict) -> str:
-    label = artist.get("label") or artist.get("text")
-    return f"{artist.get('kind')} {i}" + (f" {label!r}" if label else "")
-
-
-def _compare_values(where: str, ref, got, rtol: float, atol: float, out: list) -> None:
-    """Append a difference of two JSON values (dicts, lists of numbers or of strings, scalars)."""
-    from .regression import _texts_agree
-
-    if isinstance(ref, dict) and isinstance(got, dict):
-        for key in sorted(set(ref) | set(got)):
-            if key not in got or key not in ref:
-                out.append(f"{where}: {key} {'missing' if key not in got else 'added'}")
-            else:
-                _compare_values(f"{where} {key}", ref[key], got[key], rtol, atol, out)
-        return
-    if isinstance(ref, str) or isinstance(got, str) or ref is None or got is None or isinstance(ref, bool):
-        if isinstance(ref, str) and isinstance(got, str) and ref in ("nan", "inf", "-inf") and got == ref:
-            return
-        if isinstance(ref, str) and isinstance(got, str):
-            if not _texts_agree(ref, got, rtol, atol):
-                out.append(f"{where}: {got!r}, reference {ref!r}")
-        elif ref != got:
-            out.append(f"{where}: {got!r}, reference {ref!r}")
-        return
-    try:
-        a, b = _as_float(ref), _as_float(got)
-    except (TypeError, ValueError):  # lists of strings (legend entries, tick labels) or of dicts
-        if isinstance(ref, list) and isinstance(got, list):
-            if len(ref) != len(got):
-                out.append(f"{where}: {len(got)} items, reference {len(ref)}: {got!r} vs reference {ref!r}"
-                           if all(isinstance(x, str) for x in ref + got) else
-                           f"{where}: {len(got)} items, reference {len(ref)}")
-                return
-            for i, (r, g) in enumerate(zip(ref, got)):
-                _compare_values(f"{where}[{i}]", r, g, rtol, atol, out)
-        else:
-            out.append(f"{where}: {got!r}, reference {ref!r}")
-        return
-    if a.shape != b.shape:
-        out.append(f"{where}: shape {b.shape}, reference {a.shape}")
-        return
-    ok = np.isclose(a, b, rtol=rtol, atol=atol, equal_nan=True) | (np.isinf(a) & (a == b))
-    if not ok.all():
-        with np.errstate(invalid="ignore"):
-            err = np.where(ok, 0.0, np.abs(a - b))
-        err = np.where(np.isnan(err), np.inf, err)
-        j = np.unravel_index(int(np.argmax(err)), a.shape)
-        rel = err[j] / abs(a[j]) if a[j] not in (0.0,) and np.isfinite(a[j]) else float("inf")
-        out.append(f"{where}: {int((~ok).sum())} of {a.size} values differ, largest at {list(map(int, j))}: "
-                   f"{b[j]!r} vs reference {a[j]!r} (abs {err[j]:.3g}, rel {rel:.3g})")
-
-
-def compare_figure_data(reference: dict, result: dict, rtol: float | None = None,
-                        atol: float | None = None) -> list[str]:
-    """Differences between two figure descriptions (empty when they agree), one string each.
-
-    Each names the axes (index and title) and the artist (kind, index, label) and gives the
-    largest difference. Default tolerances: those of the result tables.
-    """
-    from .regression import ATOL, RTOL
-
-    rtol = RTOL if rtol is None else rtol
-    atol = ATOL if atol is None else atol
-    out: list[str] = []
-    top_ref = {k: v for k, v in reference.items() if k != "axes"}
-    top_got = {k: v for k, v in result.items() if k != "axes"}
-    _compare_values("figure", top_ref, top_got, rtol, atol, out)
-    ra, ga = reference.get("axes", []), result.get("axes", [])
-    if len(ra) != len(ga):
-        out.append(f"figure: {len(ga)} axes, reference {len(ra)}")
-    for k, (rax, gax) in enumerate(zip(ra, ga)):
-        where = _name(k, rax)
-        props_r = {key: v for key, v in rax.items() if key != "artists"}
-        props_g = {key: v for key, v in gax.items() if key != "artists"}
-        _compare_values(where, props_r, props_g, rtol, atol, out)
-        rart, gart = rax.get("artists", []), gax.get("artists", [])
-        if len(rart) != len(gart):
-            names_r = [_artist_name(i, a) for i, a in enumerate(rart)]
-            names_g = [_artist_name(i, a) for i, a in enumerate(gart)]
-            extra = [n for n in names_g if n not in names_r]
-            gone = [n for n in names_r if n not in names_g]
-            out.append(f"{where}: {len(gart)} artists, reference {len(rart)}"
-                       + (f"; new: {', '.join(extra)}" if extra else "")
-                       + (f"; gone: {', '.join(gone)}" if gone else ""))
-            continue
-        for i, (r, g) in enumerate(zip(rart, gart)):
-            _compare_values(f"{where} {_artist_name(i, r)}", r, g, rtol, atol, out)
-    return out
