@@ -81,7 +81,7 @@ bench: $(STAMP)
 # Everything the pipeline makes: tables, logs, figures (committed, but rebuilt), the report and
 # Snakemake's metadata (its conda/container caches stay). `make report` afterwards runs every job.
 CLEAN_PATHS = results logs report/*.html report/*.ipynb report/*.meta.json report/files \
-	report/ro-crate-metadata.json report/*.png figures/*/*.png figures/*/*.data.json figures/*/*.meta.json
+	report/ro-crate-metadata.json report/README.md report/*.png figures/*/*.png figures/*/*.data.json figures/*/*.meta.json
 clean:
 	rm -rf $(CLEAN_PATHS)
 	test ! -d .snakemake || find .snakemake -mindepth 1 -maxdepth 1 ! -name conda ! -name singularity \
