@@ -406,7 +406,7 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
     for old in out.glob("*.png"):
         old.unlink()
     failing = [d for d in figures if d.problems]
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><link rel='icon' href='data:,'>"
              f"<title>Regeneration differences</title><style>{_CSS}</style></head><body>",
              "<h1>Regeneration differences</h1>",
              f"<p id='summary'>{len(failing)} figure(s) and {len(tables)} table(s) differ from their "
