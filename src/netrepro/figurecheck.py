@@ -245,7 +245,7 @@ def _compare_values(where: str, ref, got, rtol: float, atol: float, out: list, f
         j = np.unravel_index(int(np.argmax(err)), a.shape)
         rel = err[j] / abs(a[j]) if a[j] != 0 and np.isfinite(a[j]) else float("inf")
         out.append(f"{where}: {int((~ok).sum())} of {a.size} values differ, largest at {list(map(int, j))}: "
-                   f"{b[j]!r} vs reference {a[j]!r} (abs {err[j]:.3g}, rel {rel:.3g})")
+                   f"{float(b[j])!r} vs reference {float(a[j])!r} (abs {err[j]:.3g}, rel {rel:.3g})")
 
 
 def _weak(rules, k: int, i: int, artist: dict) -> bool:

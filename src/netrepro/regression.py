@@ -108,6 +108,11 @@ def _covered_rows(rule: dict, ref: pd.DataFrame, where: str) -> np.ndarray:
     return covered
 
 
+def _plain(value):
+    """A numpy scalar as the Python value (printed without its numpy type)."""
+    return value.item() if hasattr(value, "item") else value
+
+
 def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=(), cells=None) -> list[str]:
     """Differences between two CSV tables, as readable strings (empty when they agree).
 
@@ -142,7 +147,7 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
             ok = np.where(rows, _weak_agree(check, a, b, rtol, atol), ok)
         if not ok.all():
             if cells is not None:
-                cells.extend((int(r), col, b.iloc[r], a.iloc[r]) for r in np.flatnonzero(~ok)[:50])
+                cells.extend((int(r), col, _plain(b.iloc[r]), _plain(a.iloc[r])) for r in np.flatnonzero(~ok)[:50])
             i = int(np.argmin(ok))
             problems.append(f"{result}: column {col!r} differs in {int((~ok).sum())} rows "
                             f"(first at row {i}: {b.iloc[i]!r} vs reference {a.iloc[i]!r})")
