@@ -29,7 +29,6 @@ tolerance is reported but does not fail.
 from __future__ import annotations
 
 import html
-import io
 import json
 import re
 import shlex
@@ -41,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from .figuredata import SUFFIX, data_path
+from .io import atomic_path
 
 __all__ = ["RMS_TOLERANCE", "FigureDifference", "Baseline", "open_baseline", "compare_figure_data",
            "png_rms", "compare_figures", "load_figure_rules", "write_difference_page", "figure_jobs",
@@ -135,7 +135,7 @@ class Baseline:
         query = "".join(f"{rev}:{prefix}/{n}\n" for n in names).encode()
         out = subprocess.run(["git", "cat-file", "--batch"], cwd=self._top, input=query,
                              capture_output=True, check=True).stdout
-        buf = io.BytesIO(out)
+        buf = _bytes_io(out)
         for name in names:
             header = buf.readline().split()
             if len(header) < 3 or header[1] == b"missing":
@@ -301,10 +301,18 @@ def compare_figure_data(reference: dict, result: dict, rtol: float | None = None
 
 
 # ----------------------------------------------------------------------------- pixels
+def _bytes_io(data: bytes):
+    """A binary stream of ``data`` (the standard library's ``io``, imported here: module-level
+    ``import io`` next to ``from .io import`` hides ``netrepro.io`` from modulefinder, see tests/test_codedeps.py)."""
+    import io
+
+    return io.BytesIO(data)
+
+
 def _rgb(data: bytes) -> np.ndarray:
     from PIL import Image
 
-    return np.asarray(Image.open(io.BytesIO(data)).convert("RGB")).astype(np.int16)
+    return np.asarray(Image.open(_bytes_io(data)).convert("RGB")).astype(np.int16)
 
 
 def png_rms(reference: bytes, result: bytes) -> float | None:
@@ -322,7 +330,7 @@ def png_rms(reference: bytes, result: bytes) -> float | None:
 def _image_size(data: bytes) -> tuple[int, int]:
     from PIL import Image
 
-    return Image.open(io.BytesIO(data)).size
+    return Image.open(_bytes_io(data)).size
 
 
 # ----------------------------------------------------------------------------- all figures
@@ -448,7 +456,8 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
         parts.append("</section>")
     parts.append("</body></html>")
     page = out / "index.html"
-    page.write_text("\n".join(parts))
+    with atomic_path(page) as tmp:
+        tmp.write_text("\n".join(parts))
     return page
 
 

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .io import atomic_path
+
 __all__ = ["SUFFIX", "FORMAT", "data_path", "describe_figure", "write_figure_data"]
 
 SUFFIX = ".data.json"
@@ -177,8 +179,6 @@ def describe_figure(fig) -> dict:
 
 def write_figure_data(fig, png) -> Path:
     """Write ``describe_figure(fig)`` beside the PNG ``png`` (atomically); returns its path."""
-    from .io import atomic_path
-
     target = data_path(png)
     text = json.dumps(describe_figure(fig), separators=(",", ":"), allow_nan=False)
     with atomic_path(target) as tmp:
