@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report test lint lock bench verify clean clean-results readme
+.PHONY: report test lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -48,6 +48,19 @@ lint: $(STAMP_TEST)
 	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/snakemake --lint
 	$(BIN)/python -m netrepro check-paper
+	$(BIN)/actionlint .github/workflows/regenerate.yml
+
+# What CI runs after its build (after `make report`): every table against the checksum in its
+# provenance sidecar, then tables and figures against the committed references; on a difference
+# it fails and writes results/regeneration/index.html (README: "Checking that figures regenerate").
+check: $(STAMP)
+	$(BIN)/python -m netrepro verify
+	$(BIN)/python -m netrepro.regression compare --reference tests/reference --results results
+
+# An intended change: the last build becomes the reference (tables into tests/reference/; the
+# figures and their data sidecars are already in figures/). Prints what changed; then commit both.
+update-references: $(STAMP)
+	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
 lock: $(STAMP)
@@ -69,7 +82,7 @@ bench: $(STAMP)
 # Everything the pipeline makes: tables, logs, figures (committed, but rebuilt), the report and
 # Snakemake's metadata (its conda/container caches stay). `make report` afterwards runs every job.
 CLEAN_PATHS = results logs report/*.html report/*.ipynb report/*.meta.json report/files \
-	report/ro-crate-metadata.json report/*.png figures/*/*.png figures/*/*.meta.json
+	report/ro-crate-metadata.json report/README.md report/*.png figures/*/*.png figures/*/*.data.json figures/*/*.meta.json
 clean:
 	rm -rf $(CLEAN_PATHS)
 	test ! -d .snakemake || find .snakemake -mindepth 1 -maxdepth 1 ! -name conda ! -name singularity \

@@ -99,3 +99,33 @@ def test_committed_platform_rules_name_existing_reference_columns_with_a_reason(
         for rule in entries:
             assert set(rule["columns"]) <= columns, (table, rule["columns"])
             assert len(rule["reason"].split()) >= 5, (table, rule["reason"])
+
+
+def test_a_result_table_without_a_reference_fails_naming_it(tmp_path):
+    """Issue 30: a new table is never silently skipped (timings and shards have no reference)."""
+    from netrepro.regression import main
+
+    ref, got = _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
+    for extra in ("p/new.csv", "benchmarks.csv", "p/shards/s0.csv"):
+        (tmp_path / "res" / extra).parent.mkdir(parents=True, exist_ok=True)
+        pd.DataFrame({"x": [2.0]}).to_csv(tmp_path / "res" / extra, index=False)
+    count, problems = compare_trees(tmp_path / "ref", tmp_path / "res")
+    assert count == 1 and len(problems) == 1
+    assert "p/new.csv: no reference" in problems[0]
+    assert main(["compare", "--reference", str(tmp_path / "ref"), "--results", str(tmp_path / "res"),
+                 "--figures", "", "--html", "", "--platform-rules", ""]) == 1
+
+
+def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
+    from netrepro.regression import main
+
+    _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.5]}))
+    _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}), name="p/same.csv")
+    (tmp_path / "ref" / "p" / "gone.csv").write_text("x\n1\n")
+    pd.DataFrame({"y": [3]}).to_csv(tmp_path / "res" / "p" / "new.csv", index=False)
+    args = ["--reference", str(tmp_path / "ref"), "--results", str(tmp_path / "res"), "--figures", "", "--platform-rules", ""]
+    assert main(["update", *args]) == 0
+    out = capsys.readouterr().out
+    assert "table changed: " in out and "p/t.csv" in out and "table added: " in out and "p/new.csv" in out
+    assert "table removed: " in out and "p/gone.csv" in out and "same.csv" not in out
+    assert main(["compare", *args, "--html", ""]) == 0

@@ -12,7 +12,14 @@ holds copies of everything it describes (the report is self-contained, see ``rep
   hash and commit; result: every table, figure and page);
 * one ``CreateAction`` per job, from the provenance sidecars (instrument: its Snakemake rule;
   object: the tables it read; result: what it wrote; start and end time);
-* every result table and figure (``files/data/``) with its SHA-256 and size.
+* every result table and figure (``files/data/``) with its SHA-256 and size;
+* a ``README.md`` about the crate (Workflow RO-Crate).
+
+It also claims the Provenance Run Crate profile: the workflow lists the rules it orchestrates
+(``hasPart``), each the ``instrument`` of its jobs' actions. ``tests/test_crate_validator.py``
+runs the community's validator (``rocrate-validator``, offline, with the JSON-LD contexts kept in
+``tests/data/rocrate/``): every REQUIRED check of workflow-run-crate-0.5 and
+provenance-run-crate-0.5 passes, and every RECOMMENDED one but a short allow-list with reasons.
 
 Written as JSON-LD directly (no library needed to write it); ``tests/test_release_crate.py``
 reads it back, checks it against the sidecars and, where the ``rocrate`` library is installed
@@ -25,6 +32,7 @@ import datetime as _dt
 import json
 import mimetypes
 import os
+import re
 from pathlib import Path
 
 from .io import atomic_path, sha256_file
@@ -35,10 +43,50 @@ CONTEXT = ["https://w3id.org/ro/crate/1.1/context", "https://w3id.org/ro/terms/w
 PROFILES = {
     "https://w3id.org/ro/wfrun/process/0.5": ("Process Run Crate", "0.5"),
     "https://w3id.org/ro/wfrun/workflow/0.5": ("Workflow Run Crate", "0.5"),
+    "https://w3id.org/ro/wfrun/provenance/0.5": ("Provenance Run Crate", "0.5"),
     "https://w3id.org/workflowhub/workflow-ro-crate/1.0": ("Workflow RO-Crate", "1.0"),
 }
 SNAKEMAKE_LANGUAGE = "https://w3id.org/workflowhub/workflow-ro-crate#snakemake"
 LICENSE = "https://spdx.org/licenses/BSD-3-Clause"
+BIOSCHEMAS_WORKFLOW = "https://bioschemas.org/profiles/ComputationalWorkflow/1.0-RELEASE"
+COMPLETED = "http://schema.org/CompletedActionStatus"  # a string, as Process Run Crate 0.5 lists it
+# the crate's author and publisher: the project's maintainers (CITATION.cff `authors`)
+MAINTAINERS = {"@id": "#netrepro-maintainers", "@type": "Organization", "name": "The netrepro maintainers"}
+README = """# RO-Crate of a netrepro report
+
+This folder is a Workflow Run Crate (and a Provenance Run Crate): `ro-crate-metadata.json`
+describes how one run of the netrepro Snakemake workflow made the report (`index.html`, one page
+per paper) and every result table and figure copied under `files/data/`, job by job: the rule
+each job ran, the tables it read, what it wrote, when, and the package versions. The workflow's
+sources and configuration are under `files/workflow/`. Open `index.html` to read the report.
+"""
+
+
+def _software_id(name: str, version: str) -> str:
+    """An absolute, resolvable identifier of a package release (PyPI; python.org for Python)."""
+    if name.lower() == "python":
+        return f"https://www.python.org/downloads/release/python-{version.replace('.', '')}/"
+    return f"https://pypi.org/project/{name}/{version}/"
+
+
+def _rule_source(crate_root: Path, rule: str, workflow_files: list[str]) -> str:
+    """The crate path of the workflow file that defines ``rule`` (generated rules: the file that generates them)."""
+    texts = {f: (crate_root / f).read_text(errors="replace") if (crate_root / f).is_file() else ""
+             for f in workflow_files}
+    for f, text in texts.items():
+        if f"rule {rule}:" in text:
+            return f
+    generated = [f for f, text in texts.items() if "name:" in text and "_spec.rule" in text]
+    if generated and re.search(r"_(fig\w+|notebook)$", rule):
+        return generated[0]
+    return workflow_files[0]
+
+
+def _single(value):
+    """RO-Crate 1.1 (JSON-LD appendix): a property with one value is that value, not a one-element list."""
+    if isinstance(value, list) and len(value) == 1:
+        return value[0]
+    return value
 
 
 def iso(timestamp: float) -> str:
@@ -107,8 +155,8 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     for name, version in versions.items():
         if version is None:
             continue
-        packages.append({"@id": f"#software-{name}", "@type": "SoftwareApplication", "name": name,
-                         "version": str(version)})
+        packages.append({"@id": _software_id(name, str(version)), "@type": "SoftwareApplication", "name": name,
+                         "version": str(version), "url": _software_id(name, str(version))})
 
     # one action per job, from the sidecars
     jobs: dict[str, list[tuple[str, dict]]] = {}
@@ -121,13 +169,14 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
         rule = rule_of(meta)
         rules.setdefault(rule, {"@id": f"#rule-{rule}", "@type": "SoftwareApplication", "name": rule,
                                 "description": f"Snakemake rule {rule}: calls {meta.get('function', '?')}",
-                                "isPartOf": {"@id": main}})
+                                "url": _rule_source(root, rule, workflow_files),
+                                "version": str(run.get("commit")), "isPartOf": {"@id": main}})
         results = [data_id(p) for p, _ in sorted(members)]
         objects = sorted({data_id(item["path"]) for _, m in members for item in (m.get("inputs") or {}).values()
                           if item.get("path") in sidecars})
         action = {"@id": action_id(rule, index), "@type": "CreateAction", "name": f"rule {rule}",
                   "instrument": {"@id": f"#rule-{rule}"}, "object": _ref(objects), "result": _ref(results),
-                  "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"}}
+                  "actionStatus": COMPLETED}
         end = meta.get("finished")  # sidecars before "finished" was recorded: the file's time
         first = Path(sorted(members)[0][0])
         if not end and first.is_file():
@@ -152,7 +201,9 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
         "endTime": run["end"],
         "object": _ref([*config_files, "#config-hash", "#commit"]),
         "result": _ref([*pages, *sorted(data_id(p) for p in sidecars)]),
-        "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"},
+        "actionStatus": COMPLETED,
+        "description": "One run of the netrepro Snakemake workflow (`make report`): every job below, then the "
+                       "report pages; object: the configuration files, its hash and the commit.",
     }
     values = [
         {"@id": "#config-hash", "@type": "PropertyValue", "name": "config_hash", "value": str(run.get("config_hash")),
@@ -165,23 +216,32 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
                        encodingFormat="text/x-snakemake"),
         "@type": ["File", "SoftwareSourceCode", "ComputationalWorkflow"],
         "programmingLanguage": {"@id": SNAKEMAKE_LANGUAGE},
-        "version": str(run.get("commit")), "license": {"@id": LICENSE},
-        "hasPart": _ref(workflow_files[1:]),
+        "version": str(run.get("commit")), "license": {"@id": LICENSE}, "url": main,
+        # Provenance Run Crate: the workflow lists the tools it orchestrates (its rules)
+        "hasPart": _ref(r["@id"] for _, r in sorted(rules.items())),
         "softwareRequirements": _ref(p["@id"] for p in packages),
+        "conformsTo": {"@id": BIOSCHEMAS_WORKFLOW},
     }
-    has_part = [*workflow_files, *config_files, *pages, *sorted(files)]
+    (root / "README.md").write_text(README)
+    os.chmod(root / "README.md", 0o644)
+    has_part = ["README.md", *workflow_files, *config_files, *pages, *sorted(files)]
     graph.append({"@id": "ro-crate-metadata.json", "@type": "CreativeWork", "about": {"@id": "./"},
                   "conformsTo": _ref(["https://w3id.org/ro/crate/1.1",
                                       "https://w3id.org/workflowhub/workflow-ro-crate/1.0"])})
     graph.append({"@id": "./", "@type": "Dataset", "name": "Reproduction report: networked estimation and control",
                   "description": "The report, its tables and figures, and how one run of the netrepro workflow made them.",
                   "datePublished": run["end"], "license": {"@id": LICENSE},
+                  "author": {"@id": MAINTAINERS["@id"]}, "publisher": {"@id": MAINTAINERS["@id"]},
                   "conformsTo": _ref(PROFILES), "mainEntity": {"@id": main},
                   "hasPart": _ref(data_id(p) if p in sidecars else p for p in has_part),
                   "mentions": _ref([run_id, *(a["@id"] for a in actions)])})
     graph.extend({"@id": url, "@type": "CreativeWork", "name": name, "version": version}
                  for url, (name, version) in PROFILES.items())
     graph.append({"@id": LICENSE, "@type": "CreativeWork", "name": "BSD 3-Clause License"})
+    graph.append(dict(MAINTAINERS))
+    graph.append({"@id": BIOSCHEMAS_WORKFLOW, "@type": "CreativeWork", "name": "Bioschemas ComputationalWorkflow profile",
+                  "version": "1.0-RELEASE"})
+    graph.append(_file_entity(root, "README.md", "README.md", encodingFormat="text/markdown", about={"@id": "./"}))
     graph.append({"@id": SNAKEMAKE_LANGUAGE, "@type": "ComputerLanguage", "name": "Snakemake",
                   "identifier": {"@id": "https://doi.org/10.12688/f1000research.29032.2"},
                   "url": {"@id": "https://snakemake.readthedocs.io"},
@@ -197,6 +257,7 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     graph.extend(actions)
     graph.extend(rules[r] for r in sorted(rules))
     graph.extend(packages)
+    graph = [{key: value if key == "@id" else _single(value) for key, value in entity.items()} for entity in graph]
     out = Path(out) if out else root / "ro-crate-metadata.json"
     with atomic_path(out) as tmp:
         tmp.write_text(json.dumps({"@context": CONTEXT, "@graph": graph}, indent=1) + "\n")

@@ -45,8 +45,15 @@ def new_figure(nrows=1, ncols=1, figsize=(6.4, 4.0), **kw):
 
 
 def save_figure(fig, path) -> None:
-    """Save atomically as PNG without software/date metadata, then close the figure."""
+    """Save atomically as PNG without software/date metadata, then close the figure.
+
+    Beside the PNG goes its data sidecar ``<name>.data.json`` (:mod:`netrepro.figuredata`):
+    what the figure draws, the figure's reference for ``python -m netrepro.regression compare``.
+    """
+    from .figuredata import write_figure_data
+
     plt = _pyplot()
     with plt.rc_context(STYLE), atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", metadata={"Software": None}, bbox_inches="tight")
+    write_figure_data(fig, path)
     plt.close(fig)

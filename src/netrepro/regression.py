@@ -1,10 +1,14 @@
-"""Figures regenerate: compare a run's result tables with committed reference values.
+"""Figures regenerate: compare a run's result tables and figures with the committed references.
 
-``python -m netrepro.regression compare`` checks every table under
-``tests/reference/`` against the same path under ``results/``: string
+``python -m netrepro.regression compare`` (what CI and ``make check`` run) checks every table
+under ``tests/reference/`` against the same path under ``results/`` (a result table without a
+reference is a difference too), and every figure under ``figures/`` against its committed
+version (:mod:`netrepro.figurecheck`: what it draws, with the tables' tolerances, and its
+pixels); on any difference it writes ``results/regeneration/index.html``. String
 columns exactly, numeric columns within ``rtol``/``atol`` (seeds are fixed, so
 differences only come from floating-point details of the platform).
-``python -m netrepro.regression update`` refreshes the references from ``results/``.
+``python -m netrepro.regression update`` refreshes the reference tables from ``results/`` and
+prints what changed (the figures' references are the committed files under ``figures/``).
 Measured times (columns named like ``*time*``, ``seconds``, ...) and the free-text
 ``note`` of claims tables are not compared. Numbers printed inside text are compared
 with the numeric tolerance, the words exactly. The few values that legitimately
@@ -19,6 +23,7 @@ import argparse
 import re
 import shutil
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +36,8 @@ RTOL = 1e-6
 ATOL = 1e-9
 # measured times are not reproducible values; claim notes may quote them
 VOLATILE_COLUMNS = re.compile(r"time|seconds|per_second|extrapolated|fit_exponent", re.I)
+# where the figures' references live in the repository (their committed versions: --figure-reference git:REV)
+FIGURES = Path("figures")
 PLATFORM_RULES = Path(__file__).resolve().parents[2] / "tests" / "platform_dependent.yaml"
 CHECKS = ("sign", "text", "finite", "info")
 # a decimal number as printed in a table or a sentence (sign, digits, optional exponent)
@@ -51,6 +58,8 @@ def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, l
         return {}
     rules = {}
     for i, rule in enumerate(yaml.safe_load(Path(path).read_text()) or []):
+        if "figure" in rule and "table" not in rule:  # figure entries: netrepro.figurecheck.load_figure_rules
+            continue
         missing = {"table", "columns", "check", "reason"} - set(rule)
         if missing or rule["check"] not in CHECKS:
             raise ValueError(f"{path}: entry {i} ({rule.get('table')}): needs table, columns, "
@@ -99,11 +108,17 @@ def _covered_rows(rule: dict, ref: pd.DataFrame, where: str) -> np.ndarray:
     return covered
 
 
-def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()) -> list[str]:
+def _plain(value):
+    """A numpy scalar as the Python value (printed without its numpy type)."""
+    return value.item() if hasattr(value, "item") else value
+
+
+def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=(), cells=None) -> list[str]:
     """Differences between two CSV tables, as readable strings (empty when they agree).
 
     ``rules`` are this table's entries of ``tests/platform_dependent.yaml``: in the rows and
-    columns they cover, their weaker check replaces the comparison of values.
+    columns they cover, their weaker check replaces the comparison of values. ``cells``: a list
+    that receives ``(row, column, result, reference)`` of the differing cells (at most 50 per column).
     """
     ref, got = pd.read_csv(reference), pd.read_csv(result)
     problems = []
@@ -131,18 +146,28 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
         for rows, check in weak.get(col, []):
             ok = np.where(rows, _weak_agree(check, a, b, rtol, atol), ok)
         if not ok.all():
+            if cells is not None:
+                cells.extend((int(r), col, _plain(b.iloc[r]), _plain(a.iloc[r])) for r in np.flatnonzero(~ok)[:50])
             i = int(np.argmin(ok))
             problems.append(f"{result}: column {col!r} differs in {int((~ok).sum())} rows "
                             f"(first at row {i}: {b.iloc[i]!r} vs reference {a.iloc[i]!r})")
     return problems
 
 
-def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None,
+def _result_tables(results_dir: Path) -> list[Path]:
+    """The result tables that have references: all CSVs but timings and shards (merged tables are checked)."""
+    return [t for t in sorted(Path(results_dir).rglob("*.csv"))
+            if t.name != "benchmarks.csv" and "shards" not in t.relative_to(results_dir).parts]
+
+
+def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, details=None,
                   **tol) -> tuple[int, list[str]]:
     """Compare every reference table with its result; returns (number compared, problems).
 
     ``platform_rules``: the file of platform-dependent values (``None``: compare all strictly;
-    the command line passes ``tests/platform_dependent.yaml``).
+    the command line passes ``tests/platform_dependent.yaml``). A result table without a
+    reference is a problem (a new table needs ``update``, else it would never be checked).
+    ``details``: a list that receives ``{"table", "problems", "cells"}`` per differing table.
     """
     rules = load_platform_rules(platform_rules)
     unknown = sorted(set(rules) - {p.relative_to(reference_dir).as_posix()
@@ -150,15 +175,41 @@ def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None,
     if unknown:
         raise ValueError(f"platform rules name tables without a reference: {', '.join(unknown)}")
     problems, count = [], 0
+    details = [] if details is None else details
     for ref in sorted(Path(reference_dir).rglob("*.csv")):
         rel = ref.relative_to(reference_dir)
         got = Path(results_dir) / rel
         count += 1
         if not got.is_file():
-            problems.append(f"{got}: missing (reference {ref})")
-            continue
-        problems.extend(compare_tables(ref, got, rules=rules.get(rel.as_posix(), ()), **tol))
+            found = [f"{got}: missing (reference {ref})"]
+            cells = []
+        else:
+            cells = []
+            found = compare_tables(ref, got, rules=rules.get(rel.as_posix(), ()), cells=cells, **tol)
+        if found:
+            problems.extend(found)
+            details.append({"table": got, "problems": found, "cells": cells})
+    for got in _result_tables(results_dir):
+        if not (Path(reference_dir) / got.relative_to(results_dir)).is_file():
+            found = [f"{got}: no reference in {reference_dir} (a new table: `make update-references`, then commit)"]
+            problems.extend(found)
+            details.append({"table": got, "problems": found, "cells": []})
     return count, problems
+
+
+def _update_tables(reference: Path, results: Path) -> list[str]:
+    """Replace the reference tables by the result tables; returns what changed (added, removed, changed)."""
+    old = {p.relative_to(reference).as_posix(): p.read_bytes() for p in reference.rglob("*.csv")} \
+        if reference.is_dir() else {}
+    new = {t.relative_to(results).as_posix(): t.read_bytes() for t in _result_tables(results)}
+    shutil.rmtree(reference, ignore_errors=True)
+    for rel, data in new.items():
+        target = reference / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_bytes(data)
+    return ([f"table added: {reference / r}" for r in sorted(set(new) - set(old))]
+            + [f"table removed: {reference / r}" for r in sorted(set(old) - set(new))]
+            + [f"table changed: {reference / r}" for r in sorted(set(old) & set(new)) if old[r] != new[r]])
 
 
 def main(argv=None) -> int:
@@ -168,25 +219,54 @@ def main(argv=None) -> int:
     parser.add_argument("--results", default="results")
     parser.add_argument("--platform-rules", default=str(PLATFORM_RULES),
                         help="values that differ between CPUs and their weaker checks ('' for none)")
+    parser.add_argument("--figures", default="figures", help="the built figures ('' to compare tables only)")
+    parser.add_argument("--figure-reference", default="git:HEAD",
+                        help="the figures' references: git:REV (committed files under figures/) or a folder")
+    parser.add_argument("--html", default="results/regeneration/index.html",
+                        help="the difference page, written when anything differs")
     args = parser.parse_args(argv)
     if args.command == "update":
-        ref = Path(args.reference)
-        shutil.rmtree(ref, ignore_errors=True)
-        for table in sorted(Path(args.results).rglob("*.csv")):
-            # timings are not reproducible values; shards are checked through their merged tables
-            if table.name == "benchmarks.csv" or "shards" in table.parts:
-                continue
-            target = ref / table.relative_to(args.results)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(table, target)
-        print(f"reference tables written to {ref}")
+        changes = _update_tables(Path(args.reference), Path(args.results))
+        if args.figures:
+            from .figurecheck import compare_figures, open_baseline
+
+            _, diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures)
+            for d in diffs:
+                changes.append(f"figure changed: figures/{d.name}.png (and its .data.json): " + "; ".join(
+                    (d.problems + d.notes)[:2]))
+            if args.figure_reference.startswith("git:"):
+                changes.append("figure references are the files under figures/: commit them with the tables")
+        for line in changes or ["nothing changed"]:
+            print(line)
+        print(f"reference tables written to {args.reference}")
         return 0
+    start = time.perf_counter()
+    details: list[dict] = []
     count, problems = compare_trees(Path(args.reference), Path(args.results),
-                                    platform_rules=args.platform_rules or None)
+                                    platform_rules=args.platform_rules or None, details=details)
     for line in problems:
         print("DIFF", line)
     print(f"regression: {count} reference tables compared, {len(problems)} differences")
-    return 1 if problems or count == 0 else 0
+    figure_diffs, failing, n_fig = [], [], 0
+    if args.figures:
+        from .figurecheck import compare_figures, load_figure_rules, open_baseline
+
+        n_fig, figure_diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures,
+                                              rules=load_figure_rules(args.platform_rules or None))
+        failing = [d for d in figure_diffs if d.problems]
+        for d in figure_diffs:
+            for line in d.problems:
+                print("DIFF", line)
+            for line in d.notes:
+                print("NOTE", line)
+        print(f"regression: {n_fig} figures compared, {len(failing)} differ "
+              f"({time.perf_counter() - start:.1f} s with the tables)")
+    if (problems or failing) and args.html:
+        from .figurecheck import write_difference_page
+
+        page = write_difference_page(Path(args.html).parent, failing, details)
+        print(f"regression: the differences, figure by figure: {page}")
+    return 1 if problems or failing or count == 0 or (args.figures and n_fig == 0) else 0
 
 
 if __name__ == "__main__":

@@ -1,0 +1,52 @@
+"""The user's CI (.github/workflows/regenerate.yml) runs what .ci/run runs (issue 26)."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+WORKFLOW = ROOT / ".github" / "workflows" / "regenerate.yml"
+MAKE = re.compile(r"^\s*make\s+([\w-]+)\s*$", re.M)
+
+
+def _workflow():
+    return yaml.safe_load(WORKFLOW.read_text())
+
+
+def _steps():
+    (job,) = _workflow()["jobs"].values()
+    return job, job["steps"]
+
+
+def test_the_workflow_runs_the_make_targets_of_ci_run_in_the_same_order():
+    ci = MAKE.findall((ROOT / ".ci" / "run").read_text())
+    _, steps = _steps()
+    workflow = [t for step in steps for t in MAKE.findall(step.get("run", ""))]
+    assert ci == workflow, f".ci/run runs make {ci}, the workflow make {workflow}"
+    assert ci[-1] == "check" and {"test", "lint", "clean", "report"} <= set(ci)
+
+
+def test_the_workflow_sets_up_like_ci_and_uploads_the_differences_on_failure():
+    job, steps = _steps()
+    runs = "\n".join(step.get("run", "") for step in steps)
+    assert "for setup in .ci/setup.d/*.sh" in runs and "for setup in .ci/setup.d/*.sh" in (ROOT / ".ci/run").read_text()
+    # `on:` is read by YAML 1.1 as True
+    triggers = _workflow().get("on", _workflow().get(True))
+    assert {"push", "pull_request", "schedule"} <= set(triggers)
+    assert "3.11" in job["container"]
+    cache = [s for s in steps if str(s.get("uses", "")).startswith("actions/cache")]
+    assert cache and cache[0]["with"]["path"] == ".venv" and "hashFiles('requirements/*.txt'" in cache[0]["with"]["key"]
+    upload = [s for s in steps if str(s.get("uses", "")).startswith("actions/upload-artifact")]
+    assert upload and upload[0]["if"] == "failure()"
+    assert "results/regeneration/" in upload[0]["with"]["path"] and "report/" in upload[0]["with"]["path"]
+
+
+def test_the_workflow_passes_actionlint_and_make_lint_runs_it():
+    actionlint = Path(sys.executable).parent / "actionlint"
+    proc = subprocess.run([str(actionlint), str(WORKFLOW)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    lint = re.search(r"^lint:.*?(?=^\S)", (ROOT / "Makefile").read_text(), re.M | re.S).group(0)
+    assert "actionlint .github/workflows/regenerate.yml" in lint
