@@ -35,7 +35,7 @@ $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 report: $(STAMP)
 	$(BIN)/snakemake --profile workflow/profiles/default -j$(JOBS) report
 	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html report
-	$(BIN)/python -m netrepro.reportgen relocate report/snakemake_report.html
+	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
 
 test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests

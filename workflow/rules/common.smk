@@ -12,7 +12,6 @@ try:
     from netrepro.config import check_dependencies, validate_config
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
-    from netrepro.reportgen import rule_for, workflow_producers
     from netrepro.verdicts import DATA_FILES, load_paper_data, paper_dir, referenced_tables
 except ImportError as exc:
     raise WorkflowError(
@@ -57,21 +56,8 @@ def as_json(obj):
 
 
 def io_json(wildcards, input, output):
-    """The job's rule name and named inputs and outputs, as shell-quoted JSON for the runner."""
-    rule_name = producing_rule(output[0])
-    return as_json(
-        {"rule": rule_name, "inputs": dict(input.items()), "outputs": dict(output.items())}
-    )
-
-
-def producing_rule(path):
-    """Name of the rule that writes ``path``, from the workflow's own rule table (built once)."""
-    if not _PRODUCERS:
-        _PRODUCERS.update(workflow_producers(workflow.rules))
-    return rule_for(path, _PRODUCERS)
-
-
-_PRODUCERS = {}
+    """The job's named inputs and outputs, as shell-quoted JSON for the runner."""
+    return as_json({"inputs": dict(input.items()), "outputs": dict(output.items())})
 
 
 def code(func):
@@ -83,12 +69,14 @@ def step(func="{params.func}"):
     """Shell command of a pipeline step: one call into the package.
 
     Rules generated in a loop pass ``params.func`` (their shell command is formatted when the
-    job runs, after the loop has moved on); hand-written rules pass the function here.
+    job runs, after the loop has moved on); hand-written rules pass the function here. The rule's
+    name reaches the runner as Snakemake's ``{rule}`` (recorded in every output's sidecar, which is
+    where the report reads it).
     """
     # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
         "OPENBLAS_NUM_THREADS={threads} OMP_NUM_THREADS={threads} "
-        f"{PYTHON} -m netrepro run --func {func} "
+        f"{PYTHON} -m netrepro run --rule {{rule}} --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )
 
@@ -101,7 +89,7 @@ def notebook(slug="{params.slug}"):
     """
     return (
         f"{PYTHON} -m netrepro verify --inputs {{input}} > {{log}} 2>&1 && "
-        f"{PYTHON} -m netrepro.reportgen notebook --slug {slug} "
+        f"{PYTHON} -m netrepro.report notebook --slug {slug} "
         "--notebook {input.notebook} --html {output.html} >> {log} 2>&1"
     )
 
