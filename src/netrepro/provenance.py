@@ -63,8 +63,29 @@ def params_hash(params) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def git_state(repo: str | Path = ".") -> dict:
-    """Commit hash and dirty flag of the repository holding ``repo`` (None outside git)."""
+# Tracked files that the workflow itself writes (the figures are committed and rebuilt). A build
+# that rewrites them has not changed the sources: they do not make the working tree "dirty",
+# else every job after the first figure of a build, and every figure panel of the report, said
+# "dirty" while the report's run identity (taken after the figures were committed) said "clean".
+BUILD_OUTPUTS = ("figures",)
+
+
+def git_state(repo: str | Path = ".", exclude=BUILD_OUTPUTS) -> dict:
+    """Commit hash and dirty flag of the repository holding ``repo`` (None outside git).
+
+    Parameters
+    ----------
+    repo : str or Path, default "."
+        A directory of the checkout.
+    exclude : tuple of str, default :data:`BUILD_OUTPUTS`
+        Paths (relative to the top of the checkout) whose changes do not count as dirty.
+
+    Returns
+    -------
+    dict
+        ``{"commit": sha or None, "dirty": bool or None}``: dirty when a tracked file outside
+        ``exclude`` differs from the commit.
+    """
     def _git(*args):
         return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, timeout=20)
 
@@ -72,7 +93,8 @@ def git_state(repo: str | Path = ".") -> dict:
         head = _git("rev-parse", "HEAD")
         if head.returncode != 0:
             return {"commit": None, "dirty": None}
-        status = _git("status", "--porcelain", "--untracked-files=no")
+        status = _git("status", "--porcelain", "--untracked-files=no", "--", ":/",
+                      *(f":(top,exclude){path}" for path in exclude))
         return {"commit": head.stdout.strip(), "dirty": bool(status.stdout.strip())}
     except (OSError, subprocess.TimeoutExpired):
         return {"commit": None, "dirty": None}
