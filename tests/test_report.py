@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from netrepro.report.html import relocate, strip_external_scripts
+from netrepro.report.markup import relocate, strip_external_scripts
 from netrepro.report.panel import config_keys, rule_name
 from netrepro.report.sections import table_view
 from netrepro.summary import scorecard
@@ -81,7 +81,7 @@ def test_findings_table_labels_known_results_and_shows_every_column():
     view = table_view(frame, "findings")
     assert view["columns"] == ["finding_id", "verdict", "condition", "known"]
     assert view["known"] == [True, False]
-    from netrepro.report.html import render
+    from netrepro.report.markup import render
 
     page = render("table.html", table=view, table_id="t")
     assert page.count("known result") == 1 and "sigma2 &lt;= 3" in page

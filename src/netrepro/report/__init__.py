@@ -2,7 +2,7 @@
 
 * :mod:`.notebooks`: the default thin notebook of a paper, the helpers its cells call, and its
   execution with papermill (with a timeout) into static HTML.
-* :mod:`.html`: offline pages (no network request), relocated paths, the Jinja2 templates.
+* :mod:`.markup`: offline pages (no network request), relocated paths, the Jinja2 templates.
 * :mod:`.site`: the copies under ``report/files/`` and the source pages.
 * :mod:`.sections`: scorecard, paper sections, claims, figures.
 * :mod:`.panel`: the provenance panel of a figure.

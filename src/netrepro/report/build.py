@@ -18,7 +18,7 @@ from ..io import atomic_path
 from ..provenance import git_state, package_versions
 from ..references import references_html
 from ..summary import scorecard
-from .html import read_csv, relocate_json, render, stylesheet
+from .markup import read_csv, relocate_json, render, stylesheet
 from .sections import table_view
 from .panel import provenance_chain, rule_name
 from .sections import paper_section, scorecard_html

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .html import relocate
+from .markup import relocate
 from .notebooks import EXECUTION_TIMEOUT_S, NotebookError, execute_notebook, make_notebook
 
 __all__ = ["main"]

@@ -19,7 +19,7 @@ import pandas as pd
 
 from ..errors import NetreproError
 from ..io import atomic_path
-from .html import relocate, strip_external_scripts
+from .markup import relocate, strip_external_scripts
 
 __all__ = ["EXECUTION_TIMEOUT_S", "NotebookError", "make_notebook", "figure_captions", "figure_sort_key",
            "show_figures", "show_table", "execute_notebook"]

@@ -13,7 +13,7 @@ import shlex
 from pathlib import Path
 
 from ..provenance import sidecar_path
-from .html import fmt_value, render
+from .markup import fmt_value, render
 
 __all__ = ["provenance_chain", "rule_name", "config_keys", "provenance_panel", "repo_relative"]
 

@@ -14,7 +14,7 @@ from ..papers import PAPERS
 from ..provenance import sidecar_path
 from ..summary import replication_summary, summary_sentences
 from ..verdicts import TESTABLE_VERDICTS, VERDICTS
-from .html import img, read_csv, render, rst_html
+from .markup import img, read_csv, render, rst_html
 from .notebooks import figure_captions, figure_sort_key
 from .panel import provenance_panel, rule_name
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from markupsafe import Markup
 
 from ..provenance import sidecar_path
-from .html import relocate_json, render
+from .markup import relocate_json, render
 from .panel import repo_relative
 
 __all__ = ["Site", "source_page", "source_pages"]
