@@ -66,6 +66,7 @@ def test_closure_matches_bytecode_reading_for_every_module():
         assert set(module_closure(module, SRC)) == bytecode_closure(module), module
 
 
+@pytest.mark.slow  # a dry run of the whole workflow
 def test_every_rule_lists_its_function_closure_within_the_import_closure(planned_jobs):
     assert len(planned_jobs) > 50
     runner = bytecode_closure("netrepro.runner")
@@ -79,6 +80,7 @@ def test_every_rule_lists_its_function_closure_within_the_import_closure(planned
     assert narrower > 20  # most steps reach only part of what their steps.py imports
 
 
+@pytest.mark.slow
 def test_markov_steps_reach_stability_only_for_the_map(planned_jobs):
     """Of the markov compute rules, only the stability map runs code of ``stability.py``."""
     reaching = {rule for rule, (func, listed) in planned_jobs.items()
@@ -149,6 +151,7 @@ def test_function_closure_follows_names_not_imports(tmp_path):
     assert reach("slow_step") == ["netrepro", "fast", "slow", "steps"]
 
 
+@pytest.mark.slow
 def test_plotting_modules_stay_out_of_compute_steps(planned_jobs):
     """An edit to a plotting module must not rerun a computation."""
     for rule, (func, listed) in planned_jobs.items():

@@ -47,7 +47,20 @@ _IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+[.\w]+[ \t]+import[ \t]+(?:\([^)]*\)|
 
 @functools.lru_cache(maxsize=None)
 def module_file(module: str, src: Path = _SRC) -> Path | None:
-    """The source file of a package module (``pkg/__init__.py`` for a package), or None if absent."""
+    """The source file of a package module (``pkg/__init__.py`` for a package), or None if absent.
+
+    Parameters
+    ----------
+    module : str
+        A dotted module name.
+    src : Path
+        The directory that holds the package.
+
+    Returns
+    -------
+    Path or None
+        The file.
+    """
     base = src.joinpath(*module.split("."))
     for candidate in (base.with_suffix(".py"), base / "__init__.py"):
         if candidate.is_file():
@@ -96,7 +109,20 @@ def _imports_cached(module: str, src: Path) -> tuple[str, ...]:
 
 
 def imported_modules(module: str, src: Path = _SRC) -> list[str]:
-    """Package modules that ``module`` imports directly (anywhere in its source)."""
+    """Package modules that ``module`` imports directly (anywhere in its source).
+
+    Parameters
+    ----------
+    module : str
+        A dotted module name.
+    src : Path
+        The directory that holds the package.
+
+    Returns
+    -------
+    list of str
+        The imported package modules, sorted.
+    """
     return list(_imports_cached(module, Path(src)))
 
 
@@ -107,7 +133,20 @@ def _with_parents(module: str) -> list[str]:
 
 
 def module_closure(module: str, src: Path = _SRC) -> list[str]:
-    """Every package module executed when ``module`` is imported and its functions run, sorted."""
+    """Every package module executed when ``module`` is imported and its functions run, sorted.
+
+    Parameters
+    ----------
+    module : str
+        A dotted module name.
+    src : Path
+        The directory that holds the package.
+
+    Returns
+    -------
+    list of str
+        The module, what it imports (transitively) and their parent packages.
+    """
     return list(_closure_cached(module, Path(src)))
 
 

@@ -9,3 +9,5 @@
 * :mod:`.build`: the report rule's step (:func:`build_index`), with the RO-Crate.
 * :mod:`.cli`: ``python -m netrepro.report``.
 """
+
+__all__: list[str] = []
