@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report test lint lock bench verify clean clean-results readme
+.PHONY: report test test-fast lint lock bench verify clean clean-results readme
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -39,6 +39,11 @@ report: $(STAMP)
 
 test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
+
+# The fast lane: every test that runs no Snakemake and no build (marked `slow`), with fewer
+# property-test examples (the hypothesis profile "fast", tests/conftest.py).
+test-fast: $(STAMP_TEST)
+	$(BIN)/python -m pytest -n 2 -m "not slow" --hypothesis-profile fast tests
 
 # Check every result table against the checksum in its provenance sidecar.
 verify: $(STAMP)

@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from netrepro import bench
 from netrepro.engines.riccati import Sensor, covariance_paths
@@ -57,6 +58,7 @@ def test_job_times_reads_snakemake_metadata(tmp_path):
     assert jobs.iloc[0]["rule"] == "r1" and jobs.iloc[0]["job_s"] == 4.5 and jobs.iloc[0]["step_s"] == 3.0
 
 
+@pytest.mark.slow  # runs every benchmark, one job process included (about a minute)
 def test_quick_mode_writes_every_benchmark(tmp_path):
     out = tmp_path / "b.csv"
     assert bench.main(["--quick", "--out", str(out)]) == 0

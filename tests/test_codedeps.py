@@ -55,7 +55,7 @@ def planned_jobs():
         args = shlex.split(line[line.index("-m netrepro run"):])
         func = args[args.index("--func") + 1]
         io = json.loads(args[args.index("--io") + 1])
-        jobs[args[args.index("--rule") + 1]] = (func, set(io["inputs"]["code"]))
+        jobs[io["rule"]] = (func, set(io["inputs"]["code"]))
     return jobs
 
 

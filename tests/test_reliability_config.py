@@ -22,7 +22,9 @@ from hypothesis import strategies as st
 from netrepro.config import ConfigError, DependencyError, check_dependencies, validate_config
 
 ROOT = Path(__file__).resolve().parents[1]
-SLOW_OK = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+# 40 examples, or fewer under a lighter hypothesis profile (`make test-fast`)
+SLOW_OK = settings(max_examples=min(40, settings.default.max_examples), deadline=None,
+                   suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 
 def base():
