@@ -8,12 +8,13 @@
 from __future__ import annotations
 
 import base64
+import functools
 import json
 import re
 from pathlib import Path
 
 import pandas as pd
-from jinja2 import Environment, PackageLoader
+from jinja2 import Environment, FileSystemBytecodeCache, PackageLoader
 from jinja2.ext import Extension
 from markupsafe import Markup, escape
 
@@ -240,6 +241,10 @@ def img(path: Path) -> Markup:
 def read_csv(path) -> pd.DataFrame | None:
     """A table, ``None`` if it is not built, an empty frame if it is empty.
 
+    The report reads a paper's claims, errata and findings tables in several sections: each
+    version of a file (size, modification time) is parsed once. The frame is shared: callers
+    must not modify it.
+
     Parameters
     ----------
     path : str or Path
@@ -253,6 +258,12 @@ def read_csv(path) -> pd.DataFrame | None:
     path = Path(path)
     if not path.is_file():
         return None
+    stat = path.stat()
+    return _read_csv(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=256)
+def _read_csv(path: str, mtime_ns: int, size: int) -> pd.DataFrame:
     try:
         return pd.read_csv(path)
     except pd.errors.EmptyDataError:
@@ -272,8 +283,28 @@ def _finalize(value):
     return blank(value)
 
 
+class _Bytecode(FileSystemBytecodeCache):
+    """Compiled templates kept in Jinja2's per-user cache directory (keyed by the template's
+    source checksum), so that the report job does not compile them again; a cache it cannot
+    write is skipped."""
+
+    def dump_bytecode(self, bucket):
+        try:
+            super().dump_bytecode(bucket)
+        except OSError:
+            pass
+
+
+def _bytecode_cache():
+    try:
+        return _Bytecode()
+    except OSError:  # no usable cache directory
+        return None
+
+
 _ENV = Environment(loader=PackageLoader("netrepro.report", "templates"), autoescape=True,
-                   extensions=[_JoinLines], finalize=_finalize, keep_trailing_newline=False)
+                   extensions=[_JoinLines], finalize=_finalize, keep_trailing_newline=False,
+                   bytecode_cache=_bytecode_cache())
 _ENV.filters.update(num=num, value=fmt_value, short=short, rst=rst_html,
                     css=lambda text: re.sub(r"[^a-z]+", "-", str(text).lower()).strip("-"))
 

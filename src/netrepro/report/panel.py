@@ -8,6 +8,7 @@ rule's shell command as Snakemake's ``{rule}``): the report reads no rule table 
 
 from __future__ import annotations
 
+import functools
 import json
 import shlex
 from pathlib import Path
@@ -35,15 +36,24 @@ def provenance_chain(path: str | Path, seen=None) -> list[dict]:
     """
     seen = set() if seen is None else seen
     path = Path(path)
-    side = sidecar_path(path)
-    if str(path) in seen or not side.is_file():
+    if str(path) in seen:
+        return []
+    meta = _sidecar(str(path))
+    if meta is None:
         return []
     seen.add(str(path))
-    meta = json.loads(side.read_text())
     chain = [meta]
     for item in meta.get("inputs", {}).values():
         chain.extend(provenance_chain(item["path"], seen))
     return chain
+
+
+@functools.lru_cache(maxsize=None)
+def _sidecar(path: str) -> dict | None:
+    """The sidecar of ``path`` (``None`` if it has none), read once per report: the chains of the
+    figures share their upstream tables."""
+    side = sidecar_path(path)
+    return json.loads(side.read_text()) if side.is_file() else None
 
 
 def rule_name(meta: dict) -> str:
@@ -92,6 +102,16 @@ def _flatten(obj, prefix="") -> dict:
     return {prefix: obj} if prefix else {}
 
 
+@functools.lru_cache(maxsize=None)
+def _by_leaf(config_json: str) -> dict[str, list]:
+    """Configuration keys by their last part (a key equal to a param's, or ending in it, has its
+    last part), for one configuration section (given as JSON: the steps of a paper share it)."""
+    by_leaf: dict[str, list] = {}
+    for k, v in _flatten(json.loads(config_json)).items():
+        by_leaf.setdefault(k.split(".")[-1], []).append((k, v))
+    return by_leaf
+
+
 def config_keys(params: dict, config_section: dict, slug: str) -> list[tuple[str, object, bool]]:
     """Each leaf of a step's params with the configuration key it came from.
 
@@ -112,10 +132,7 @@ def config_keys(params: dict, config_section: dict, slug: str) -> list[tuple[str
         param's name and holds the same value, otherwise the param's own name
         (a constant fixed in the rule, ``from_config`` False).
     """
-    # configuration keys by their last part (a key equal to the param's, or ending in it, has its last part)
-    by_leaf: dict[str, list] = {}
-    for k, v in _flatten(config_section or {}).items():
-        by_leaf.setdefault(k.split(".")[-1], []).append((k, v))
+    by_leaf = _by_leaf(json.dumps(config_section or {}, sort_keys=True))
     matches = {}
     for key, value in _flatten(params or {}).items():
         hits = [k for k, v in by_leaf.get(key.split(".")[-1], ()) if v == value]
