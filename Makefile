@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report test lint lock bench verify clean clean-results readme check update-references
+.PHONY: report test test-fast lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -35,10 +35,15 @@ $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 report: $(STAMP)
 	$(BIN)/snakemake --profile workflow/profiles/default -j$(JOBS) report
 	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html report
-	$(BIN)/python -m netrepro.reportgen relocate report/snakemake_report.html
+	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
 
 test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
+
+# The fast lane: every test that runs no Snakemake and no build (marked `slow`), with fewer
+# property-test examples (the hypothesis profile "fast", tests/conftest.py).
+test-fast: $(STAMP_TEST)
+	$(BIN)/python -m pytest -n 2 -m "not slow" --hypothesis-profile fast tests
 
 # Check every result table against the checksum in its provenance sidecar.
 verify: $(STAMP)

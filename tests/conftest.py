@@ -8,6 +8,10 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 import pytest
+from hypothesis import settings
+
+# `make test-fast` (pytest --hypothesis-profile fast): fewer examples per property test
+settings.register_profile("fast", max_examples=10)
 
 
 @pytest.fixture

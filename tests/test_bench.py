@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from netrepro import bench
 from netrepro.engines.riccati import Sensor, covariance_paths
@@ -26,10 +27,22 @@ def test_reference_ge_loop_has_the_right_law():
     assert abs(stay - 0.8) < 0.02
 
 
-def test_median_time_counts_calls():
-    calls = []
-    t = bench.median_time(lambda: calls.append(1), repeats=3)
-    assert t >= 0 and len(calls) == 4
+def test_median_time_is_the_median_of_the_timed_calls(monkeypatch):
+    """On a fake clock: the warm-up call is not timed, the result is the median sample, and with
+    ``min_time`` each sample is the time per call of a loop lasting at least ``min_time``."""
+    from types import SimpleNamespace
+
+    clock = [0.0]
+    monkeypatch.setattr(bench, "time", SimpleNamespace(perf_counter=lambda: clock[0]))
+    durations = iter([100.0, 1.0, 5.0, 2.0])  # warm-up, then three timed calls
+
+    def call():
+        clock[0] += next(durations)
+
+    assert bench.median_time(call, repeats=3) == 2.0
+    durations = iter([100.0] + [1.0] * 3 + [3.0] + [0.5] * 5)  # 3 calls reach 2.5 s; then 1 call; then 5
+    assert bench.median_time(call, repeats=3, min_time=2.5) == 1.0  # samples 1.0, 3.0, 0.5 per call
+    assert next(durations, None) is None
 
 
 def test_job_times_reads_snakemake_metadata(tmp_path):
@@ -45,6 +58,7 @@ def test_job_times_reads_snakemake_metadata(tmp_path):
     assert jobs.iloc[0]["rule"] == "r1" and jobs.iloc[0]["job_s"] == 4.5 and jobs.iloc[0]["step_s"] == 3.0
 
 
+@pytest.mark.slow  # runs every benchmark, one job process included (about a minute)
 def test_quick_mode_writes_every_benchmark(tmp_path):
     out = tmp_path / "b.csv"
     assert bench.main(["--quick", "--out", str(out)]) == 0

@@ -1,90 +1,49 @@
-"""The public API is documented: ``__all__`` everywhere, numpydoc sections on engines and paper models.
+"""The public API is documented: ``__all__`` everywhere, numpydoc sections checked per parameter.
 
-Checked (issue 14):
+Checked (issues 14, 29):
 
-* every module of the package defines ``__all__`` (read from the source, nothing imported);
-  papers still in the old flat layout (``netrepro/papers/<slug>*.py``) are skipped;
-* every public function and class (a name in ``__all__``, defined in that module) of
-  ``netrepro.engines.*`` and of a paper's math modules (every module of a package
-  ``netrepro.papers.<slug>`` other than ``__init__``, ``steps``, ``claims``, ``figures``,
-  ``checks``) has a numpydoc ``Parameters`` section (functions with parameters; classes:
-  ``Parameters`` or ``Attributes``) and a ``Returns`` (or ``Yields``) section (functions that
-  return a value).
+* every module of the package defines ``__all__`` (read from the source, nothing imported), and
+  ``__all__`` names only what the module defines or imports (no stale name); a paper package's
+  ``__init__.py`` is the exception: a docstring only (``docs/adding-a-paper.md``), in one form
+  for every paper, whose ``Modules`` section names only modules that exist;
+* every public function and class (a name in ``__all__``, defined in that module) of every module
+  except the plotting modules (``netrepro.plotting``, the papers' ``figures``) and the command
+  lines (``__main__``, ``netrepro.report.cli``) has a numpydoc docstring, parsed by
+  ``numpydoc.docscrape`` as python-control's docstring test does
+  (``control/tests/docstrings_test.py``):
 
-Docstrings are split into numpydoc sections by the small parser below (a title line followed by
-a line of dashes as long as the title), no numpydoc dependency.
+  - each parameter of the signature (``*args`` and ``**kwargs`` included, ``self``/``cls`` and
+    names starting with ``_`` not) is listed in ``Parameters`` (or ``Other Parameters``) with a
+    description, and no listed parameter is missing from the signature;
+  - a function that returns (yields) a value has a ``Returns`` (``Yields``) section;
+  - a class documents its constructor's parameters in ``Parameters`` or ``Attributes``.
+
+The objects that do not pass yet (written before this check, in modules of other owners) are
+listed in ``tests/data/docstring_pending.txt`` and left out; every other public object is checked.
+Once the parallel edits of issue 29 are merged, :data:`PENDING_STRICT` turns on the check that
+each listed object exists and still fails (a documented one must leave the list).
 """
 
 import ast
 import importlib
-import importlib.util
 import inspect
 import pkgutil
+import re
 import textwrap
 from pathlib import Path
 
 import pytest
+from numpydoc.docscrape import NumpyDocString
 
 import netrepro
-import netrepro.engines
-import netrepro.papers
 
 SRC = Path(netrepro.__file__).resolve().parent
-NOT_MATH = {"__init__", "steps", "claims", "evidence", "figures", "checks"}
-
-
-def numpydoc_sections(doc: str | None) -> dict:
-    """Sections of a numpydoc docstring: title -> body text (the part before the first title under ``""``)."""
-    lines = textwrap.dedent(inspect.cleandoc(doc or "")).splitlines()
-    sections, title, body = {}, "", []
-    i = 0
-    while i < len(lines):
-        line = lines[i].strip()
-        nxt = lines[i + 1].strip() if i + 1 < len(lines) else ""
-        if line and nxt and set(nxt) == {"-"} and len(nxt) == len(line):
-            sections[title] = "\n".join(body).strip()
-            title, body = line, []
-            i += 2
-            continue
-        body.append(lines[i])
-        i += 1
-    sections[title] = "\n".join(body).strip()
-    return sections
-
-
-def test_parser_finds_numpydoc_sections():
-    doc = """Summary.
-
-    More text.
-
-    Parameters
-    ----------
-    x : float
-        The input.
-
-    Returns
-    -------
-    float
-        The output.
-    """
-    sec = numpydoc_sections(doc)
-    assert set(sec) == {"", "Parameters", "Returns"} and "x : float" in sec["Parameters"]
-    assert numpydoc_sections("Only a summary.\n\n    Parameters\n    ---\n") == {"": "Only a summary.\n\nParameters\n---"}
-    assert numpydoc_sections(None) == {"": ""}
-
-
-# ----------------------------------------------------------------------------- which modules
-def _is_flat_paper(name: str) -> bool:
-    """``netrepro.papers.<module>`` that is a plain module (the old one-file-per-paper layout)."""
-    parts = name.split(".")
-    return len(parts) == 3 and parts[1] == "papers" and not (SRC / "papers" / parts[2]).is_dir()
+# plotting and command lines: not part of the documented API
+NOT_DOCUMENTED = re.compile(r"^netrepro\.(plotting|__main__|report\.(cli|__main__)|papers\.\w+\.figures)$")
 
 
 def _all_modules():
-    names = ["netrepro"]
-    for info in pkgutil.walk_packages(netrepro.__path__, "netrepro."):
-        names.append(info.name)
-    return sorted(n for n in names if not _is_flat_paper(n))
+    return sorted(["netrepro", *(info.name for info in pkgutil.walk_packages(netrepro.__path__, "netrepro."))])
 
 
 def _source(name: str) -> Path:
@@ -94,30 +53,83 @@ def _source(name: str) -> Path:
 
 
 def _documented_modules():
-    names = [info.name for info in pkgutil.walk_packages(netrepro.engines.__path__, "netrepro.engines.")]
-    names.append("netrepro.engines")
-    for info in pkgutil.iter_modules(netrepro.papers.__path__, "netrepro.papers."):
-        if not info.ispkg:
-            continue  # old flat layout: skipped until the paper moves to its package
-        pkg = importlib.import_module(info.name)
-        names += [sub.name for sub in pkgutil.iter_modules(pkg.__path__, info.name + ".")
-                  if sub.name.rsplit(".", 1)[1] not in NOT_MATH]
-    return sorted(names)
+    return [name for name in _all_modules() if not NOT_DOCUMENTED.match(name)]
 
 
-@pytest.mark.parametrize("name", _all_modules())
-def test_every_module_defines_all(name):
-    tree = ast.parse(_source(name).read_text())
-    assigned = [t.id for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
-                for t in (node.targets if isinstance(node, ast.Assign) else [node.target]) if isinstance(t, ast.Name)]
-    assert "__all__" in assigned, f"{name} ({_source(name)}) defines no __all__"
+def _top_level_names(tree) -> set[str]:
+    """Names a module binds at its top level (definitions, assignments, imports)."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node in tree.body:
+            names.add(node.name)
+    for node in tree.body:
+        for sub in ([node] if not isinstance(node, (ast.If, ast.Try)) else ast.walk(node)):
+            if isinstance(sub, (ast.Assign, ast.AnnAssign)):
+                for target in (sub.targets if isinstance(sub, ast.Assign) else [sub.target]):
+                    names.update(n.id for n in ast.walk(target) if isinstance(n, ast.Name))
+            elif isinstance(sub, (ast.Import, ast.ImportFrom)):
+                names.update((a.asname or a.name).split(".")[0] for a in sub.names)
+            elif isinstance(sub, (ast.FunctionDef, ast.ClassDef)):
+                names.add(sub.name)
+    return names
 
 
-def test_module_lists_see_the_engines_and_skip_flat_papers():
-    mods = _all_modules()
-    assert "netrepro.engines.lmi" in mods and "netrepro.engines" in mods
-    assert not any(_is_flat_paper(m) for m in mods)
-    assert "netrepro.engines.certify" in _documented_modules()
+def _dunder_all(tree):
+    for node in tree.body:
+        if isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            if any(isinstance(t, ast.Name) and t.id == "__all__" for t in targets):
+                return node
+    return None
+
+
+class PackageDoc(NumpyDocString):
+    """A paper package's docstring: numpydoc sections plus ``Modules`` (name lines, indented text)."""
+
+    sections = {**NumpyDocString.sections, "Modules": []}
+
+
+PAPER_PACKAGE = re.compile(r"^netrepro\.papers\.\w+$")
+
+
+@pytest.mark.parametrize("name", [m for m in _all_modules() if PAPER_PACKAGE.match(m)])
+def test_paper_packages_are_a_docstring_naming_their_modules(name):
+    slug = name.rsplit(".", 1)[1]
+    path = _source(name)
+    tree = ast.parse(path.read_text())
+    assert len(tree.body) == 1 and isinstance(tree.body[0], ast.Expr), f"{path}: a docstring only"
+    doc = PackageDoc(ast.get_docstring(tree))
+    assert re.fullmatch(rf"Paper `{slug}`: .+, \*.+\*.*", " ".join(doc["Summary"])), doc["Summary"]
+    lines = doc["Modules"]
+    named = [line.strip("`") for line in lines if line and not line[0].isspace()]
+    assert named, f"{path}: no Modules section"
+    missing = [m for m in named if not (path.parent / f"{m}.py").is_file()]
+    assert not missing, f"{path} names modules that do not exist: {missing}"
+    described = [i + 1 < len(lines) and lines[i + 1][:1].isspace() for i, line in enumerate(lines)
+                 if line and not line[0].isspace()]
+    assert all(described), f"{path}: a module without a description"
+
+
+@pytest.mark.parametrize("name", [m for m in _all_modules() if not PAPER_PACKAGE.match(m)])
+def test_every_module_defines_all_naming_only_what_it_defines(name):
+    path = _source(name)
+    tree = ast.parse(path.read_text())
+    node = _dunder_all(tree)
+    assert node is not None, f"{name} ({path}) defines no __all__"
+    listed = ast.literal_eval(node.value)
+    bound = _top_level_names(tree)
+    # a package may list its submodules
+    stale = [n for n in listed if n not in bound and not (path.name == "__init__.py" and (
+        (path.parent / f"{n}.py").is_file() or (path.parent / n / "__init__.py").is_file()))]
+    assert not stale, f"{name}.__all__ names {stale}, which the module does not define"
+    assert len(set(listed)) == len(listed), f"{name}.__all__ lists a name twice"
+
+
+def test_all_check_catches_a_stale_name(tmp_path):
+    tree = ast.parse("from .x import a\n__all__ = ['a', 'b']\ndef b():\n    pass\nC = 1\n")
+    assert _top_level_names(tree) >= {"a", "b", "C"}
+    tree = ast.parse("__all__ = ['gone']\n")
+    assert "gone" not in _top_level_names(tree)
 
 
 # ----------------------------------------------------------------------------- which objects
@@ -148,12 +160,9 @@ def _returns_value(func) -> bool:
     return False
 
 
-def _has_parameters(func) -> bool:
-    try:
-        params = inspect.signature(func).parameters
-    except (TypeError, ValueError):
-        return True
-    return any(p not in ("self", "cls") for p in params)
+PENDING = {line.strip() for line in (Path(__file__).parent / "data" / "docstring_pending.txt").read_text().splitlines()
+           if line.strip() and not line.startswith("#")}
+PENDING_STRICT = False
 
 
 def _public_objects():
@@ -161,8 +170,8 @@ def _public_objects():
     for name in _documented_modules():
         mod = importlib.import_module(name)
         for attr in getattr(mod, "__all__", []):
-            if not hasattr(mod, attr) and importlib.util.find_spec(f"{name}.{attr}") is not None:
-                continue  # a submodule listed in a package's __all__: checked as a module of its own
+            if not hasattr(mod, attr):
+                continue  # a submodule listed in a package's __all__ (checked on its own), or a stale name
             obj = getattr(mod, attr)
             if not inspect.isclass(obj):  # compiled (numba) and cached (lru_cache) functions: the Python function
                 obj = getattr(obj, "py_func", obj)
@@ -172,19 +181,111 @@ def _public_objects():
     return out
 
 
-@pytest.mark.parametrize("obj", _public_objects())
-def test_public_api_has_numpydoc_sections(obj):
-    sec = numpydoc_sections(obj.__doc__)
-    missing = []
+def _documented_names(entries) -> dict[str, str]:
+    """``{name: description}`` of numpydoc parameter entries (``x, y : float`` documents both)."""
+    names = {}
+    for entry in entries:
+        for name in entry.name.split(","):
+            names[name.strip()] = "\n".join(entry.desc).strip()
+    return names
+
+
+def _signature_names(func, skip_first=False) -> list[str]:
+    try:
+        params = list(inspect.signature(func).parameters.values())
+    except (TypeError, ValueError):
+        return []
+    if skip_first and params:
+        params = params[1:]
+    out = []
+    for p in params:
+        if p.name in ("self", "cls") or p.name.startswith("_"):
+            continue
+        out.append({p.VAR_POSITIONAL: f"*{p.name}", p.VAR_KEYWORD: f"**{p.name}"}.get(p.kind, p.name))
+    return out
+
+
+def docstring_problems(obj) -> list[str]:
+    """What the numpydoc docstring of a public function or class lacks (empty: nothing)."""
+    doc = inspect.getdoc(obj)
+    if not doc:
+        return ["no docstring"]
+    try:
+        parsed = NumpyDocString(doc)
+    except Exception as exc:  # noqa: BLE001 - numpydoc's parse errors name the problem
+        return [f"numpydoc cannot parse it: {exc}"]
     if inspect.isclass(obj):
-        if "Parameters" not in sec and "Attributes" not in sec:
-            missing.append("Parameters or Attributes")
+        documented = _documented_names(parsed["Parameters"] + parsed["Other Parameters"] + parsed["Attributes"])
+        init = obj.__init__ if "__init__" in vars(obj) or getattr(obj, "__dataclass_fields__", None) else None
+        signature = _signature_names(init, skip_first=True) if init is not None else []
+        if not documented and not signature:
+            return [] if (parsed["Summary"] or parsed["Extended Summary"]) else ["no description"]
     else:
-        if _has_parameters(obj) and "Parameters" not in sec:
-            missing.append("Parameters")
-        if _returns_value(obj) and "Returns" not in sec and "Yields" not in sec:
-            missing.append("Returns")
-    assert not missing, f"{obj.__module__}.{obj.__qualname__}: docstring lacks {', '.join(missing)}"
+        documented = _documented_names(parsed["Parameters"] + parsed["Other Parameters"])
+        signature = _signature_names(obj)
+    problems = [f"parameter {p!r} is not documented" for p in signature if p not in documented]
+    problems += [f"parameter {p!r} has no description" for p in signature if documented.get(p) == ""]
+    if not inspect.isclass(obj):
+        stale = [p for p in documented if p.lstrip("*") not in {s.lstrip("*") for s in signature}]
+        if not any(s.startswith("**") for s in signature):
+            problems += [f"documented parameter {p!r} is not in the signature" for p in stale]
+        if _returns_value(obj) and not (parsed["Returns"] or parsed["Yields"]):
+            problems.append("no Returns (or Yields) section")
+    return problems
+
+
+@pytest.mark.parametrize("obj", [p for p in _public_objects() if p.id not in PENDING])
+def test_public_api_has_numpydoc_docstrings(obj):
+    problems = docstring_problems(obj)
+    assert not problems, f"{obj.__module__}.{obj.__qualname__}: {'; '.join(problems)}"
+
+
+def test_docstring_check_finds_each_problem():
+    def good(x, *args, flag=False, **options):
+        """Summary.
+
+        Parameters
+        ----------
+        x, flag : float
+            The input.
+        *args : int
+            More.
+        **options
+            Passed on.
+
+        Returns
+        -------
+        float
+            The output.
+        """
+        return x
+
+    def missing(x, y):
+        """Summary.
+
+        Parameters
+        ----------
+        x : float
+            The input.
+        z : int
+            Gone.
+        """
+        return x
+
+    def empty(x):
+        """Summary.
+
+        Parameters
+        ----------
+        x : float
+        """
+
+    assert docstring_problems(good) == []
+    assert docstring_problems(missing) == ["parameter 'y' is not documented",
+                                           "documented parameter 'z' is not in the signature",
+                                           "no Returns (or Yields) section"]
+    assert docstring_problems(empty) == ["parameter 'x' has no description"]
+    assert docstring_problems(lambda a: a) == ["no docstring"]
 
 
 def test_return_detection():
@@ -209,3 +310,20 @@ def test_return_detection():
 
     assert not _returns_value(none) and _returns_value(value) and not _returns_value(only_inner)
     assert _returns_value(gen) and not _returns_value(annotated)
+
+
+def test_module_lists_cover_everything_but_plotting_and_command_lines():
+    mods = _documented_modules()
+    assert {"netrepro.engines.lmi", "netrepro.verdicts", "netrepro.report.build", "netrepro.codedeps"} <= set(mods)
+    assert not {"netrepro.plotting", "netrepro.__main__", "netrepro.report.cli"} & set(mods)
+    assert not any(m.endswith(".figures") for m in mods)
+    assert any(m.endswith(".evidence") for m in mods) and any(m.endswith(".steps") for m in mods)
+
+
+@pytest.mark.skipif(not PENDING_STRICT, reason="other owners move and document functions in parallel (issue 29)")
+def test_pending_list_holds_only_undocumented_objects():
+    """Every line of the pending list is a public object whose docstring still fails (no stale line)."""
+    objects = {param.id: param.values[0] for param in _public_objects()}
+    assert PENDING <= set(objects), sorted(PENDING - set(objects))
+    passing = sorted(ident for ident in PENDING if not docstring_problems(objects[ident]))
+    assert not passing, f"documented now, delete from tests/data/docstring_pending.txt: {passing}"

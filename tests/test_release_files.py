@@ -120,7 +120,7 @@ def test_a_broken_citation_is_rejected_by_the_schema():
     schema = json.loads((ROOT / "tests/data/cff-1.2.0.schema.json").read_text())
     doc = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     del doc["authors"]
-    with pytest.raises(jsonschema.ValidationError):
+    with pytest.raises(jsonschema.ValidationError, match="'authors' is a required property"):
         jsonschema.Draft7Validator(schema).validate(doc)
 
 

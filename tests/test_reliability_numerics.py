@@ -132,7 +132,7 @@ def test_failing_step_keeps_no_stale_sidecar(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     run_step("demo", "tests.test_reliability_numerics:table_step", {"x": 1.0}, {}, {"table": "results/t.csv"})
     Path("results/t.csv").unlink()  # as snakemake does before rerunning a job
-    with pytest.raises(ZeroDivisionError):
+    with pytest.raises(ZeroDivisionError, match="division by zero"):
         run_step("demo", "tests.test_reliability_numerics:failing_step", {}, {}, {"table": "results/t.csv"})
     assert not Path("results/t.csv").exists() and not sidecar_path("results/t.csv").exists()
 
@@ -144,7 +144,7 @@ def failing_step(params, inputs, outputs):
 def test_atomic_path_exception_leaves_target_untouched(tmp_path):
     target = tmp_path / "x.csv"
     target.write_text("old\n")
-    with pytest.raises(RuntimeError), atomic_path(target) as tmp:
+    with pytest.raises(RuntimeError, match="^interrupted$"), atomic_path(target) as tmp:
         tmp.write_text("half")
         raise RuntimeError("interrupted")
     assert target.read_text() == "old\n" and list(tmp_path.iterdir()) == [target]

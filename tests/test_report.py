@@ -4,7 +4,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from netrepro.reportgen import config_keys, relocate, rule_for, scorecard, strip_external_scripts
+from netrepro.report.markup import relocate, strip_external_scripts
+from netrepro.report.panel import config_keys, rule_name
+from netrepro.report.sections import table_view
+from netrepro.summary import scorecard
 
 
 def test_scorecard_counts_and_total():
@@ -18,13 +21,10 @@ def test_scorecard_counts_and_total():
     assert score.loc["total", ["claims", "reproduced", "differs", "erratum", "other"]].tolist() == [6, 3, 1, 1, 1]
 
 
-def test_rule_for_files_and_wildcard_patterns():
-    producers = {"files": {"figures/x/fig1.png": "x_fig1"},
-                 "patterns": [[r"results/x/shards/part_(?P<i>[^/]+)\.csv$", "x_shard"]]}
-    assert rule_for("figures/x/fig1.png", producers) == "x_fig1"
-    assert rule_for("results/x/shards/part_3.csv", producers) == "x_shard"
-    assert rule_for("results/y.csv", producers) is None
-    assert rule_for("figures/x/fig1.png", None) is None
+def test_rule_name_is_the_one_the_sidecar_records():
+    assert rule_name({"rule": "x_shard", "output": "results/x/shards/part_3.csv"}) == "x_shard"
+    assert rule_name({"output": "results/y.csv"}) == "?"
+    assert rule_name({"rule": None}) == "?"
 
 
 def test_config_keys_names_the_configuration_entry():
@@ -63,11 +63,35 @@ def test_relocate_leaves_long_words_without_interpreter_alone(tmp_path):
 
 def test_source_pages_in_two_processes_equal_the_serial_pages():
     """The report rule (threads: 2) highlights the source pages in two processes: same pages, same order."""
-    from netrepro.reportgen import _source_page, _source_pages
+    from netrepro.report.site import source_page, source_pages
 
     root = Path(__file__).resolve().parents[1]
-    rels = ["src/netrepro/io.py", "src/netrepro/errors.py", "src/netrepro/reportgen.py", "src/netrepro/runner.py"]
-    serial = [_source_page(rel, (root / rel).read_text()) for rel in rels]
-    assert _source_pages(root, rels, workers=2) == serial
-    assert _source_pages(root, rels, workers=1) == serial
-    assert _source_pages(root, rels[:1], workers=4) == serial[:1]  # never more processes than files
+    rels = ["src/netrepro/io.py", "src/netrepro/errors.py", "src/netrepro/report/site.py", "src/netrepro/runner.py"]
+    serial = [source_page(rel, (root / rel).read_text()) for rel in rels]
+    assert source_pages(root, rels, workers=2) == serial
+    assert source_pages(root, rels, workers=1) == serial
+    assert source_pages(root, rels[:1], workers=4) == serial[:1]  # never more processes than files
+    assert 'id="L-1" class="line"' in serial[0] and serial[0].count('class="line"') == len(
+        (root / rels[0]).read_text().splitlines())
+
+
+def test_findings_table_labels_known_results_and_shows_every_column():
+    frame = pd.DataFrame({"paper": ["p", "p"], "finding_id": ["F1", "F2"], "verdict": ["holds", "conditional"],
+                          "condition": ["", "sigma2 <= 3"], "known": [True, False]})
+    view = table_view(frame, "findings")
+    assert view["columns"] == ["finding_id", "verdict", "condition", "known"]
+    assert view["known"] == [True, False]
+    from netrepro.report.markup import render
+
+    page = render("table.html", table=view, table_id="t")
+    assert page.count("known result") == 1 and "sigma2 &lt;= 3" in page
+    old = table_view(frame.drop(columns=["known"]), "findings")  # a findings table without the new columns
+    assert old["known"] == [] and "known result" not in render("table.html", table=old, table_id="t")
+
+
+def test_reconstruction_value_of_an_integer_setting_shows_as_an_integer():
+    frame = pd.DataFrame({"paper": ["m"] * 3, "key": ["paths.seed", "scalar.Ep0", "note"],
+                          "value": ["20150101.0", "10.0", "[C; CA]"]})
+    config = {"paths": {"seed": 20150101}, "scalar": {"Ep0": 10.0}}
+    rows = table_view(frame, "reconstructions", config)["rows"]
+    assert [r[1] for r in rows] == ["20150101", "10.0", "[C; CA]"]  # a float setting keeps its form

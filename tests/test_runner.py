@@ -44,7 +44,7 @@ def test_resolve_errors_name_the_problem():
 
 def test_failing_step_leaves_no_output(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(KeyError):
+    with pytest.raises(KeyError, match="^'x'$"):  # the step reads params["x"], which is not given
         run_step("demo", "tests.test_runner:table_step", {}, {}, {"table": "c.csv"})
     assert not (tmp_path / "c.csv").exists()
 

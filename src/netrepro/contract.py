@@ -75,7 +75,7 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
     required = {
         root / "workflow/rules" / f"{slug}.smk": "the paper's rules file",
         root / "workflow/schemas" / f"{slug}.schema.yaml": "the paper's configuration schema",
-        root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.reportgen make-notebook)",
+        root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.report make-notebook)",
         root / "tests/papers" / slug: "the paper's tests (tests/papers/<slug>/)",
         root / "tests/reference" / slug: "the committed reference tables (tests/reference/<slug>/; copy them from "
                                           "results/<slug>/ after a checked build)",

@@ -3,7 +3,7 @@
 The research-object standard for "this run produced these files from these inputs with this
 software" (https://w3id.org/ro/crate/1.1 with the Workflow Run Crate and Process Run Crate
 profiles 0.5, https://w3id.org/ro/wfrun/workflow/0.5). The crate's root is ``report/``, which
-holds copies of everything it describes (the report is self-contained, see ``reportgen``):
+holds copies of everything it describes (the report is self-contained, see ``netrepro.report``):
 
 * the workflow (``files/workflow/``: the Snakefiles and the configuration files), the crate's
   ``mainEntity``, a ``ComputationalWorkflow`` in Snakemake with the package versions as

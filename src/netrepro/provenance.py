@@ -58,13 +58,45 @@ TRACKED_PACKAGES = (
 
 
 def params_hash(params) -> str:
-    """SHA-256 (first 16 hex digits) of the canonical JSON of ``params``."""
+    """SHA-256 (first 16 hex digits) of the canonical JSON of ``params``.
+
+    Parameters
+    ----------
+    params : object
+        A JSON-like value (keys sorted; other objects as their ``str``).
+
+    Returns
+    -------
+    str
+        16 hexadecimal digits.
+    """
     blob = json.dumps(params, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
-def git_state(repo: str | Path = ".") -> dict:
-    """Commit hash and dirty flag of the repository holding ``repo`` (None outside git)."""
+# Tracked files that the workflow itself writes (the figures are committed and rebuilt). A build
+# that rewrites them has not changed the sources: they do not make the working tree "dirty",
+# else every job after the first figure of a build, and every figure panel of the report, said
+# "dirty" while the report's run identity (taken after the figures were committed) said "clean".
+BUILD_OUTPUTS = ("figures",)
+
+
+def git_state(repo: str | Path = ".", exclude=BUILD_OUTPUTS) -> dict:
+    """Commit hash and dirty flag of the repository holding ``repo`` (None outside git).
+
+    Parameters
+    ----------
+    repo : str or Path, default "."
+        A directory of the checkout.
+    exclude : tuple of str, default :data:`BUILD_OUTPUTS`
+        Paths (relative to the top of the checkout) whose changes do not count as dirty.
+
+    Returns
+    -------
+    dict
+        ``{"commit": sha or None, "dirty": bool or None}``: dirty when a tracked file outside
+        ``exclude`` differs from the commit.
+    """
     def _git(*args):
         return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, timeout=20)
 
@@ -72,14 +104,26 @@ def git_state(repo: str | Path = ".") -> dict:
         head = _git("rev-parse", "HEAD")
         if head.returncode != 0:
             return {"commit": None, "dirty": None}
-        status = _git("status", "--porcelain", "--untracked-files=no")
+        status = _git("status", "--porcelain", "--untracked-files=no", "--", ":/",
+                      *(f":(top,exclude){path}" for path in exclude))
         return {"commit": head.stdout.strip(), "dirty": bool(status.stdout.strip())}
     except (OSError, subprocess.TimeoutExpired):
         return {"commit": None, "dirty": None}
 
 
 def package_versions(names=TRACKED_PACKAGES) -> dict:
-    """Installed versions of the packages that shape the numbers."""
+    """Installed versions of the packages that shape the numbers.
+
+    Parameters
+    ----------
+    names : tuple of str, default :data:`TRACKED_PACKAGES`
+        Distribution names.
+
+    Returns
+    -------
+    dict
+        ``{"python": version, name: version or None}``.
+    """
     versions = {"python": platform.python_version()}
     for name in names:
         try:
@@ -94,6 +138,11 @@ def job_command() -> str:
 
     Snakemake's console shows one line per job; the full command of a step is kept here, in the
     sidecar of each output and once in the job's log (see :func:`write_sidecar`).
+
+    Returns
+    -------
+    str
+        The shell-quoted command, with paths under the checkout relative.
     """
     argv = getattr(sys, "orig_argv", None) or [sys.executable, *sys.argv]
     return shlex.join(_relative(arg) for arg in argv)
@@ -111,7 +160,20 @@ def _relative(arg: str) -> str:
 
 
 def find_seeds(params, prefix="") -> dict:
-    """All entries of a nested parameter dict whose key contains 'seed'."""
+    """All entries of a nested parameter dict whose key contains 'seed'.
+
+    Parameters
+    ----------
+    params : dict
+        A step's parameters.
+    prefix : str, default ""
+        Dotted path of ``params`` inside the outer dict (recursion).
+
+    Returns
+    -------
+    dict
+        ``{dotted key: seed}``.
+    """
     seeds = {}
     if isinstance(params, dict):
         for key, value in params.items():
@@ -124,6 +186,18 @@ def find_seeds(params, prefix="") -> dict:
 
 
 def sidecar_path(output: str | Path) -> Path:
+    """The provenance sidecar of a file.
+
+    Parameters
+    ----------
+    output : str or Path
+        A table or figure.
+
+    Returns
+    -------
+    Path
+        ``<output>.meta.json``.
+    """
     output = Path(output)
     return output.with_name(output.name + ".meta.json")
 
@@ -171,7 +245,20 @@ def step_environment(inputs: dict) -> dict:
 
 
 def write_sidecar(output: str | Path, record: StepRecord) -> Path:
-    """Write the provenance sidecar of ``output`` (which must exist)."""
+    """Write the provenance sidecar of ``output`` (which must exist).
+
+    Parameters
+    ----------
+    output : str or Path
+        The file the step wrote.
+    record : StepRecord
+        What the runner knows about the step.
+
+    Returns
+    -------
+    Path
+        The sidecar.
+    """
     global _COMMAND_LOGGED
     output = Path(output)
     command = job_command()
@@ -199,6 +286,18 @@ def write_sidecar(output: str | Path, record: StepRecord) -> Path:
 
 
 def read_sidecar(output: str | Path) -> dict:
+    """The provenance sidecar of a file, parsed.
+
+    Parameters
+    ----------
+    output : str or Path
+        A table or figure.
+
+    Returns
+    -------
+    dict
+        The sidecar.
+    """
     return json.loads(sidecar_path(output).read_text())
 
 
@@ -209,6 +308,18 @@ def write_unfinished_sidecar(output: str | Path, rule: str) -> Path:
     once the output is complete, so a job killed at any moment leaves its output either absent,
     marked unfinished, or complete with its checksum; never a result that looks written outside
     the pipeline, and never one that verifies.
+
+    Parameters
+    ----------
+    output : str or Path
+        The file about to be written.
+    rule : str
+        The job's rule.
+
+    Returns
+    -------
+    Path
+        The sidecar.
     """
     meta = {"output": str(output), "unfinished": True, "rule": rule,
             "started": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}
@@ -217,6 +328,16 @@ def write_unfinished_sidecar(output: str | Path, rule: str) -> Path:
 
 def verify_output(output: str | Path) -> dict:
     """Check ``output`` against its sidecar checksum; return the sidecar.
+
+    Parameters
+    ----------
+    output : str or Path
+        A table or figure.
+
+    Returns
+    -------
+    dict
+        The sidecar.
 
     Raises
     ------
@@ -255,7 +376,17 @@ def verify_output(output: str | Path) -> dict:
 
 @dataclass(frozen=True)
 class Verdict:
-    """The state of one file checked by :func:`verify_tree`."""
+    """The state of one file checked by :func:`verify_tree`.
+
+    Attributes
+    ----------
+    path : Path
+        The file.
+    status : str
+        ``"ok"``, ``"corrupt"``, ``"missing"``, ``"no-sidecar"``, ``"partial"`` or ``"unfinished"``.
+    message : str
+        What is wrong, for a reader.
+    """
 
     path: Path
     status: str  # "ok", "corrupt", "missing", "no-sidecar", "partial", "unfinished"
@@ -263,6 +394,7 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
+        """Whether the file verified."""
         return self.status == "ok"
 
 

@@ -164,7 +164,24 @@ def _verb(count: int, one: str, many: str) -> str:
 
 def summary_sentences(claims: pd.DataFrame, errata: pd.DataFrame | None, findings: pd.DataFrame | None,
                       summary: pd.DataFrame) -> list[str]:
-    """The replication summary of a paper in three sentences, every number counted from the tables."""
+    """The replication summary of a paper in three sentences, every number counted from the tables.
+
+    Parameters
+    ----------
+    claims : pandas.DataFrame
+        The paper's claims table.
+    errata : pandas.DataFrame or None
+        Its errata table.
+    findings : pandas.DataFrame or None
+        Its findings table.
+    summary : pandas.DataFrame
+        :func:`replication_summary` of the claims.
+
+    Returns
+    -------
+    list of str
+        The sentences.
+    """
     verdicts = _verdicts(claims)
     counts = verdicts.value_counts()
     testable = int(verdicts.isin(TESTABLE_VERDICTS).sum())

@@ -13,7 +13,6 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
-    from netrepro.reportgen import rule_for, workflow_producers
     from netrepro.verdicts import DATA_FILES, load_paper_data, paper_dir, referenced_tables
 except ImportError as exc:
     raise WorkflowError(
@@ -59,20 +58,38 @@ def as_json(obj):
 
 def io_json(wildcards, input, output):
     """The job's rule name and named inputs and outputs, as shell-quoted JSON for the runner."""
-    rule_name = producing_rule(output[0])
     return as_json(
-        {"rule": rule_name, "inputs": dict(input.items()), "outputs": dict(output.items())}
+        {
+            "rule": producing_rule(output[0]),
+            "inputs": dict(input.items()),
+            "outputs": dict(output.items()),
+        }
     )
 
 
 def producing_rule(path):
-    """Name of the rule that writes ``path``, from the workflow's own rule table (built once)."""
+    """Name of the rule that declares the output ``path`` (a wildcard output by its pattern).
+
+    The rules' declared outputs are read once from ``workflow.rules``. Not Snakemake's ``{rule}``
+    in the shell command: ``snakemake --lint`` reports it as a variable from outside the rule
+    (one lint per rule, and the lint test fails); nor a ``rule=`` param, which would be one more
+    line in each of the papers' rules.
+    """
     if not _PRODUCERS:
-        _PRODUCERS.update(workflow_producers(workflow.rules))
-    return rule_for(path, _PRODUCERS)
+        for each in workflow.rules:
+            for out in each.output:
+                if out.contains_wildcard():
+                    _PATTERNS.append((out.regex(), each.name))
+                else:
+                    _PRODUCERS[str(out)] = each.name
+    path = str(path)
+    if path in _PRODUCERS:
+        return _PRODUCERS[path]
+    return next((name for pattern, name in _PATTERNS if pattern.fullmatch(path)), "?")
 
 
 _PRODUCERS = {}
+_PATTERNS = []
 
 
 def code(func):
@@ -84,7 +101,9 @@ def step(func="{params.func}"):
     """Shell command of a pipeline step: one call into the package.
 
     Rules generated in a loop pass ``params.func`` (their shell command is formatted when the
-    job runs, after the loop has moved on); hand-written rules pass the function here.
+    job runs, after the loop has moved on); hand-written rules pass the function here. The rule's
+    name reaches the runner in ``params.io`` (:func:`io_json`) and is recorded in every output's
+    sidecar, which is where the report reads it.
     """
     # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
@@ -102,7 +121,7 @@ def notebook(slug="{params.slug}"):
     """
     return (
         f"{PYTHON} -m netrepro verify --inputs {{input}} > {{log}} 2>&1 && "
-        f"{PYTHON} -m netrepro.reportgen notebook --slug {slug} "
+        f"{PYTHON} -m netrepro.report notebook --slug {slug} "
         "--notebook {input.notebook} --html {output.html} >> {log} 2>&1"
     )
 

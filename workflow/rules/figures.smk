@@ -48,7 +48,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             f"{_slug}_notebook"
         input:
             notebook=f"workflow/notebooks/{_slug}.ipynb",
-            code=code("netrepro.reportgen"),
+            code=code("netrepro.report.notebooks"),
             figures=_figures,
             tables=PAPER_TABLES[_slug],
             claims=_claims,

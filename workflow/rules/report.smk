@@ -6,7 +6,6 @@ import os
 import platform
 
 from netrepro.provenance import params_hash
-from netrepro.reportgen import workflow_producers
 
 
 report: "../report/workflow.rst"
@@ -15,7 +14,7 @@ report: "../report/workflow.rst"
 rule report:
     input:
         unpack(report_inputs),
-        code=code("netrepro.reportgen:build_index"),
+        code=code("netrepro.report.build:build_index"),
         # titles and citations: a title fix reruns the report, and nothing of any paper
         registry="src/netrepro/papers.yaml",
     output:
@@ -36,11 +35,10 @@ rule report:
                 "config_hash": params_hash(config),
                 "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
                 "configfiles": [os.path.relpath(f) for f in workflow.overwrite_configfiles or []],
-                "producers": workflow_producers(workflow.rules),
                 "machine": f"{platform.system()} {platform.machine()}",
                 "benchmarks": "results/benchmarks.csv",
             }
         ),
         io=io_json,
     shell:
-        step("netrepro.reportgen:build_index")
+        step("netrepro.report.build:build_index")

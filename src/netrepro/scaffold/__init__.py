@@ -135,7 +135,7 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
 
 def write_plan(plan: Plan, root: str | Path = ".") -> list[str]:
     """Write the files of ``plan`` under ``root``; return their paths."""
-    from ..reportgen import make_notebook  # the report's notebook template, imported only when writing
+    from ..report.notebooks import make_notebook  # the report's notebook template, imported only when writing
 
     root = Path(root)
     for rel, text in plan.create.items():

@@ -10,8 +10,9 @@ Modules
 -------
 ``model``
     The scalar equations: critical probability, the Riccati step (6), the bounds s_k (10)
-    and r_k (9), the report's rough estimate of E(p_k), exact E(p_k) by enumeration,
-    Sinopoli's operator phi(K, p).
+    and r_k (9), the report's rough estimate of E(p_k), Sinopoli's operator phi(K, p).
+``exact``
+    Exact E(p_k) by enumeration of the arrival sequences.
 ``estimators``
     The conditional Monte Carlo estimator of E(p_k) (averages bounded quantities only).
 ``exact``
@@ -30,12 +31,9 @@ Modules
 ``steps``
     Pipeline steps writing ``results/intermittent/*.csv``.
 ``evidence``
-    Assembly only: the evidence table the claims, errata, reconstructions and findings
-    (``*.yaml`` beside this package) are judged against.
+    Our side of the claims, errata, findings and reconstructions (``results/evidence/``).
 ``figures``
-    Figs 1, 2, 4, 5, S1 and S2 from the tables.
+    Plotting only: Figs 1, 2, 4, 5 and S1 from the tables; ``figures.yaml`` lists them.
 ``checks``
-    ``check_config``: configuration checks beyond the schema.
+    Configuration checks the schema cannot express.
 """
-
-__all__ = []  # the modules are imported by name (netrepro.papers.intermittent.model, ...)

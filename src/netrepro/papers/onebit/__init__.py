@@ -1,5 +1,5 @@
-"""Paper `onebit` (002): L. Zhang, M. Stein, J. A. Nossek, *Asymptotic Performance Analysis for
-1-Bit Bayesian Smoothing*.
+"""Paper `onebit`: L. Zhang, M. Stein, J. A. Nossek, *Asymptotic Performance Analysis for 1-Bit
+Bayesian Smoothing*.
 
 Recursive Bayesian information matrices (BIMs) for filtering (7), prediction (14) and smoothing
 (16)-(19) in general vector form, their Gaussian random-walk specialisations (22)-(27), the 1-bit
@@ -17,8 +17,16 @@ Modules
     transients.
 ``estimators``
     Beyond the paper: simulation, the grid 1-bit filter/smoother, the Kalman filter/RTS smoother.
-``steps``, ``claims``, ``figures``, ``checks``
-    Pipeline steps, the paper's claims/errata/reconstructions, plotting, configuration checks.
+``kernels``
+    Compiled inner loops of the estimators.
+``steps``
+    Pipeline steps writing ``results/onebit/*.csv``.
+``shards``
+    Which estimator cases the sharded step runs, and how its shard files merge back (IO, no mathematics).
+``evidence``
+    Our side of the claims, errata, findings and reconstructions (``results/evidence/``).
+``figures``
+    Plotting only: Figs 1-2 and S1-S4 from the tables; ``figures.yaml`` lists them.
+``checks``
+    Configuration checks the schema cannot express.
 """
-
-__all__: list[str] = []

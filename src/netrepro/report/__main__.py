@@ -1,0 +1,8 @@
+"""``python -m netrepro.report`` (:func:`netrepro.report.cli.main`)."""
+
+from ..runner import exit_process
+from .cli import main
+
+__all__: list[str] = []
+
+exit_process(main())

@@ -1,0 +1,141 @@
+"""The report rule's step: ``report/index.html``, the copies under ``report/files/`` and the
+Workflow Run Crate ``report/ro-crate-metadata.json`` (written by :mod:`netrepro.crate`)."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+import platform
+from pathlib import Path
+
+import pandas as pd
+from markupsafe import Markup
+
+from ..crate import iso, write_crate
+from ..errors import ConfigError
+from ..figurespec import load_figure_specs
+from ..io import atomic_path
+from ..provenance import git_state, package_versions
+from ..references import references_html
+from ..summary import scorecard
+from .markup import read_csv, relocate_json, render, stylesheet
+from .sections import table_view
+from .panel import provenance_chain, rule_name
+from .sections import paper_section, scorecard_html
+from .site import Site
+
+__all__ = ["build_index"]
+
+
+def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
+    """Pipeline step: write ``report/index.html`` from claims, errata, figures and sidecars.
+
+    Parameters
+    ----------
+    params : dict
+        ``papers`` maps each slug to the outputs it registered in the Snakefile
+        (``PAPER_OUTPUTS``); ``config_hash`` identifies the run's configuration; optional
+        ``config`` (the papers' configuration sections, to name the configuration key of each
+        parameter), ``order`` (the papers in the order of the configuration; the JSON of
+        ``papers`` has its keys sorted), ``configfiles`` (given with ``--configfile``),
+        ``machine``, ``benchmarks`` (path of an optional benchmark table).
+    inputs : dict
+        The rule's inputs (read through ``params``; listed so that Snakemake orders the jobs).
+    outputs : dict
+        ``html``, and optionally ``files``, a folder receiving the linked source pages and
+        tables so that the report is self-contained, and ``crate``.
+
+    Returns
+    -------
+    dict
+        The scorecard, recorded in the report's provenance.
+    """
+    root = Path(".").resolve()
+    order = [s for s in params.get("order", []) if s in params["papers"]]
+    papers = {s: params["papers"][s] for s in order + sorted(set(params["papers"]) - set(order))}
+    files_dir = Path(outputs["files"]) if outputs.get("files") else None
+    # the rule's threads (exported by its shell command as OMP_NUM_THREADS) highlight the source pages
+    site = Site(root, files_dir, workers=int(os.environ.get("OMP_NUM_THREADS") or 1))
+    claims = {slug: read_csv(spec["claims"]) for slug, spec in papers.items()}
+    score = scorecard({s: (f if f is not None else pd.DataFrame({"verdict": []})) for s, f in claims.items()},
+                      errata={s: read_csv(spec["errata"]) for s, spec in papers.items() if spec.get("errata")},
+                      findings={s: read_csv(spec["findings"]) for s, spec in papers.items() if spec.get("findings")})
+    git = git_state()
+    versions = package_versions()
+    configfiles = params.get("configfiles", [])
+    ctx = {"root": root, "site": site, "config": params.get("config", {}), "configfiles": configfiles,
+           "commit": git["commit"], "layouts": _layouts(papers)}
+    run = {"commit": git["commit"], "dirty": git["dirty"], "config_hash": params["config_hash"],
+           "configfiles": configfiles, "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
+           "machine": params.get("machine", "") or f"{platform.system()} {platform.machine()}",
+           "platform": platform.platform()}
+    bench_path = Path(params.get("benchmarks") or "results/benchmarks.csv")
+    bench_frame = read_csv(bench_path)
+    bench = None if bench_frame is None else {
+        "path": bench_path, "html": Markup(render("table.html", table=table_view(bench_frame),
+                                                  table_id="benchmarks-table"))}
+    page = render("index.html", css=stylesheet(), papers=list(papers), run=run, versions=versions, bench=bench,
+                  scorecard=Markup(scorecard_html(score, papers)),
+                  sections=[Markup(paper_section(slug, spec, claims[slug], ctx)) for slug, spec in papers.items()],
+                  references=Markup(references_html(papers)))
+    sidecars = _run_sidecars(papers)
+    workflow_files = _workflow_sources(root)
+    configs = list(dict.fromkeys(["config/config.yaml", *configfiles]))
+    if outputs.get("crate") and files_dir is not None:
+        site.tables.update(sidecars)  # the crate describes copies inside report/ (self-contained)
+        for rel in [*workflow_files, *configs]:
+            if (root / rel).is_file() and not Path(rel).is_absolute() and not rel.startswith(".."):
+                site.raw[f"workflow/{rel}"] = rel
+    site.write()
+    with atomic_path(outputs["html"]) as tmp:
+        tmp.write_text(page)
+    os.chmod(outputs["html"], 0o644)
+    if outputs.get("crate") and files_dir is not None:
+        crate_root = Path(outputs["crate"]).parent
+        prefix = files_dir.relative_to(crate_root).as_posix() if files_dir.is_relative_to(crate_root) else "files"
+        pages = [Path(outputs["html"]).name] + [Path(spec["notebook"]).name for spec in papers.values()
+                                                if spec.get("notebook") and Path(spec["notebook"]).is_file()]
+        write_crate(crate_root, sidecars={p: relocate_json(m, root) for p, m in sidecars.items()},
+                    rule_of=rule_name,
+                    run={"end": iso(_dt.datetime.now(_dt.timezone.utc).timestamp()), "config_hash": params["config_hash"],
+                         "commit": git["commit"], "dirty": git["dirty"]},
+                    workflow_files=[f"{prefix}/workflow/{rel}" for rel in workflow_files if f"workflow/{rel}" in site.raw],
+                    config_files=[f"{prefix}/workflow/{rel}" for rel in configs if f"workflow/{rel}" in site.raw],
+                    pages=pages, versions=versions, out=outputs["crate"])
+    return {"provenance": {"scorecard": score.to_dict(orient="records")}}
+
+
+def _layouts(papers: dict) -> dict:
+    """``{slug: {figure id: layout}}`` from the figure lists (which layout choices are the paper's)."""
+    out = {}
+    for slug in papers:
+        try:
+            out[slug] = {spec.figure_id: spec.layout for spec in load_figure_specs(slug)}
+        except ConfigError:  # a paper without a figure list shows no layout notes
+            out[slug] = {}
+    return out
+
+
+def _run_sidecars(papers: dict) -> dict[str, dict]:
+    """Every result table and figure of the run with its sidecar: the registered outputs of each
+    paper and everything upstream of them (path -> sidecar, in the order found)."""
+    seen: set[str] = set()
+    found: dict[str, dict] = {}
+    for spec in papers.values():
+        paths = [*spec.get("figures", []), *spec.get("tables", []),
+                 *(spec.get(k) for k in ("claims", "errata", "reconstructions", "findings"))]
+        for path in paths:
+            if not path:
+                continue
+            for meta in provenance_chain(path, seen):
+                out = str(meta.get("output", ""))
+                if out and Path(out).is_file():
+                    found.setdefault(out, meta)
+    return found
+
+
+def _workflow_sources(root: Path) -> list[str]:
+    """The Snakefiles of the workflow, the root entry point first (repository-relative)."""
+    files = ["Snakefile", "workflow/Snakefile", *sorted(p.relative_to(root).as_posix()
+                                                         for p in (root / "workflow" / "rules").glob("*.smk"))]
+    return [f for f in files if (root / f).is_file()]

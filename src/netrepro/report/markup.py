@@ -1,0 +1,338 @@
+"""HTML text of the report: sanitising pages for offline use, relocating paths, escaping values.
+
+* :func:`strip_external_scripts` drops everything a page would fetch from the network.
+* :func:`relocate` / :func:`relocate_json` rewrite absolute paths of the build machine.
+* :func:`render` fills a Jinja2 template of ``netrepro/report/templates/``.
+"""
+
+from __future__ import annotations
+
+import base64
+import functools
+import json
+import re
+from pathlib import Path
+
+import pandas as pd
+from jinja2 import Environment, FileSystemBytecodeCache, PackageLoader
+from jinja2.ext import Extension
+from markupsafe import Markup, escape
+
+__all__ = ["NO_FAVICON", "strip_external_scripts", "relocate", "relocate_json", "render", "read_csv",
+           "rst_html", "img", "num", "fmt_value", "short", "blank"]
+
+_EXTERNAL = re.compile(r"<script[^>]*\bsrc=\"https?://[^\"]*\"[^>]*>\s*</script>|<link[^>]*\bhref=\"https?://[^\"]*\"[^>]*>",
+                       re.I)
+NO_FAVICON = '<link rel="icon" href="data:,">'
+_INLINE_SCRIPT = re.compile(r"<script\b[^>]*>(.*?)</script>", re.I | re.S)
+_REMOTE_IMPORT = re.compile(r"""import\s*\(?\s*["']https?://|\bfrom\s*["']https?://|=\s*["']https?://[^"']*\.m?js["']""")
+
+
+def strip_external_scripts(text: str) -> str:
+    """Remove scripts and style sheets fetched from the network (offline report).
+
+    Drops ``<script src=http...>``, ``<link href=http...>`` and inline scripts that
+    import modules from a URL (nbconvert's mermaid loader), so the page makes no
+    network request and logs no console error when opened offline.
+
+    Parameters
+    ----------
+    text : str
+        An HTML page.
+
+    Returns
+    -------
+    str
+        The page without network requests, with an empty favicon.
+    """
+    text = _EXTERNAL.sub("", text)
+    if 'rel="icon"' not in text:  # no favicon request: a static page makes no request it cannot satisfy
+        text = re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
+    return _INLINE_SCRIPT.sub(lambda m: "" if _REMOTE_IMPORT.search(m.group(1)) else m.group(0), text)
+
+
+_PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
+_WORD = re.compile(r"[^\s'\"<>]+")
+
+
+def _short_interpreter(word: re.Match) -> str:
+    text = word.group(0)
+    return _PYTHON_PATH.sub(r"\1", text) if "/bin/python" in text else text
+
+
+def relocate(text: str, root: str | Path) -> str:
+    """``text`` with no absolute path of the build machine.
+
+    Parameters
+    ----------
+    text : str
+        Any text (a page, a command line).
+    root : str or Path
+        The checkout: paths under it become relative to it (``root`` itself ``.``).
+
+    Returns
+    -------
+    str
+        The text; interpreter paths (``/.../bin/python3``) are shortened to their last part.
+    """
+    return _relocate_under(text, str(Path(root).resolve()))
+
+
+def _relocate_under(text: str, root: str) -> str:
+    """:func:`relocate` with ``root`` already resolved."""
+    text = text.replace(root + "/", "").replace(root, ".")
+    if "/bin/python" not in text:
+        return text
+    # word by word: on a long word without spaces (a base64 image) the path pattern backtracks
+    # from every '/', quadratic in the word's length (seconds per notebook page)
+    return _WORD.sub(_short_interpreter, text)
+
+
+def relocate_json(obj, root: str | Path):
+    """:func:`relocate` applied to every string of a JSON value.
+
+    Parameters
+    ----------
+    obj : object
+        A JSON value (a sidecar copied into the report).
+    root : str or Path
+        The checkout.
+
+    Returns
+    -------
+    object
+        The same structure with every string relocated.
+    """
+    return _relocate_json_under(obj, str(Path(root).resolve()))
+
+
+def _relocate_json_under(obj, root: str):
+    if isinstance(obj, str):
+        return _relocate_under(obj, root)
+    if isinstance(obj, list):
+        return [_relocate_json_under(v, root) for v in obj]
+    if isinstance(obj, dict):
+        return {k: _relocate_json_under(v, root) for k, v in obj.items()}
+    return obj
+
+
+# ----------------------------------------------------------------------------- values
+def blank(value):
+    """``value`` as a template shows it: ``None`` and NaN as nothing.
+
+    Parameters
+    ----------
+    value : object
+        A cell of a table or a field of a sidecar.
+
+    Returns
+    -------
+    object
+        ``""`` for a missing value, else ``value``.
+    """
+    if value is None or (isinstance(value, float) and pd.isna(value)):
+        return ""
+    return value
+
+
+def num(value) -> Markup:
+    """A number as a reader wants it (7 significant digits; the exact value on hover).
+
+    Parameters
+    ----------
+    value : object
+        A cell of a claims table.
+
+    Returns
+    -------
+    markupsafe.Markup
+        Escaped text, or a ``<span title=exact>`` holding the rounded number.
+    """
+    text = escape(blank(value))
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return text
+    if isinstance(value, bool) or not pd.notna(number) or number == int(number) and abs(number) < 1e15:
+        return text
+    shown = f"{number:.7g}"
+    return text if shown == str(value) else Markup('<span title="{}">{}</span>').format(text, shown)
+
+
+def fmt_value(value) -> str:
+    """A parameter's value in one line (lists and dicts as JSON, cut at 120 characters).
+
+    Parameters
+    ----------
+    value : object
+        A leaf of a step's params.
+
+    Returns
+    -------
+    str
+        The text shown.
+    """
+    if isinstance(value, (list, dict)):
+        text = json.dumps(value)
+        return text if len(text) <= 120 else text[:117] + "..."
+    return str(value)
+
+
+def short(sha) -> str:
+    """The first 12 characters of a checksum or commit (``""`` if none).
+
+    Parameters
+    ----------
+    sha : str or None
+        A checksum.
+
+    Returns
+    -------
+    str
+        Its prefix.
+    """
+    return str(sha or "")[:12]
+
+
+def rst_html(text: str) -> Markup:
+    """Render a caption written in reStructuredText (fallback: escaped paragraphs).
+
+    Parameters
+    ----------
+    text : str
+        The caption.
+
+    Returns
+    -------
+    markupsafe.Markup
+        Its HTML body (``""`` for an empty caption).
+    """
+    text = text.strip()
+    if not text:
+        return Markup("")
+    try:
+        from docutils.core import publish_parts
+
+        body = publish_parts(text, writer_name="html5",
+                             settings_overrides={"report_level": 5, "halt_level": 5, "syntax_highlight": "none",
+                                                 "embed_stylesheet": False, "math_output": "HTML"})["body"]
+        return Markup(body)
+    except Exception:  # noqa: BLE001 - any docutils failure falls back to plain text
+        return Markup("").join(Markup("<p>{}</p>").format(p) for p in re.split(r"\n\s*\n", text))
+
+
+def img(path: Path) -> Markup:
+    """An ``<img>`` with the PNG embedded (the report works offline).
+
+    Parameters
+    ----------
+    path : Path
+        A PNG file.
+
+    Returns
+    -------
+    markupsafe.Markup
+        The tag.
+    """
+    data = base64.b64encode(Path(path).read_bytes()).decode()
+    return Markup('<img src="data:image/png;base64,{}" alt="{}" loading="eager">').format(data, Path(path).stem)
+
+
+def read_csv(path) -> pd.DataFrame | None:
+    """A table, ``None`` if it is not built, an empty frame if it is empty.
+
+    The report reads a paper's claims, errata and findings tables in several sections: each
+    version of a file (size, modification time) is parsed once. The frame is shared: callers
+    must not modify it.
+
+    Parameters
+    ----------
+    path : str or Path
+        A CSV file.
+
+    Returns
+    -------
+    pandas.DataFrame or None
+        The table.
+    """
+    path = Path(path)
+    if not path.is_file():
+        return None
+    stat = path.stat()
+    return _read_csv(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=256)
+def _read_csv(path: str, mtime_ns: int, size: int) -> pd.DataFrame:
+    try:
+        return pd.read_csv(path)
+    except pd.errors.EmptyDataError:
+        return pd.DataFrame()
+
+
+# ----------------------------------------------------------------------------- templates
+class _JoinLines(Extension):
+    """Templates are written over lines for reading: a line break and the indentation after it
+    are not part of the page (write ``{{ "\\n" }}`` for a line break that is)."""
+
+    def preprocess(self, source, name, filename=None):
+        return re.sub(r"\n[ \t]*", "", source)
+
+
+def _finalize(value):
+    return blank(value)
+
+
+class _Bytecode(FileSystemBytecodeCache):
+    """Compiled templates kept in Jinja2's per-user cache directory (keyed by the template's
+    source checksum), so that the report job does not compile them again; a cache it cannot
+    write is skipped."""
+
+    def dump_bytecode(self, bucket):
+        try:
+            super().dump_bytecode(bucket)
+        except OSError:
+            pass
+
+
+def _bytecode_cache():
+    try:
+        return _Bytecode()
+    except OSError:  # no usable cache directory
+        return None
+
+
+_ENV = Environment(loader=PackageLoader("netrepro.report", "templates"), autoescape=True,
+                   extensions=[_JoinLines], finalize=_finalize, keep_trailing_newline=False,
+                   bytecode_cache=_bytecode_cache())
+_ENV.filters.update(num=num, value=fmt_value, short=short, rst=rst_html,
+                    css=lambda text: re.sub(r"[^a-z]+", "-", str(text).lower()).strip("-"))
+
+
+def render(name: str, **context) -> str:
+    """Fill the template ``name`` of ``netrepro/report/templates/``.
+
+    Parameters
+    ----------
+    name : str
+        The template's file name.
+    **context
+        Its variables.
+
+    Returns
+    -------
+    str
+        The HTML.
+    """
+    return _ENV.get_template(name).render(**context)
+
+
+def stylesheet() -> Markup:
+    """The report's one style sheet (``templates/report.css``), inlined into the page.
+
+    Returns
+    -------
+    markupsafe.Markup
+        The CSS.
+    """
+    return Markup(_ENV.loader.get_source(_ENV, "report.css")[0])

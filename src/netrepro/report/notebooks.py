@@ -1,0 +1,225 @@
+"""The papers' notebooks: the default thin notebook of a paper, the helpers its cells call
+(figures with captions, tables), and its execution with papermill into static, offline HTML.
+
+A notebook cell that fails, or runs longer than the execution timeout, stops the execution with
+:class:`NotebookError` naming the notebook, the cell and the error: the notebook's rule fails,
+the build never hangs on it.
+"""
+
+from __future__ import annotations
+
+import html
+import os
+import re
+import shlex
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ..errors import NetreproError
+from ..io import atomic_path
+from .markup import relocate, strip_external_scripts
+
+__all__ = ["EXECUTION_TIMEOUT_S", "NotebookError", "make_notebook", "figure_captions", "figure_sort_key",
+           "show_figures", "show_table", "execute_notebook"]
+
+# Seconds one cell may run. The slowest cell of the five notebooks (the figures, embedded as
+# PNG) takes about 2 s; ten minutes only stops a cell that hangs.
+EXECUTION_TIMEOUT_S = 600
+
+
+class NotebookError(NetreproError):
+    """A paper's notebook failed or timed out."""
+
+
+def _cells(slug: str):
+    import nbformat.v4 as nbf
+
+    params = nbf.new_code_cell(f'slug = "{slug}"\nroot = "."')
+    params.metadata["tags"] = ["parameters"]
+    return [
+        params,
+        nbf.new_code_cell(
+            "from pathlib import Path\nimport pandas as pd\n"
+            "from netrepro.report.notebooks import figure_captions, show_figures, show_table\n"
+            "root = Path(root)"
+        ),
+        nbf.new_markdown_cell(f"# Paper `{slug}`\nFigures (rendered by the pipeline's figure rules), then the claim, "
+                              "erratum, finding and reconstruction tables. Every value below is read from `results/`."),
+        nbf.new_code_cell("show_figures(root, slug)"),
+        nbf.new_markdown_cell("## Claims"),
+        nbf.new_code_cell('show_table(root / "results" / "claims" / f"{slug}.csv")'),
+        nbf.new_markdown_cell("## Errata"),
+        nbf.new_code_cell('show_table(root / "results" / "errata" / f"{slug}.csv")'),
+        nbf.new_markdown_cell("## Findings (ours, beyond the paper)"),
+        nbf.new_code_cell('show_table(root / "results" / "findings" / f"{slug}.csv")'),
+        nbf.new_markdown_cell("## Reconstructions"),
+        nbf.new_code_cell('show_table(root / "results" / "reconstructions" / f"{slug}.csv")'),
+        nbf.new_markdown_cell("## Result tables (first rows)"),
+        nbf.new_code_cell(
+            'for table in sorted((root / "results" / slug).glob("*.csv")):\n'
+            '    print(table.relative_to(root))\n'
+            '    show_table(table, max_rows=8)'
+        ),
+    ]
+
+
+def make_notebook(slug: str, path: str | Path) -> Path:
+    """Write the default thin notebook of paper ``slug``.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+    path : str or Path
+        Where to write it (``workflow/notebooks/<slug>.ipynb``).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    import nbformat
+    import nbformat.v4 as nbf
+
+    nb = nbf.new_notebook(cells=_cells(slug))
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    nbformat.write(nb, str(path))
+    return path
+
+
+def figure_captions(root: Path, slug: str) -> dict:
+    """Figure stem -> caption text from ``workflow/report/<slug>/<stem>.rst``.
+
+    Parameters
+    ----------
+    root : Path
+        The checkout.
+    slug : str
+        The paper.
+
+    Returns
+    -------
+    dict
+        ``{stem: caption}``.
+    """
+    folder = Path(root) / "workflow" / "report" / slug
+    return {p.stem: p.read_text().strip() for p in sorted(folder.glob("*.rst"))}
+
+
+def figure_sort_key(path: Path):
+    """Sort key of a figure file: the paper's figures by number, then ours (``figS<n>``).
+
+    Parameters
+    ----------
+    path : Path
+        A figure file.
+
+    Returns
+    -------
+    tuple
+        ``(ours, number, stem)``.
+    """
+    match = re.match(r"fig(S?)(\d+)", path.stem)
+    return (bool(match and match.group(1)), int(match.group(2)) if match else 0, path.stem)
+
+
+def show_figures(root, slug):
+    """Display the paper's figures with captions (used inside notebooks).
+
+    Parameters
+    ----------
+    root : str or Path
+        The checkout.
+    slug : str
+        The paper.
+    """
+    from IPython.display import Image, Markdown, display
+
+    captions = figure_captions(root, slug)
+    for fig in sorted((Path(root) / "figures" / slug).glob("*.png"), key=figure_sort_key):
+        display(Markdown(f"### {fig.stem}\n{captions.get(fig.stem, '')}"))
+        display(Image(filename=str(fig)))
+
+
+def show_table(path, max_rows=None):
+    """Display a CSV table as HTML (used inside notebooks).
+
+    Parameters
+    ----------
+    path : str or Path
+        The table.
+    max_rows : int, optional
+        Show only the first rows.
+    """
+    from IPython.display import HTML, display
+
+    path = Path(path)
+    if not path.is_file():
+        display(HTML(f"<p><em>{html.escape(str(path))} not built</em></p>"))
+        return
+    frame = pd.read_csv(path)
+    if max_rows is not None:
+        frame = frame.head(max_rows)
+    display(HTML(frame.to_html(index=False, escape=True, na_rep="")))
+
+
+def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root: str | Path = ".",
+                     timeout: float = EXECUTION_TIMEOUT_S) -> Path:
+    """Run ``notebook`` with papermill (parameters ``slug``, ``root``) and export static HTML.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+    notebook : str or Path
+        The notebook to run.
+    html_out : str or Path
+        The page to write (the executed notebook is kept beside it as ``.ipynb``).
+    root : str or Path, default "."
+        The checkout; the kernel runs there.
+    timeout : float, default :data:`EXECUTION_TIMEOUT_S`
+        Seconds one cell may run (papermill's ``execution_timeout``).
+
+    Returns
+    -------
+    Path
+        ``html_out``.
+
+    Raises
+    ------
+    NotebookError
+        A cell raised, or ran longer than ``timeout``; no page is written.
+    """
+    import nbformat
+    import papermill
+    from nbclient.exceptions import CellTimeoutError, DeadKernelError
+    from nbconvert import HTMLExporter
+
+    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
+    # path of the machine that built it (and any path a warning prints is made relative too).
+    print("command:", shlex.join(getattr(sys, "orig_argv", sys.argv)), flush=True)
+    root = Path(root).resolve()
+    html_out = Path(html_out)
+    executed = html_out.with_suffix(".ipynb")
+    try:
+        papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
+                                   kernel_name="python3", cwd=str(root), progress_bar=False,
+                                   request_save_on_cell_execute=False, execution_timeout=timeout)
+    except papermill.PapermillExecutionError as exc:
+        raise NotebookError(f"notebook {notebook} (paper {slug}): cell {exc.exec_count} failed: "
+                            f"{exc.ename}: {exc.evalue}") from None
+    except CellTimeoutError as exc:
+        raise NotebookError(f"notebook {notebook} (paper {slug}): a cell ran longer than the execution timeout "
+                            f"of {timeout:g} s and was stopped ({str(exc).splitlines()[0]})") from None
+    except DeadKernelError as exc:
+        raise NotebookError(f"notebook {notebook} (paper {slug}): the kernel died ({exc})") from None
+    exporter = HTMLExporter()
+    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
+    with atomic_path(html_out) as tmp:
+        tmp.write_text(relocate(strip_external_scripts(body), root))
+    os.chmod(html_out, 0o644)
+    return html_out

@@ -1,0 +1,259 @@
+"""The sections of ``report/index.html``: the scorecard over papers, and per paper its replication
+summary, figures, claims, errata, findings, reconstructions and result tables. Each function
+gathers the values; the markup is in ``templates/``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+from markupsafe import Markup
+
+from ..registry import load_registry
+from ..provenance import sidecar_path
+from ..summary import replication_summary, summary_sentences
+from ..verdicts import TESTABLE_VERDICTS, VERDICTS
+from .markup import img, read_csv, render, rst_html
+from .notebooks import figure_captions, figure_sort_key
+from .panel import provenance_panel, rule_name
+
+__all__ = ["table_view", "claims_html", "summary_html", "figure_html", "paper_section", "scorecard_html"]
+
+# Text tables shown cell by cell (besides the claims, which have their own layout)
+_TEXT_TABLES = (
+    ("Errata", "errata", "Errors of the text: printed form, corrected form, numerical demonstration, kind "
+                         "(only equation and prose errors count as errata; notation and typesetting slips are "
+                         "listed) and which of our results the printed form would change."),
+    ("Findings", "findings", "Our own discoveries beyond the paper's claims, with the evidence and the table "
+                             "(and figure) that shows it. They are not errata of the text."),
+    ("Reconstructions", "reconstructions",
+     "Parameters the paper does not state or garbles: the value we chose, why, and where conclusions depend on it."),
+)
+
+
+def _truthy(value) -> bool:
+    return str(value).strip().lower() in ("true", "1", "yes")
+
+
+def _setting(config: dict, key: str):
+    """The configuration value at the dotted ``key`` (``None`` if there is none)."""
+    value = config
+    for part in str(key).split("."):
+        if not isinstance(value, dict) or part not in value:
+            return None
+        value = value[part]
+    return value
+
+
+def _as_configured(cell, setting):
+    """A reconstruction's value as the configuration writes it: an integer setting stored in the
+    table as a float (``20150101.0``, a float column of the evidence table) shows as the integer."""
+    if not isinstance(setting, int) or isinstance(setting, bool):
+        return cell
+    try:
+        return str(setting) if float(cell) == setting else cell
+    except (TypeError, ValueError):
+        return cell
+
+
+def table_view(frame: pd.DataFrame, key: str = "", config: dict | None = None) -> dict:
+    """A table as the ``data_table`` macro shows it: every column, cell by cell.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table (its ``paper`` column is dropped).
+    key : str, default ""
+        Which table: ``findings`` labels a finding with ``known`` true a "known result";
+        ``reconstructions`` shows the value of an integer setting as an integer.
+    config : dict, optional
+        The paper's configuration section (the types of the reconstructed settings).
+
+    Returns
+    -------
+    dict
+        ``columns``, ``rows`` (lists of cells) and ``known`` (one flag per row, or empty).
+    """
+    frame = frame.drop(columns=["paper"], errors="ignore")
+    if key == "reconstructions" and {"key", "value"} <= set(frame.columns):
+        frame = frame.assign(value=[_as_configured(v, _setting(config or {}, k))
+                                    for k, v in zip(frame["key"], frame["value"])])
+    known = [_truthy(v) for v in frame["known"]] if key == "findings" and "known" in frame else []
+    return {"columns": list(frame.columns), "rows": [list(row) for row in frame.itertuples(index=False)],
+            "known": known}
+
+
+def _cell(row: pd.Series, name: str):
+    value = row.get(name, "")
+    return "" if value is None or (isinstance(value, float) and pd.isna(value)) else value
+
+
+def claims_html(frame: pd.DataFrame, slug: str) -> str:
+    """Claims table: where, statement, paper's value, ours, tolerance and why, verdict (robust, condition), note.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        ``results/claims/<slug>.csv``.
+    slug : str
+        The paper.
+
+    Returns
+    -------
+    str
+        The table's HTML.
+    """
+    names = ("claim_id", "location", "statement", "paper_value", "reproduced_value", "tolerance",
+             "tolerance_reason", "test", "verdict", "robust", "condition", "erratum_id", "note")
+    rows = []
+    for _, row in frame.iterrows():
+        claim = {n: _cell(row, n) for n in names}
+        claim["verdict"] = str(claim["verdict"]).strip()
+        claim["robust"] = str(claim["robust"])
+        rows.append(claim)
+    return render("claims.html", slug=slug, rows=rows)
+
+
+def summary_html(slug: str, spec: dict, frame: pd.DataFrame | None) -> str:
+    """The replication summary that opens a paper's section (counted by :mod:`netrepro.summary`).
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+    spec : dict
+        Its registered outputs (``errata``, ``findings``, ``figures``).
+    frame : pandas.DataFrame or None
+        Its claims table.
+
+    Returns
+    -------
+    str
+        The summary's HTML (``""`` without a claims table).
+    """
+    if frame is None:
+        return ""
+    errata = read_csv(spec["errata"]) if spec.get("errata") else None
+    findings = read_csv(spec["findings"]) if spec.get("findings") else None
+    table = replication_summary(frame, [Path(f).stem for f in spec.get("figures", [])])
+    rows = [{**r, "testable": int(r["testable"])} for r in table.to_dict(orient="records")]
+    return render("summary.html", slug=slug, sentences=summary_sentences(frame, errata, findings, table), rows=rows)
+
+
+def figure_html(fig: Path, slug: str, captions: dict, ctx: dict) -> str:
+    """One figure with its caption, layout notes, image and provenance panel.
+
+    Parameters
+    ----------
+    fig : Path
+        The figure.
+    slug : str
+        Its paper.
+    captions : dict
+        Figure stem -> caption (reStructuredText).
+    ctx : dict
+        The report's context (see :func:`netrepro.report.panel.provenance_panel`; ``layouts``).
+
+    Returns
+    -------
+    str
+        The ``<figure>``.
+    """
+    return render("figure.html", slug=slug, stem=fig.stem, fig=fig, ours=fig.stem.startswith("figS"),
+                  label=("Figure " + fig.stem[3:]) if fig.stem.startswith("fig") else fig.stem,
+                  caption=rst_html(captions.get(fig.stem, "")),
+                  layout=ctx.get("layouts", {}).get(slug, {}).get(fig.stem) or {},
+                  image=img(fig) if fig.is_file() else None, panel=Markup(provenance_panel(fig, slug, ctx)))
+
+
+def _table_row(path: str, ctx: dict) -> dict:
+    frame = read_csv(path)
+    side = sidecar_path(Path(path))
+    meta = json.loads(side.read_text()) if side.is_file() else {}
+    return {"path": path, "href": ctx["site"].table_link(str(path)), "rows": "" if frame is None else len(frame),
+            "rule": rule_name(meta) if meta else "", "sha": meta.get("output_sha256")}
+
+
+def paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict) -> str:
+    """A paper's section of the report.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+    spec : dict
+        Its registered outputs (``PAPER_OUTPUTS`` of the workflow).
+    frame : pandas.DataFrame or None
+        Its claims table.
+    ctx : dict
+        The report's context.
+
+    Returns
+    -------
+    str
+        The ``<section>``.
+    """
+    meta = load_registry().get(slug, {})
+    captions = figure_captions(ctx["root"], slug)
+    figures = sorted((Path(f) for f in spec.get("figures", [])), key=figure_sort_key)
+    claims = None
+    counts = ""
+    if frame is not None:
+        found = frame["verdict"].value_counts() if "verdict" in frame else {}
+        counts = ", ".join(f"{int(found.get(v, 0))} {v}" for v in VERDICTS)
+        claims = {"n": len(frame), "href": ctx["site"].table_link(spec["claims"]),
+                  "html": Markup(claims_html(frame, slug))}
+    parts = []
+    for title, key, intro in _TEXT_TABLES:
+        table = read_csv(spec[key]) if spec.get(key) else None
+        parts.append({"key": key, "title": title, "intro": Markup(intro), "path": spec.get(key),
+                      "table": None if table is None else table_view(table, key, ctx["config"].get(slug, {}))})
+    notebook = spec.get("notebook")
+    return render(
+        "paper.html", slug=slug, title=meta.get("title", slug), authors=meta.get("authors", ""),
+        source_text=meta.get("file"), notebook=Path(notebook).name if notebook else None,
+        summary=Markup(summary_html(slug, spec, frame)),
+        paper_figures=[Markup(figure_html(f, slug, captions, ctx)) for f in figures if not f.stem.startswith("figS")],
+        our_figures=[Markup(figure_html(f, slug, captions, ctx)) for f in figures if f.stem.startswith("figS")],
+        claims=claims, claims_path=spec.get("claims"), counts=counts, parts=parts,
+        tables=[_table_row(p, ctx) for p in dict.fromkeys(spec.get("tables", []))])
+
+
+def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
+    """The scorecard: verdict counts per paper and in total, with the share reproduced.
+
+    Parameters
+    ----------
+    score : pandas.DataFrame
+        :func:`netrepro.summary.scorecard` (its last row is the total).
+    papers : dict
+        Slug -> registered outputs.
+
+    Returns
+    -------
+    str
+        The cards, the table and its legend.
+    """
+    total = score.iloc[-1]
+    shown = list(VERDICTS)
+    counted = [*shown, "claims", "testable", "other", "errata", "minor_errata", "findings"]
+    rows = []
+    for _, row in score.iterrows():
+        slug = row["paper"]
+        spec = papers.get(slug)
+        n = max(int(row["testable"]), 1)
+        item = {"paper": slug, "title": None, "n": {k: int(row[k]) for k in counted},
+                "share": "" if pd.isna(row["scored_reproduced_pct"]) else f'{row["scored_reproduced_pct"]:.1f} %',
+                "bar": [(v, int(row[v]), f"{160 * int(row[v]) / n:.1f}") for v in TESTABLE_VERDICTS if int(row[v])]}
+        if spec is not None:
+            recon = read_csv(spec["reconstructions"]) if spec.get("reconstructions") else None
+            figs = spec.get("figures", [])
+            item.update(title=load_registry().get(slug, {}).get("title", slug), reconstructions="" if recon is None else len(recon),
+                        paper_figures=sum(not Path(f).stem.startswith("figS") for f in figs),
+                        our_figures=sum(Path(f).stem.startswith("figS") for f in figs))
+        rows.append(item)
+    pct = total["scored_reproduced_pct"]
+    return render("scorecard.html", total={k: int(total[k]) for k in counted}, shown=shown,
+                  untestable=[v for v in shown if v not in TESTABLE_VERDICTS], show_other=int(total["other"]) > 0,
+                  rows=rows, pct="" if pd.isna(pct) else f"{pct:.1f} %")

@@ -1,0 +1,47 @@
+"""A paper's notebook that fails or hangs stops its rule with the notebook's error (papermill's
+execution timeout): the build never hangs on a notebook."""
+
+import subprocess
+import sys
+import time
+
+import nbformat
+import nbformat.v4 as nbf
+import pytest
+
+from netrepro.report.notebooks import NotebookError, execute_notebook, make_notebook
+
+
+def _notebook(path, source):
+    nb = nbf.new_notebook(cells=[nbf.new_code_cell('slug = "x"\nroot = "."', metadata={"tags": ["parameters"]}),
+                                 nbf.new_code_cell(source)])
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, str(path))
+    return path
+
+
+def test_a_notebook_that_sleeps_is_stopped_by_the_timeout(tmp_path):
+    notebook = _notebook(tmp_path / "sleeps.ipynb", "import time\ntime.sleep(120)")
+    start = time.monotonic()
+    proc = subprocess.run([sys.executable, "-m", "netrepro.report", "notebook", "--slug", "x", "--notebook",
+                           str(notebook), "--html", str(tmp_path / "x.html"), "--timeout", "3"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=100)
+    assert proc.returncode == 1
+    assert "ran longer than the execution timeout of 3 s" in proc.stderr
+    assert time.monotonic() - start < 100  # stopped, not waited out (the cell sleeps 120 s)
+    assert not (tmp_path / "x.html").exists()
+
+
+def test_a_failing_cell_names_the_notebook_and_the_error(tmp_path):
+    notebook = _notebook(tmp_path / "fails.ipynb", 'raise ValueError("table results/x.csv has no column p")')
+    with pytest.raises(NotebookError, match=r"fails\.ipynb \(paper x\): cell \d+ failed: ValueError: table "
+                                            r"results/x\.csv has no column p"):
+        execute_notebook("x", notebook, tmp_path / "x.html", root=tmp_path, timeout=60)
+    assert not (tmp_path / "x.html").exists()
+
+
+def test_the_default_notebook_imports_the_report_helpers(tmp_path):
+    path = make_notebook("p", tmp_path / "p.ipynb")
+    sources = [c.source for c in nbformat.read(str(path), as_version=4).cells]
+    assert sources[0] == 'slug = "p"\nroot = "."'
+    assert "from netrepro.report.notebooks import figure_captions, show_figures, show_table" in sources[1]
