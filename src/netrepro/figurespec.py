@@ -14,8 +14,7 @@ arguments of the plot::
 
 The generated rule is ``<slug>_<id>``; it writes ``figures/<slug>/<id>.png``. The figure's
 caption is ``workflow/report/<slug>/<id>.rst`` (shown by the report, the notebook and
-``snakemake --report``). A one-line ``caption`` field, which nothing read, is retired: still
-accepted and ignored until every ``figures.yaml`` has dropped it (:data:`RETIRED_KEYS`).
+``snakemake --report``); figures.yaml holds no caption of its own.
 """
 
 from __future__ import annotations
@@ -29,13 +28,12 @@ import yaml
 from .errors import ConfigError
 from .io import load_yaml
 
-__all__ = ["FigureSpec", "RETIRED_KEYS", "load_figure_specs", "figure_list_path"]
+__all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]
 
 _SRC = Path(__file__).resolve().parent
 _FIGURE_ID = re.compile(r"^fig(S?\d+)$")
 _KEYS = {"plot", "inputs", "params", "layout"}
 # fields that entries may still carry and that nothing reads (removed once no figures.yaml has them)
-RETIRED_KEYS = {"caption"}
 _LAYOUT_KEYS = {"from_paper", "ours"}
 
 
@@ -147,7 +145,7 @@ def load_figure_specs(slug: str, src: Path = _SRC) -> list[FigureSpec]:
             raise ConfigError(f"{where}: ids look like fig1 or figS1")
         if not isinstance(entry, dict) or not isinstance(entry.get("plot"), str):
             raise ConfigError(f"{where}: field 'plot' (the plotting function's name) is required")
-        unknown = set(entry) - _KEYS - RETIRED_KEYS
+        unknown = set(entry) - _KEYS
         if unknown:
             raise ConfigError(f"{where}: unknown fields {sorted(unknown)} (allowed: {sorted(_KEYS)})")
         for name in ("inputs", "params", "layout"):
