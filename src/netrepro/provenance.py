@@ -402,6 +402,9 @@ def _is_partial(path: Path) -> bool:
     return path.name.startswith(".") and PARTIAL_MARK in path.name
 
 
+DIFFERENCE_PAGE_DIR = "regeneration"  # results/regeneration/: written by `regression compare`
+
+
 def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
     """Check files and directory trees against their provenance sidecars.
 
@@ -425,7 +428,9 @@ def verify_tree(paths, inputs_only: bool = False) -> list[Verdict]:
     files = []
     for root in map(Path, paths):
         if root.is_dir():
-            files.extend(sorted(p for p in root.rglob("*") if p.is_file()))
+            # the regeneration check's difference page (results/regeneration/) is a report, not an output
+            files.extend(sorted(p for p in root.rglob("*") if p.is_file()
+                                and DIFFERENCE_PAGE_DIR not in p.relative_to(root).parts[:1]))
         else:
             files.append(root)
     seen = set()

@@ -241,6 +241,8 @@ def main(argv=None) -> int:
         print(f"reference tables written to {args.reference}")
         return 0
     start = time.perf_counter()
+    # a page from an earlier run would describe differences that may be gone
+    shutil.rmtree(Path(args.html).parent, ignore_errors=True)
     details: list[dict] = []
     count, problems = compare_trees(Path(args.reference), Path(args.results),
                                     platform_rules=args.platform_rules or None, details=details)
