@@ -129,3 +129,28 @@ def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
     assert "table changed: " in out and "p/t.csv" in out and "table added: " in out and "p/new.csv" in out
     assert "table removed: " in out and "p/gone.csv" in out and "same.csv" not in out
     assert main(["compare", *args, "--html", ""]) == 0
+
+
+def test_clearing_an_old_difference_page_touches_nothing_else(tmp_path):
+    from netrepro.figurecheck import clear_difference_page
+
+    keep = [tmp_path / "README.md", tmp_path / "figure.png", tmp_path / "sub" / "x_result.png"]
+    gone = [tmp_path / "index.html", tmp_path / "markov_fig2_reference.png", tmp_path / "markov_fig2_result.png",
+            tmp_path / "markov_fig2_difference.png"]
+    for path in keep + gone:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("x")
+    clear_difference_page(tmp_path)
+    assert all(p.exists() for p in keep) and not any(p.exists() for p in gone)
+
+
+def test_compare_with_no_page_deletes_nothing_in_the_working_directory(tmp_path, monkeypatch):
+    # `--html ''` once made compare remove Path('').parent, the working directory, with everything in it
+    from netrepro.regression import main
+
+    (tmp_path / "ref").mkdir()
+    (tmp_path / "res").mkdir()
+    (tmp_path / "precious.txt").write_text("keep me")
+    monkeypatch.chdir(tmp_path)
+    main(["compare", "--reference", "ref", "--results", "res", "--figures", "", "--html", "", "--platform-rules", ""])
+    assert (tmp_path / "precious.txt").read_text() == "keep me"

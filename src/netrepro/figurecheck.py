@@ -42,7 +42,7 @@ import numpy as np
 from .figuredata import SUFFIX, data_path
 from .io import atomic_path
 
-__all__ = ["RMS_TOLERANCE", "FigureDifference", "Baseline", "open_baseline", "compare_figure_data",
+__all__ = ["RMS_TOLERANCE", "FigureDifference", "Baseline", "open_baseline", "compare_figure_data", "clear_difference_page",
            "png_rms", "compare_figures", "load_figure_rules", "write_difference_page", "figure_jobs",
            "regenerate_figures"]
 
@@ -401,6 +401,20 @@ def _safe(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
 
 
+_PAGE_IMAGE = re.compile(r".+_(reference|result|difference)\.png$")
+
+
+def clear_difference_page(out_dir) -> None:
+    """Remove a difference page written earlier in ``out_dir``: its ``index.html`` and its images only.
+
+    Nothing else in the folder is touched, whatever folder it is (``--html`` may name any path).
+    """
+    out = Path(out_dir)
+    for path in [out / "index.html", *out.glob("*.png")]:
+        if path.is_file() and (path.name == "index.html" or _PAGE_IMAGE.fullmatch(path.name)):
+            path.unlink()
+
+
 def write_difference_page(out_dir, figures: list[FigureDifference], tables: list[dict],
                           other: list[str] = ()) -> Path:
     """Write ``out_dir/index.html`` (and its images) showing every difference; returns its path.
@@ -411,8 +425,7 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    for old in out.glob("*.png"):
-        old.unlink()
+    clear_difference_page(out)
     failing = [d for d in figures if d.problems]
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><link rel='icon' href='data:,'>"
              f"<title>Regeneration differences</title><style>{_CSS}</style></head><body>",

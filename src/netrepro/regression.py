@@ -241,8 +241,10 @@ def main(argv=None) -> int:
         print(f"reference tables written to {args.reference}")
         return 0
     start = time.perf_counter()
-    # a page from an earlier run would describe differences that may be gone
-    shutil.rmtree(Path(args.html).parent, ignore_errors=True)
+    if args.html:  # a page from an earlier run would describe differences that may be gone
+        from .figurecheck import clear_difference_page
+
+        clear_difference_page(Path(args.html).parent)
     details: list[dict] = []
     count, problems = compare_trees(Path(args.reference), Path(args.results),
                                     platform_rules=args.platform_rules or None, details=details)

@@ -268,27 +268,9 @@ def exit_process(code: int) -> None:
     os._exit(code)
 
 
-def _new_paper_main(args) -> int:
-    from .errors import NetreproError
-    from .scaffold import new_paper
-
-    try:
-        written = new_paper(args.slug, args.title, args.source, args.root, args.authors)
-    except NetreproError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    print("\n".join(f"wrote {path}" for path in written))
-    print(f"next: `make report` builds {args.slug}'s figure, claim and report section; "
-          f"`python -m netrepro check-paper {args.slug}` checks the contract; docs/adding-a-paper.md walks through the rest")
-    return 0
-
-
 def main(argv=None) -> int:
-    if argv is None and sys.argv[1:2] == ["diff"] or argv and argv[:1] == ["diff"]:
-        from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
-
-        return diff_main((sys.argv[2:] if argv is None else argv[1:]))
-    parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0],
+                                     epilog="Also: new-paper, check-paper, diff (netrepro.commands; each with --help).")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run one pipeline step")
     run.add_argument("--rule", default=None, help="rule name (default: the \"rule\" entry of --io)")
@@ -303,22 +285,7 @@ def main(argv=None) -> int:
     ver.add_argument("--remove-corrupt", action="store_true",
                      help="delete corrupt or unverifiable results so that snakemake rebuilds them")
     ver.add_argument("-q", "--quiet", action="store_true", help="print only problems and the summary")
-    new = sub.add_parser("new-paper", help="create the working skeleton of a new paper (docs/adding-a-paper.md)")
-    new.add_argument("slug", help="the paper's slug: a lower-case Python identifier")
-    new.add_argument("--title", required=True, help="the paper's title")
-    new.add_argument("--source", required=True, help="the paper's source text (must exist)")
-    new.add_argument("--authors", default="", help="the authors, one line")
-    new.add_argument("--root", default=".", help="the repository's root (default: here)")
-    chk = sub.add_parser("check-paper", help="check that papers follow the paper contract (file:line per violation)")
-    chk.add_argument("slugs", nargs="*", help="papers to check (default: every registered paper)")
-    chk.add_argument("--root", default=".", help="the repository's root (default: here)")
     args = parser.parse_args(argv)
-    if args.command == "new-paper":
-        return _new_paper_main(args)
-    if args.command == "check-paper":
-        from .contract import main as check_main
-
-        return check_main(args.slugs, args.root)
     if args.command == "verify":
         return verify_main(args.paths, inputs_only=args.inputs, remove_corrupt=args.remove_corrupt,
                            quiet=args.quiet)

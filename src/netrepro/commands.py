@@ -1,0 +1,57 @@
+"""``python -m netrepro new-paper | check-paper | diff``: the commands for people, beside the runner's.
+
+Kept apart from :mod:`netrepro.runner`, which every pipeline job runs: a rule's code inputs are the
+modules its job can reach, so the scaffold, the contract and the diff tool stay out of them (an
+edit to a template reruns nothing).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+__all__ = ["COMMANDS", "main"]
+
+COMMANDS = ("new-paper", "check-paper", "diff")
+
+
+def _new_paper(args) -> int:
+    from .errors import NetreproError
+    from .scaffold import new_paper
+
+    try:
+        written = new_paper(args.slug, args.title, args.source, args.root, args.authors)
+    except NetreproError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print("\n".join(f"wrote {path}" for path in written))
+    print(f"next: `make report` builds {args.slug}'s figure, claim and report section; "
+          f"`python -m netrepro check-paper {args.slug}` checks the contract; "
+          "docs/adding-a-paper.md walks through the rest")
+    return 0
+
+
+def main(argv=None) -> int:
+    """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["diff"]:
+        from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
+
+        return diff_main(argv[1:])
+    parser = argparse.ArgumentParser(prog="python -m netrepro")
+    sub = parser.add_subparsers(dest="command", required=True)
+    new = sub.add_parser("new-paper", help="create the working skeleton of a new paper (docs/adding-a-paper.md)")
+    new.add_argument("slug", help="the paper's slug: a lower-case Python identifier")
+    new.add_argument("--title", required=True, help="the paper's title")
+    new.add_argument("--source", required=True, help="the paper's source text (must exist)")
+    new.add_argument("--authors", default="", help="the authors, one line")
+    new.add_argument("--root", default=".", help="the repository's root (default: here)")
+    chk = sub.add_parser("check-paper", help="check that papers follow the paper contract (file:line per violation)")
+    chk.add_argument("slugs", nargs="*", help="papers to check (default: every registered paper)")
+    chk.add_argument("--root", default=".", help="the repository's root (default: here)")
+    args = parser.parse_args(argv)
+    if args.command == "new-paper":
+        return _new_paper(args)
+    from .contract import main as check_main
+
+    return check_main(args.slugs, args.root)
