@@ -32,8 +32,22 @@ import pytest
 import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
-IGNORE = shutil.ignore_patterns(".venv", ".git", "results", "logs", ".snakemake", "report", "figures", "__pycache__",
-                                "*.egg-info", ".pytest_cache", ".hypothesis")
+BUILD_PRODUCTS = {"results", "logs", ".snakemake", "report", "figures"}
+
+
+def top_level_ignore(root, names_at_root, anywhere=("__pycache__",)):
+    """An ignore function for copytree: ``names_at_root`` only at ``root`` (src/netrepro/report and
+    workflow/report are sources), ``anywhere`` at every level."""
+    root = Path(root).resolve()
+
+    def ignore(directory, names):
+        here = names_at_root if Path(directory).resolve() == root else set()
+        return [n for n in names if n in here or n in anywhere or n.endswith(".egg-info")]
+
+    return ignore
+
+
+IGNORE_AT_ROOT = {".venv", ".git", ".pytest_cache", ".hypothesis", *BUILD_PRODUCTS}
 TARGETS = [
     "results/intermittent/exact_mean.csv",
     "results/intermittent/monte_carlo.csv",
@@ -80,7 +94,7 @@ def write_config(workdir, name, **scalar):
 
 def fresh_copy(tmp_path_factory, name):
     work = tmp_path_factory.mktemp(name) / "repo"
-    shutil.copytree(ROOT, work, ignore=IGNORE)
+    shutil.copytree(ROOT, work, ignore=top_level_ignore(ROOT, IGNORE_AT_ROOT))
     write_config(work, "rel.yaml", n_paths=300_000, block_size=10_000, n_chunks=1, n_shards=1)
     return work
 
@@ -88,7 +102,7 @@ def fresh_copy(tmp_path_factory, name):
 def clone(src, tmp_path_factory, name, results=True):
     """A copy of a built scratch repository (same code), with or without its results and metadata."""
     work = tmp_path_factory.mktemp(name) / "repo"
-    ignore = None if results else shutil.ignore_patterns("results", "logs", ".snakemake", "figures", "report")
+    ignore = None if results else top_level_ignore(src, BUILD_PRODUCTS, anywhere=())
     shutil.copytree(src, work, symlinks=True, ignore=ignore)
     return work
 

@@ -576,7 +576,8 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
         cause = f.cause.get("variant", "")
         if cause and not _names_evidence(cause, evidence, rows_q):
             raise InputError(f"finding {data.slug}/{f.finding_id}: cause variant {cause!r} is neither an evidence "
-                             f"quantity, a variant of {f.quantity!r}, nor '<quantity>: <variant>' of the evidence table")
+                             f"quantity nor a variant of {f.quantity!r} (nor '<quantity>: <variant>' of the evidence "
+                             "table)")
         value, note = rows_q[NOMINAL]
         variants = {label: v for label, (v, _) in rows_q.items() if label != NOMINAL}
         problems.append(_undeclared("finding", data.slug, f.finding_id, f.depends_on, variants))

@@ -436,6 +436,7 @@ if enabled("hinf"):
         rules.hinf_fig5_control.output.table,
         rules.hinf_evasive_network.output.table,
         rules.hinf_loop_variants.output.table,
+        rules.hinf_loop_variants.output.runs,
         rules.hinf_kalman_best.output.table,
         rules.hinf_evidence.output.table,
     ]
