@@ -1,2 +1,4 @@
 """One package per paper (``src/netrepro/papers/<slug>/``); the list of papers is the registry,
 ``src/netrepro/papers.yaml`` (:mod:`netrepro.registry`)."""
+
+__all__: list[str] = []
