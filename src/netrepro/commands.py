@@ -32,7 +32,22 @@ def _new_paper(args) -> int:
 
 
 def main(argv=None) -> int:
-    """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code."""
+    """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code.
+
+    ``diff`` is handed to :func:`netrepro.diff.main` (its own parser); ``new-paper`` writes a
+    paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The command line without the program name, e.g. ``["check-paper", "markov"]``;
+        ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        The command's exit code (0 on success).
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["diff"]:
         from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B

@@ -45,7 +45,21 @@ _IO_MODULES = {"pandas", "json", "yaml", "pickle", "csv", "shutil"}
 
 @dataclass(frozen=True)
 class Violation:
-    """One breach of the contract: where it is and what is wrong."""
+    """One breach of the contract: where it is and what is wrong.
+
+    Printed as ``path:line: [check] message``.
+
+    Parameters
+    ----------
+    path : str
+        The file (or folder) in breach, relative to the repository's root where possible.
+    line : int
+        The line of the breach in ``path``; 0 when it concerns the whole file.
+    check : str
+        The name of the check that found it (e.g. ``"roles"``).
+    message : str
+        What is wrong, in one line.
+    """
 
     path: str
     line: int
@@ -64,7 +78,18 @@ def _rel(path: Path, root: Path) -> str:
 
 
 def math_modules(package: Path) -> list[Path]:
-    """The paper's math modules: every module of its package but the non-math roles."""
+    """The paper's math modules: every module of its package but the non-math roles.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The paper's package folder (``src/netrepro/papers/<slug>``).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The package's ``*.py`` files whose stem is not in ``NOT_MATH``, sorted.
+    """
     return sorted(p for p in package.glob("*.py") if p.stem not in NOT_MATH)
 
 
@@ -379,7 +404,23 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
 
 
 def main(slugs, root: str | Path = ".") -> int:
-    """Print every violation of the papers ``slugs`` (all registered ones when empty); 1 if any."""
+    """Print every violation of the papers ``slugs`` (all registered ones when empty); 1 if any.
+
+    Each violation is printed on its own line, then one ``check-paper <slug>: ok`` (or
+    ``N violation(s)``) line per paper.
+
+    Parameters
+    ----------
+    slugs : iterable of str
+        The papers to check; every paper of the registry (``src/netrepro/papers.yaml``) when empty.
+    root : str or pathlib.Path, default "."
+        The repository's root.
+
+    Returns
+    -------
+    int
+        The exit code: 1 when any paper has a violation, else 0.
+    """
     root = Path(root)
     slugs = list(slugs) or list(load_registry(root / "src/netrepro/papers.yaml"))
     found = 0

@@ -27,6 +27,20 @@ _KIND = {"claims": "claim", "findings": "finding"}
 def tables_of(run: str | Path, kind: str) -> dict:
     """``{paper: DataFrame}`` of a run's ``claims`` or ``findings`` tables.
 
+    Looks in ``<run>/results/<kind>/`` then ``<run>/<kind>/``; every cell is read as a string.
+
+    Parameters
+    ----------
+    run : str or pathlib.Path
+        The run's folder (a checkout or a copy of its ``results``).
+    kind : {"claims", "findings"}
+        Which tables to read.
+
+    Returns
+    -------
+    dict of str to pandas.DataFrame
+        Each paper's table, keyed by the CSV file's stem.
+
     Raises
     ------
     FileNotFoundError
@@ -106,6 +120,23 @@ def diff_runs(run_a: str | Path, run_b: str | Path, rel: float = 1e-9):
 
 
 def main(argv=None) -> int:
+    """Compare two runs' claims and findings tables from the command line (``python -m netrepro diff``).
+
+    Prints one line per changed entry (verdict, robust flag, value, added or removed) and a
+    summary line; the table of :func:`diff_runs` is also written to ``--csv`` when given.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments ``RUN_A RUN_B [--csv FILE] [--rel TOL] [--fail-on-change]``; ``sys.argv[1:]``
+        when None.
+
+    Returns
+    -------
+    int
+        The exit code: 2 when a run holds no tables, 1 with ``--fail-on-change`` when any verdict,
+        robust flag or membership changed, else 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro diff", description=__doc__.splitlines()[0])
     parser.add_argument("run_a")
     parser.add_argument("run_b")

@@ -73,7 +73,24 @@ _FIGURE_CHECKS = ("finite", "pixels")
 
 @dataclass
 class FigureDifference:
-    """A figure that differs from its reference: its name, the reasons, and the images."""
+    """A figure that differs from its reference: its name, the reasons, and the images.
+
+    Parameters
+    ----------
+    name : str
+        The figure, ``"<paper>/<id>"``.
+    problems : list of str, optional
+        The failing differences, one line each (empty: only notes).
+    notes : list of str, optional
+        Differences reported but not failing (allowed by a platform rule).
+    rms : float or None, optional
+        The RMS of the pixel difference (:func:`png_rms`); None when not computed or the image
+        sizes differ.
+    reference_png : bytes or None, optional
+        The committed reference PNG; None when there is none.
+    result_png : pathlib.Path or None, optional
+        The PNG of this build; None when it is missing.
+    """
 
     name: str                     # "<paper>/<id>"
     problems: list[str] = field(default_factory=list)
@@ -84,7 +101,25 @@ class FigureDifference:
 
 
 class Baseline:
-    """The committed references: a folder laid out like ``figures/``, or a git revision."""
+    """The committed references: a folder laid out like ``figures/``, or a git revision.
+
+    A revision's files are listed at once and read together on first use (one
+    ``git cat-file --batch``).
+
+    Parameters
+    ----------
+    spec : str
+        ``"git:REV"`` (``"git:"`` for ``HEAD``) to read the references from that revision of the
+        ``figures_dir`` of the surrounding checkout, or a folder laid out like ``figures/``.
+    figures_dir : pathlib.Path
+        The figures folder of the build (for a revision: the path whose committed files are read).
+
+    Raises
+    ------
+    ValueError
+        When ``spec`` names a revision outside a git checkout or one git cannot list, or a folder
+        that does not exist.
+    """
 
     def __init__(self, spec: str, figures_dir: Path):
         self.spec = spec
@@ -145,7 +180,25 @@ class Baseline:
 
 
 def open_baseline(spec: str, figures_dir) -> Baseline:
-    """The references named by ``spec`` (``git:REV`` or a folder) for the figures in ``figures_dir``."""
+    """The references named by ``spec`` (``git:REV`` or a folder) for the figures in ``figures_dir``.
+
+    Parameters
+    ----------
+    spec : str
+        ``"git:REV"`` or a folder laid out like ``figures/`` (see :class:`Baseline`).
+    figures_dir : str or pathlib.Path
+        The figures folder of the build.
+
+    Returns
+    -------
+    Baseline
+        The references.
+
+    Raises
+    ------
+    ValueError
+        When ``spec`` cannot be read (see :class:`Baseline`).
+    """
     return Baseline(spec, Path(figures_dir))
 
 
@@ -155,6 +208,21 @@ def load_figure_rules(path) -> dict[str, list[dict]]:
     An entry: ``figure``, ``check`` (``finite`` or ``pixels``), ``reason``; for ``finite``,
     ``artists`` (labels, or ``"<axes>:<artist>"`` indices into the sidecar) and optionally
     ``limits`` (axes indices whose limits follow those artists).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path or None
+        The platform rules file; entries without ``figure`` (table rules) are skipped.
+
+    Returns
+    -------
+    dict of str to list of dict
+        Each figure's rules, in the file's order; empty when ``path`` is None or not a file.
+
+    Raises
+    ------
+    ValueError
+        When a figure entry lacks a valid ``check``, a ``reason``, or (for ``finite``) ``artists``.
     """
     import yaml
 
@@ -265,6 +333,25 @@ def compare_figure_data(reference: dict, result: dict, rtol: float | None = None
     Each names the axes (index and title), the artist (kind, index, label) and the largest
     difference. Default tolerances: those of the result tables. ``rules``: this figure's
     platform rules (:func:`load_figure_rules`).
+
+    Parameters
+    ----------
+    reference : dict
+        The committed figure description (a data sidecar, :func:`netrepro.figuredata.describe_figure`).
+    result : dict
+        The description of this build's figure.
+    rtol : float, optional
+        Relative tolerance of numbers; :data:`netrepro.regression.RTOL` when None.
+    atol : float, optional
+        Absolute tolerance of numbers; :data:`netrepro.regression.ATOL` when None.
+    rules : sequence of dict, default ()
+        This figure's platform rules: a ``finite`` rule compares its artists (and the limits of the
+        axes it names) by shape and NaN/inf pattern only.
+
+    Returns
+    -------
+    list of str
+        One line per difference; empty when the figures agree.
     """
     from .regression import ATOL, RTOL
 
@@ -316,7 +403,20 @@ def _rgb(data: bytes) -> np.ndarray:
 
 
 def png_rms(reference: bytes, result: bytes) -> float | None:
-    """RMS of the pixel difference (``calculate_rms``, as ``compare_images``); None if sizes differ."""
+    """RMS of the pixel difference (``calculate_rms``, as ``compare_images``); None if sizes differ.
+
+    Parameters
+    ----------
+    reference : bytes
+        The reference PNG file's contents.
+    result : bytes
+        The PNG file's contents of this build.
+
+    Returns
+    -------
+    float or None
+        The RMS of the RGB difference (0.0 for identical bytes); None when the image sizes differ.
+    """
     from matplotlib.testing.compare import calculate_rms
 
     if reference == result:
@@ -340,6 +440,33 @@ def compare_figures(baseline: Baseline, figures_dir, rules: dict | None = None, 
     """Compare every figure of ``figures_dir`` with ``baseline``; returns (number compared, differences).
 
     A difference with an empty ``problems`` list carries only notes (allowed by a platform rule).
+
+    Parameters
+    ----------
+    baseline : Baseline
+        The committed references.
+    figures_dir : str or pathlib.Path
+        The figures of this build (``<paper>/<id>.png`` and their data sidecars).
+    rules : dict of str to list of dict, optional
+        The platform rules of :func:`load_figure_rules`; none when None.
+    rtol : float, optional
+        Relative tolerance of the figures' data (:func:`compare_figure_data`).
+    atol : float, optional
+        Absolute tolerance of the figures' data (:func:`compare_figure_data`).
+    rms_tolerance : float, default RMS_TOLERANCE
+        The largest pixel RMS difference that passes without a ``pixels`` rule.
+
+    Returns
+    -------
+    n_compared : int
+        How many figures were compared (those of the references and of this build).
+    differences : list of FigureDifference
+        The figures with a problem or a note.
+
+    Raises
+    ------
+    ValueError
+        When the platform rules name a figure that has no reference.
     """
     figures_dir = Path(figures_dir)
     rules = rules or {}
@@ -408,6 +535,12 @@ def clear_difference_page(out_dir) -> None:
     """Remove a difference page written earlier in ``out_dir``: its ``index.html`` and its images only.
 
     Nothing else in the folder is touched, whatever folder it is (``--html`` may name any path).
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The page's folder; only ``index.html`` and ``*_reference.png``, ``*_result.png``,
+        ``*_difference.png`` files in it are removed.
     """
     out = Path(out_dir)
     for path in [out / "index.html", *out.glob("*.png")]:
@@ -420,6 +553,24 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
     """Write ``out_dir/index.html`` (and its images) showing every difference; returns its path.
 
     ``tables``: ``{"table": path, "problems": [...], "cells": [(row, column, result, reference), ...]}``.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The page's folder (created when missing); an earlier page in it is removed first
+        (:func:`clear_difference_page`).
+    figures : list of FigureDifference
+        The differing figures; each gets a section with its problems, notes, the reference and
+        result images and, when the pixels differ, the amplified difference image.
+    tables : list of dict
+        The differing tables, in the form above.
+    other : sequence of str, default ()
+        Further problems, shown as lines at the top of the page.
+
+    Returns
+    -------
+    pathlib.Path
+        The page, ``out_dir/index.html``.
     """
     from matplotlib.testing.compare import save_diff_image
 
@@ -483,6 +634,24 @@ def figure_jobs(root=".", targets=None) -> dict[str, dict]:
 
     The inputs are the result tables the figure reads (paths relative to ``root``), as the
     generated rule passes them (``workflow/rules/figures.smk``).
+
+    Parameters
+    ----------
+    root : str or pathlib.Path, default "."
+        The repository's root, where Snakemake is run.
+    targets : list of str, optional
+        The figure files to ask for; when None, every ``figures/*/*.png`` tracked by git or present.
+
+    Returns
+    -------
+    dict of str to dict
+        Each figure's function (``"module:function"``), its parameters and its input tables
+        (the ``code`` inputs left out).
+
+    Raises
+    ------
+    RuntimeError
+        When the dry run shows no figure job.
     """
     root = Path(root)
     if targets is None:
@@ -513,6 +682,24 @@ def regenerate_figures(jobs: dict[str, dict], out_dir, tables_dir=None, names=No
     ``tables_dir`` replaces the ``results/`` folder of the inputs (e.g. ``tests/reference``);
     ``module`` (paper -> module) replaces a paper's ``figures`` module (a scratch copy).
     Returns the names drawn.
+
+    Parameters
+    ----------
+    jobs : dict of str to dict
+        The figure jobs of :func:`figure_jobs`.
+    out_dir : str or pathlib.Path
+        The folder the figures are drawn into.
+    tables_dir : str or pathlib.Path, optional
+        A folder that replaces ``results/`` in the input paths; the inputs as they are when None.
+    names : collection of str, optional
+        Only these figures (``<paper>/<id>``); every job when None.
+    module : dict of str to module, optional
+        ``{paper: module}`` drawing that paper's figures instead of the module the job names.
+
+    Returns
+    -------
+    list of str
+        The names of the figures drawn, sorted.
     """
     import importlib
 

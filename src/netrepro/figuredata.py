@@ -30,7 +30,18 @@ FORMAT = 1
 
 
 def data_path(png) -> Path:
-    """The data sidecar of a figure: ``fig1.png`` -> ``fig1.data.json`` (same folder)."""
+    """The data sidecar of a figure: ``fig1.png`` -> ``fig1.data.json`` (same folder).
+
+    Parameters
+    ----------
+    png : str or pathlib.Path
+        The figure's PNG file.
+
+    Returns
+    -------
+    pathlib.Path
+        The sidecar's path, beside the PNG.
+    """
     png = Path(png)
     return png.with_name(png.stem + SUFFIX)
 
@@ -169,6 +180,17 @@ def describe_figure(fig) -> dict:
 
     Returns ``{"format", "suptitle", "legends", "axes": [...]}`` with one entry per axes of
     ``fig.axes`` (twin axes and colour bars are axes too); see the module docstring.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The drawn figure.
+
+    Returns
+    -------
+    dict
+        ``format``, ``size_inches``, ``suptitle``, ``legends``, ``texts`` and ``axes`` (one
+        description per axes: limits, labels, ticks, legend and artists).
     """
     sup = fig._suptitle.get_text() if getattr(fig, "_suptitle", None) is not None else ""
     return {"format": FORMAT, "size_inches": _array(fig.get_size_inches()), "suptitle": sup,
@@ -178,7 +200,20 @@ def describe_figure(fig) -> dict:
 
 
 def write_figure_data(fig, png) -> Path:
-    """Write ``describe_figure(fig)`` beside the PNG ``png`` (atomically); returns its path."""
+    """Write ``describe_figure(fig)`` beside the PNG ``png`` (atomically); returns its path.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The drawn figure.
+    png : str or pathlib.Path
+        The figure's PNG file; the sidecar is :func:`data_path` of it.
+
+    Returns
+    -------
+    pathlib.Path
+        The data sidecar written.
+    """
     target = data_path(png)
     text = json.dumps(describe_figure(fig), separators=(",", ":"), allow_nan=False)
     with atomic_path(target) as tmp:

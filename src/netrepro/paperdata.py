@@ -105,6 +105,8 @@ class ClaimEntry:
         Reconstruction keys whose declared ranges the claim is re-judged across.
     erratum_id : str
         The erratum that explains a disagreement, if any.
+    note : str
+        A remark on the claim, carried into the ``note`` column of the claims table.
     group : str
         The claim group of the replication summary.
     test : str
@@ -223,9 +225,15 @@ class PaperData:
     slug : str
         The paper.
     claims : list of ClaimEntry
+        The claims of ``claims.yaml``, in the file's order.
     errata : list of dict
+        The entries of ``errata.yaml`` (``id``, ``location``, ``kind``, ``printed``, ``corrected``,
+        ``impact``).
     reconstructions : list of dict
+        The entries of ``reconstructions.yaml`` (``key``, ``reason``, ``range``, ...), whose keys
+        the claims' and findings' ``depends_on`` name.
     findings : list of FindingEntry
+        Our own findings of ``findings.yaml``, in the file's order.
     """
 
     slug: str
@@ -240,7 +248,18 @@ class PaperData:
 
 
 def paper_dir(slug: str) -> Path:
-    """The package directory of a paper, which holds its data files."""
+    """The package directory of a paper, which holds its data files.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+
+    Returns
+    -------
+    pathlib.Path
+        ``src/netrepro/papers/<slug>`` (whether or not it exists).
+    """
     return _PAPERS_DIR / slug
 
 

@@ -90,7 +90,18 @@ def rewrite(readme: str, table: str) -> str:
 
 
 def figure_table(papers=None) -> str:
-    """The Markdown table of figure targets: per registered paper its figure rules and folder."""
+    """The Markdown table of figure targets: per registered paper its figure rules and folder.
+
+    Parameters
+    ----------
+    papers : iterable of str, optional
+        The papers' slugs, in this order; every registered paper when None (or empty).
+
+    Returns
+    -------
+    str
+        The table's lines (``| paper | figure rules | files |``), without a final newline.
+    """
     registry = load_registry()
     lines = ["| paper | figure rules | files |", "|---|---|---|"]
     for slug in papers or registry:
@@ -101,7 +112,20 @@ def figure_table(papers=None) -> str:
 
 
 def rewrite_figures(readme: str, table: str) -> str:
-    """``readme`` with the figure-targets table replaced by ``table`` (unchanged without its markers)."""
+    """``readme`` with the figure-targets table replaced by ``table`` (unchanged without its markers).
+
+    Parameters
+    ----------
+    readme : str
+        The README's text.
+    table : str
+        The new table (:func:`figure_table`), put between the ``FIG_START`` and ``FIG_END`` lines.
+
+    Returns
+    -------
+    str
+        The README's new text; ``readme`` itself when it lacks either marker.
+    """
     if FIG_START not in readme or FIG_END not in readme:
         return readme
     head, rest = readme.split(FIG_START, 1)

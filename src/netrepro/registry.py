@@ -26,7 +26,18 @@ _CITATION_FIELDS = ("type", "title", "authors")
 
 
 def valid_slug(slug: str) -> bool:
-    """Whether ``slug`` can name a paper: a lower-case Python identifier that is not a keyword."""
+    """Whether ``slug`` can name a paper: a lower-case Python identifier that is not a keyword.
+
+    Parameters
+    ----------
+    slug : str
+        The candidate slug.
+
+    Returns
+    -------
+    bool
+        True for a lower-case identifier that is not a keyword and does not start with ``_``.
+    """
     return slug.isidentifier() and not keyword.iskeyword(slug) and slug == slug.lower() and not slug.startswith("_")
 
 
@@ -57,6 +68,18 @@ def _load(path: str, stamp: tuple) -> dict:
 def load_registry(path: str | Path = REGISTRY_FILE) -> dict:
     """Slug -> entry (``source``, ``title``, ``authors``, ``citation``), in the registry's order.
 
+    The file is read again when it changed (its modification time or size).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, default REGISTRY_FILE
+        The registry file (``src/netrepro/papers.yaml``).
+
+    Returns
+    -------
+    dict of str to dict
+        Each paper's entry, keyed by its slug (a copy: changing it leaves the cache alone).
+
     Raises
     ------
     ConfigError
@@ -70,12 +93,48 @@ def load_registry(path: str | Path = REGISTRY_FILE) -> dict:
 
 
 def paper_slugs(path: str | Path = REGISTRY_FILE) -> list[str]:
-    """The registered slugs, in the registry's order."""
+    """The registered slugs, in the registry's order.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, default REGISTRY_FILE
+        The registry file.
+
+    Returns
+    -------
+    list of str
+        The slugs.
+
+    Raises
+    ------
+    ConfigError
+        When the registry cannot be read (see :func:`load_registry`).
+    """
     return list(load_registry(path))
 
 
 def registry_entry_text(slug: str, title: str, source: str, authors: str = "") -> str:
-    """The YAML text of a new registry entry (appended by ``new-paper``), every field commented."""
+    """The YAML text of a new registry entry (appended by ``new-paper``), every field commented.
+
+    The citation's authors are placeholders (``TODO``) and ``venue_checked`` is false; a comment
+    line above the entry says what to fill in.
+
+    Parameters
+    ----------
+    slug : str
+        The paper's slug.
+    title : str
+        The paper's title (the entry's and the citation's).
+    source : str
+        The paper's source text.
+    authors : str, default ""
+        The authors, one line; ``"TODO: the authors"`` when empty.
+
+    Returns
+    -------
+    str
+        The entry's YAML text, starting with its comment line.
+    """
     entry = {slug: {"source": source, "title": title, "authors": authors or "TODO: the authors",
                     "citation": {"type": "article", "title": title,
                                  "authors": [{"family-names": "TODO", "given-names": "TODO"}],

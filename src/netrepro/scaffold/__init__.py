@@ -34,7 +34,19 @@ TEST_FILES = ("__init__.py", "test_model.py", "test_steps.py", "test_evidence.py
 
 @dataclass
 class Plan:
-    """What ``new-paper`` will do: files to create (path -> text) and files to rewrite (path -> new text)."""
+    """What ``new-paper`` will do: files to create (path -> text) and files to rewrite (path -> new text).
+
+    Parameters
+    ----------
+    slug : str
+        The new paper's slug.
+    create : dict of str to str
+        The files to create, paths relative to the repository's root; the notebook's text is empty
+        (:func:`write_plan` writes it from the report's notebook template).
+    rewrite : dict of str to str
+        The existing files to rewrite (configurations, configuration schema, registry) and their
+        new text.
+    """
 
     slug: str
     create: dict
@@ -134,7 +146,22 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
 
 
 def write_plan(plan: Plan, root: str | Path = ".") -> list[str]:
-    """Write the files of ``plan`` under ``root``; return their paths."""
+    """Write the files of ``plan`` under ``root``; return their paths.
+
+    Parent folders are created; the notebook is written by :func:`netrepro.report.notebooks.make_notebook`.
+
+    Parameters
+    ----------
+    plan : Plan
+        The files to create and to rewrite (:func:`plan_new_paper`).
+    root : str or pathlib.Path, default "."
+        The repository's root.
+
+    Returns
+    -------
+    list of str
+        The paths written, relative to ``root``, sorted.
+    """
     from ..report.notebooks import make_notebook  # the report's notebook template, imported only when writing
 
     root = Path(root)
@@ -151,5 +178,31 @@ def write_plan(plan: Plan, root: str | Path = ".") -> list[str]:
 
 
 def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".", authors: str = "") -> list[str]:
-    """Create the skeleton of paper ``slug`` (see :func:`plan_new_paper`); return the paths written."""
+    """Create the skeleton of paper ``slug`` (see :func:`plan_new_paper`); return the paths written.
+
+    Every check is made before anything is written.
+
+    Parameters
+    ----------
+    slug : str
+        The new paper's slug: a lower-case Python identifier not yet registered.
+    title : str
+        The paper's title.
+    source : str or pathlib.Path
+        The paper's source text; it must exist.
+    root : str or pathlib.Path, default "."
+        The repository's root.
+    authors : str, default ""
+        The authors, one line (the registry says TODO when empty).
+
+    Returns
+    -------
+    list of str
+        The paths written, relative to ``root``, sorted.
+
+    Raises
+    ------
+    InputError
+        When the request is refused (see :func:`plan_new_paper`).
+    """
     return write_plan(plan_new_paper(slug, title, source, root, authors), root)
