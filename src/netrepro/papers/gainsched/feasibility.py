@@ -82,12 +82,14 @@ def sector_gain(sys: System, U) -> np.ndarray:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     U : array_like (..., nz, nz)
         Orthogonal matrices (a stack is allowed).
 
     Returns
     -------
     ndarray (..., nz, nz)
+        The linear gains K, one per U.
     """
     U = np.asarray(U, dtype=float)
     return 0.5 * (sys.F1 + sys.F2) + U @ (0.5 * sys.F)
@@ -103,12 +105,16 @@ def linear_gain_radius(sys: System, K, sigma2: float):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     K : array_like (..., nz, nz)
+        Linear gains of f(z) = K z (a stack is allowed).
     sigma2 : float
+        Variance of the multiplicative noise w(k) of (1) (replaces ``sys.sigma2``).
 
     Returns
     -------
     float or ndarray (...)
+        The spectral radius, one per gain (a float for a single gain).
     """
     K = np.asarray(K, dtype=float)
     AK = sys.A + sys.B @ K @ sys.Z
@@ -132,7 +138,10 @@ def linear_gain_limit(sys: System, K):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k). Its own ``sigma2``
+        is not used.
     K : array_like (..., nz, nz)
+        Linear gains of f(z) = K z (a stack is allowed).
 
     Returns
     -------
@@ -230,11 +239,15 @@ def sector_class_radius(sys: System, sigma2: float) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k). The search over O(2)
+        is made only when nz = 2.
     sigma2 : float
+        Variance of the multiplicative noise w(k) of (1) at which the radius is computed.
 
     Returns
     -------
     float
+        The largest radius found; >= 1 means the class (3) holds an f that is not mean-square stable.
     """
     rho = plant_vertex_radius(sys, sigma2)
     if sys.nz == 2:

@@ -858,12 +858,14 @@ def realisation(gains: Gains, J) -> Gains:
     Parameters
     ----------
     gains : Gains
+        The filter gains G0, Gf, H0, Hf of (9) in the original coordinates.
     J : array_like (n, n)
         Nonsingular.
 
     Returns
     -------
     Gains
+        The same filter in the coordinates x_f' = J x_f.
 
     Raises
     ------

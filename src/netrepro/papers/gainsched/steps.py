@@ -562,6 +562,23 @@ def scheduling_step(params, inputs, outputs):
       error itself.
 
     A row ``schedule_size`` gives max(|Gf|, |Hf|) of each LMI design of ``gains.csv`` (is it scheduled?).
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``lmi``, ``performance``, ``simulation`` and
+        ``scheduling`` sections (``scheduling.starts``: the designs of ``gains.csv`` the exact
+        tuning starts from).
+    inputs : dict
+        ``gains``: the designed gains table (``results/gainsched/gains.csv``).
+    outputs : dict
+        ``table`` (``results/gainsched/scheduling.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}`` with columns comparison, family, value, verdict, certified_slack,
+        status, start, n_evaluations.
     """
     from .design import Theorem3, certified_cost
     from .tuning import best_exact_gains

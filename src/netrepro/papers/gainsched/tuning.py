@@ -164,15 +164,20 @@ def exact_cost(sys: System, gains: Gains, p_seq, F, X0) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     gains : Gains
+        The filter gains of (9).
     p_seq : array_like (K,)
+        The scheduled p(k) = Prob{xi(k) = 1} of (7), one per step; its length is the horizon.
     F : ndarray (nz, nz)
+        Linear gain of f: f(z) = F z.
     X0 : ndarray (2n, 2n)
         E z̄(0) z̄(0)^T.
 
     Returns
     -------
     float
+        The sum over the horizon of E||x(k) - x_f(k)||^2, starting from ``X0``.
     """
     M1, M0, W = mode_matrices(sys, gains, p_seq, F)
     p = np.asarray(p_seq, dtype=float)
@@ -221,11 +226,15 @@ def best_exact_gains(sys: System, p_seq, F, X0, scheduled: bool, starts, gtol: f
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     p_seq : array_like (K,)
+        The scheduled p(k) = Prob{xi(k) = 1} of (7), one per step; its length is the horizon.
     F : ndarray (nz, nz)
         Linear gain of f.
     X0 : ndarray (2n, 2n)
+        Initial second moment E z̄(0) z̄(0)^T of the augmented state (10).
     scheduled : bool
+        Whether the gains depend on p (Gf, Hf free, the gain-scheduled filter) or are fixed (Gf = Hf = 0).
     starts : sequence of (str, Gains)
         Named starting gains.
     gtol : float

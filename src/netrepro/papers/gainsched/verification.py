@@ -50,7 +50,9 @@ def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     gains : Gains
+        The filter gains of (9).
     ps : array_like
         Frozen probabilities.
     p_seq : array_like
@@ -59,6 +61,8 @@ def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
     Returns
     -------
     float
+        The larger of the largest frozen radius and the largest growth rate; below 1 for mean-square
+        stability.
     """
     cases = sector_cases(sys).values()
     rho = max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases)
@@ -74,12 +78,16 @@ def convergence_rate(sys: System, gains: Gains, p_seq) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     gains : Gains
+        The filter gains of (9).
     p_seq : array_like
+        The scheduled p(k) of Section IV.
 
     Returns
     -------
     float
+        The largest per-step growth rate over the three linear gains.
     """
     return float(max(scheduled_growth_rate(sys, gains, p_seq, F) for F in linear_gains(sys).values()))
 
@@ -119,7 +127,9 @@ def missing_fraction(p_seq, n_runs: int, seed: int) -> tuple:
     p_seq : array_like
         Prob{xi(k) = 1} (7).
     n_runs : int
+        Number of simulated runs, each as long as ``p_seq``.
     seed : int
+        Seed of the random generator (``numpy.random.default_rng``).
 
     Returns
     -------
@@ -144,12 +154,17 @@ def eq15_residuals(sys: System, gains: Gains, Q0, Qp, rng: np.random.Generator, 
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
     gains : Gains
+        The filter gains of (9) that the Lyapunov matrix certifies.
     Q0, Qp : ndarray (2n, 2n)
         The Lyapunov matrix Q(p) = Q0 + p Qp of (27).
     rng : numpy.random.Generator
+        Source of the random states z̄.
     n_states : int
+        Number of random states z̄ (at least 1).
     scale : float
+        Scale of the states fed to the nonlinearities, f(scale z)/scale, to leave their linear part.
 
     Returns
     -------
@@ -180,10 +195,12 @@ def gap_relative(lower: float, upper: float) -> float:
     Parameters
     ----------
     lower, upper : float
+        The two ends compared; ``upper`` must be positive and finite.
 
     Returns
     -------
     float
+        (upper - lower) / upper.
 
     Raises
     ------

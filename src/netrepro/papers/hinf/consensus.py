@@ -259,10 +259,12 @@ def complete_laplacian(n: int):
     Parameters
     ----------
     n : int
+        Number of agents.
 
     Returns
     -------
     ndarray, shape ``(n, n)``
+        ``n`` on the diagonal, -1 elsewhere.
     """
     return n * np.eye(n) - np.ones((n, n))
 
@@ -301,11 +303,14 @@ def component_sums(u, adj):
     Parameters
     ----------
     u : ndarray, shape ``(..., N, d)``
+        The agents' inputs (one row per agent), a stack of runs allowed.
     adj : ndarray, shape ``(..., N, N)``
+        0/1 adjacency of eq (25), matching ``u``'s leading shape.
 
     Returns
     -------
     ndarray, shape ``(..., N, d)``
+        Row ``i``: the sum of ``u_j`` over the agents ``j`` of ``i``'s piece (``i`` included).
     """
     return component_membership(adj) @ np.asarray(u, dtype=float)
 
@@ -316,9 +321,11 @@ def topology_changed(adj_old, adj_new):
     Parameters
     ----------
     adj_old, adj_new : ndarray, shape ``(..., N, N)``
+        0/1 adjacency of eq (25) at the earlier and the later step.
 
     Returns
     -------
     ndarray of bool, shape ``adj.shape[:-2]``
+        True for the runs whose graph differs.
     """
     return np.any(np.asarray(adj_old) != np.asarray(adj_new), axis=(-2, -1))

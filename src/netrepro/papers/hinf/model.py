@@ -514,6 +514,7 @@ def settle_step(error_mean, threshold: float) -> int:
     error_mean : array_like
         A (Monte Carlo mean) error series over ``k = 0..K``.
     threshold : float
+        The level the series must stay below.
 
     Returns
     -------

@@ -209,11 +209,15 @@ def dinfo_dr_reading(r, theta, model: NoiseModel, reading: str = "variances"):
     r, theta : float
         Range and bearing.
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a1``, ``a2``, ``alpha``).
     reading : {"variances", "square_roots"}
+        The reading of ``R`` in eq (17): the variances ``diag(f_r, f_b)`` or their square roots (the matrix
+        of eq (3)).
 
     Returns
     -------
     ndarray, shape ``(2, 2)``
+        ``d M^{-1} / d r`` under that reading.
 
     Raises
     ------

@@ -655,6 +655,23 @@ def loop_variants_shard_step(params, inputs, outputs):
     initial estimates in every loop, so the loops are paired by run. Tasks are split over
     ``n_shards`` contiguous shards (:func:`netrepro.engines.montecarlo.shard_blocks`); each task is computed
     the same way in any shard, so the merged table does not depend on the shard count.
+
+    Parameters
+    ----------
+    params : dict
+        ``cfg`` (the whole ``hinf`` configuration; ``loop_variants`` and ``claims.late_start`` are
+        read), ``shard`` (this shard's index) and ``n_shards``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/hinf/shards/loop_variants_<shard>.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"tasks": [...]}}``: one row per task and run (late
+        errors of the local and decentralized filters, connected fraction, topology changes) and
+        the task indices of this shard.
     """
     from netrepro.engines.montecarlo import shard_blocks
 
@@ -694,6 +711,23 @@ def loop_variants_merge_step(params, inputs, outputs):
       local filters (the abstract's "system using only local estimates"); the paths differ, so the pairing is
       by seed (same run index: same target start, noise stream and initial estimate), a paired test on the run
       means.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration (``loop_variants.targets`` and ``tests.alpha`` are read).
+    inputs : dict
+        ``shards``: the shard tables of :func:`loop_variants_shard_step`.
+    outputs : dict
+        ``table`` (``results/hinf/loop_variants.csv``) and ``runs``
+        (``results/hinf/loop_variants_runs.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "runs": DataFrame}``: one row per target, loop and comparison (means,
+        paired difference, standard error, z, ``z_crit`` and ``tag``), and the per-run shard rows
+        merged in task order.
     """
     runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
     runs = runs.sort_values(["task", "run"]).drop(columns="task").reset_index(drop=True)
@@ -744,6 +778,23 @@ def kalman_best_shard_step(params, inputs, outputs):
     Targets: ``evasive`` (eqs (19)-(24)), ``drift`` (non-reactive, the evader's step length in a fixed
     heading), ``evasive_noise`` (the evader plus white noise W) and ``random``. Shards as in
     :func:`loop_variants_shard_step`.
+
+    Parameters
+    ----------
+    params : dict
+        ``cfg`` (the whole ``hinf`` configuration; ``kalman_best`` and ``claims.late_start`` are
+        read), ``shard`` (this shard's index) and ``n_shards``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/hinf/shards/kalman_best_<shard>.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"tasks": [...]}}``: one row per task, filter and run
+        (family, kind, gamma, ``W_factor``, late error, target displacement) and the task indices
+        of this shard.
     """
     from netrepro.engines.montecarlo import shard_blocks
 
@@ -782,6 +833,21 @@ def kalman_best_merge_step(params, inputs, outputs):
     Kalman setting, both chosen on the ``select`` runs (smallest mean late error; the judge runs never
     choose). Each row is tagged at the Bonferroni-corrected two-sided level ``tests.alpha`` over every
     row of the table. ``displacement`` is the target's mean ``lag``-step displacement (judge runs).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration (``kalman_best``, ``filter.gamma`` and ``tests.alpha`` are read).
+    inputs : dict
+        ``shards``: the shard tables of :func:`kalman_best_shard_step`.
+    outputs : dict
+        ``table`` (``results/hinf/kalman_best.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per target, kind and comparison (labels, means, paired
+        difference, standard error, z, ``z_crit``, ``tag`` and displacement).
     """
     runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
     runs = runs.sort_values(["task", "label", "run"], kind="stable").drop(columns="task").reset_index(drop=True)

@@ -244,7 +244,30 @@ def two_sensor_simulation_step(params, inputs, outputs):
 
 def stationary_curve_step(params, inputs, outputs):
     """Step: the exact E(p_inf)(lambda) next to s*(lambda) and r*(lambda) for lambda in (lambda_c, 1], with the
-    tail index of p_inf and whether its variance is finite (tails.tail_index, tails.moment_finite_threshold)."""
+    tail index of p_inf and whether its variance is finite (tails.tail_index, tails.moment_finite_threshold).
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2`` and ``lambda_offsets`` with the ``stationary_curve``
+        section: ``n_lambda`` grid points, geometric from ``first_fraction`` of (1 - lambda_c) above
+        lambda_c up to 1 (the variance threshold and the report's settings added).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/stationary_curve.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per lambda: the stationary mean and its bounds, s*, r*,
+        the tail index, whether the variance is finite, and whether it is a report setting.
+
+    Raises
+    ------
+    InputError
+        If ``first_fraction`` is not in (0, 1).
+    """
     a, R1, R2 = params["a"], params["R1"], params["R2"]
     lam_c = critical_probability(a)
     n, first = params["n_lambda"], params["first_fraction"]
@@ -271,7 +294,25 @@ def stationary_curve_step(params, inputs, outputs):
 def heavy_tail_step(params, inputs, outputs):
     """Step: the law of p_k at k = horizon by enumeration of all 2^k arrival sequences (model.exact_mean_enumeration):
     quantiles, mean and standard deviation, beside the tail index of the stationary law; at the report's lambdas
-    (lambda_c + the scalar offsets) and at the extra ``lambdas``."""
+    (lambda_c + the scalar offsets) and at the extra ``lambdas``.
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` and ``lambda_offsets`` with the
+        ``heavy_tail`` section (``horizon``, ``quantiles``, optional ``lambdas``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/heavy_tail.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per lambda: tail index, whether the mean and the variance
+        are finite, the mean (by enumeration and exact), the standard deviation, the quantiles
+        ``q<prob>``, the largest p_k and the stationary mean.
+    """
     a, R1, R2, p0, k = params["a"], params["R1"], params["R2"], params["Ep0"], params["horizon"]
     lam_c = critical_probability(a)
     probs = [float(q) for q in params["quantiles"]]
@@ -294,7 +335,22 @@ def heavy_tail_step(params, inputs, outputs):
 
 def region_closed_form_step(params, inputs, outputs):
     """Step: the closed-form lower bound of the two-sensor region (two_sensor.two_sensor_lower_bound) on a dense
-    lambda_1 grid with its kink lambda_1 = 1 - 1/a^2 inserted exactly (Fig. 4)."""
+    lambda_1 grid with its kink lambda_1 = 1 - 1/a^2 inserted exactly (Fig. 4).
+
+    Parameters
+    ----------
+    params : dict
+        The ``two_sensor`` section's ``a`` (the system's pole) and ``n_dense`` (grid points on [0, 1]).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/region_closed_form.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}`` with columns ``lambda1`` and ``lambda2c_lower``.
+    """
     a = params["a"]
     grid = np.union1d(np.linspace(0.0, 1.0, params["n_dense"]), [critical_probability(a)])
     return {"table": pd.DataFrame({"lambda1": grid, "lambda2c_lower": two_sensor_lower_bound(grid, a)})}

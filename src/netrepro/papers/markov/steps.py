@@ -197,6 +197,21 @@ def tight_variants_step(params, inputs, outputs):
 
     Table ``tight_variants.csv``: ``check, example, q, tol, p_lower, p_upper, certified, n_solves``; the
     claims on ``p_underline`` are re-judged across these tolerances.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C`` of each example) and ``checks``
+        (``tight``: the checks' name, example and q; ``tight_tol_variants``: the tolerances).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/markov/tight_variants.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per tight check and tolerance.
     """
     ck = params["checks"]
     rows = []

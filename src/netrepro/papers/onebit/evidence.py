@@ -67,7 +67,20 @@ def alpha_label(eps: float) -> str:
 
 
 def variant_label(key: str, text: str) -> str:
-    """The label of a variant row inside the declared range of reconstruction ``key``: ``'<key>: <text>'``."""
+    """The label of a variant row inside the declared range of reconstruction ``key``: ``'<key>: <text>'``.
+
+    Parameters
+    ----------
+    key : str
+        The reconstruction's key (``reconstructions.yaml``), e.g. ``"snr_grid_db"``.
+    text : str
+        What differs from the nominal setting, e.g. ``"alpha = 1 - 0.01, SNR = -10 dB"``.
+
+    Returns
+    -------
+    str
+        ``"<key>: <text>"``.
+    """
     return f"{key}: {text}"
 
 
