@@ -78,7 +78,7 @@ def load_registry(path: str | Path = REGISTRY_FILE) -> dict:
     Returns
     -------
     dict of str to dict
-        Each paper's entry, keyed by its slug (a copy: changing it leaves the cache alone).
+        Each paper's entry, keyed by its slug (a shallow copy of the cached mapping).
 
     Raises
     ------

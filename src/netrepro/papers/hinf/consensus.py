@@ -264,7 +264,7 @@ def complete_laplacian(n: int):
     Returns
     -------
     ndarray, shape ``(n, n)``
-        ``n`` on the diagonal, -1 elsewhere.
+        ``n - 1`` on the diagonal (each agent's degree), -1 elsewhere.
     """
     return n * np.eye(n) - np.ones((n, n))
 
