@@ -95,7 +95,7 @@ def write_config(workdir, name, **scalar):
 def fresh_copy(tmp_path_factory, name):
     work = tmp_path_factory.mktemp(name) / "repo"
     shutil.copytree(ROOT, work, ignore=top_level_ignore(ROOT, IGNORE_AT_ROOT))
-    write_config(work, "rel.yaml", n_paths=300_000, block_size=10_000, n_chunks=1, n_shards=1)
+    write_config(work, "rel.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=1, n_shards=1)
     return work
 
 
@@ -142,7 +142,7 @@ def reference(built):
 # ----------------------------------------------------------------------------- part 4: determinism
 def test_j2_other_chunking_and_forceall_give_identical_tables(built, reference, tmp_path_factory):
     work = clone(built, tmp_path_factory, "rel_det")
-    write_config(work, "rel2.yaml", n_paths=300_000, block_size=10_000, n_chunks=7, n_shards=3)
+    write_config(work, "rel2.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=7, n_shards=3)
     snakemake(work, "-j2", "--forceall", *TARGETS, config="config/rel2.yaml")
     again = tables(work)
     for path, data in reference.items():
@@ -211,7 +211,11 @@ def interrupt(work, how):
             assert proc.poll() is None, (work / "interrupted.txt").read_text()[-3000:]
             assert time.monotonic() < deadline, "the Monte Carlo step never started"
             time.sleep(0.1)
-        time.sleep(1.0)
+        # signal while a Monte Carlo job process runs: with a warm compile cache the shard takes well
+        # under a second, so a fixed wait could miss it (the signal then came after the step)
+        settle = time.monotonic() + 1.0
+        while time.monotonic() < settle and not any("monte_carlo" in line for line in job_processes(work)):
+            time.sleep(0.01)
         running = not (work / "results/intermittent/monte_carlo.csv").exists()
         if how == "TERM":
             proc.send_signal(signal.SIGTERM)
@@ -229,8 +233,21 @@ def interrupt(work, how):
 
 
 def job_processes(work):
+    """The pipeline job processes running in ``work`` (their command lines name relative paths only,
+    so the process's working directory tells whose they are)."""
     ps = subprocess.run(["ps", "-eo", "pid,args"], capture_output=True, text=True).stdout
-    return [line for line in ps.splitlines() if "netrepro run" in line and str(work) in line]
+    mine = []
+    for line in ps.splitlines():
+        pid, _, args = line.strip().partition(" ")
+        if "netrepro run" not in args:
+            continue
+        try:
+            cwd = os.readlink(f"/proc/{pid}/cwd")
+        except OSError:  # ended meanwhile
+            continue
+        if Path(cwd).resolve() == Path(work).resolve():
+            mine.append(line)
+    return mine
 
 
 @pytest.mark.parametrize("how", ["TERM", "TERM-group", "KILL-group"])
