@@ -121,7 +121,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ...verdicts import evidence_frame, load_paper_data
+from ...paperdata import load_paper_data
+from ...verdicts import evidence_frame
 from .model import critical_arrival_probability, mare_fixed_point
 
 __all__ = ["evidence_step"]

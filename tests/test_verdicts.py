@@ -270,7 +270,8 @@ SLUGS = sorted(p.parent.name for p in Path(__file__).resolve().parents[1].glob("
 @pytest.mark.parametrize("slug", SLUGS)
 def test_every_claim_of_a_paper_points_to_a_quantity_a_step_produces(slug):
     """Each claim has a tolerance reason and resolves against the committed reference tables."""
-    from netrepro.verdicts import read_evidence, referenced_tables
+    from netrepro.paperdata import referenced_tables
+    from netrepro.verdicts import read_evidence
 
     data = load_paper_data(slug)
     for entry in data.claims:

@@ -20,8 +20,7 @@ values across the declared variants: a verdict that changes inside that range is
 ``conditional``, with the condition stated, and ``robust`` is ``no``. :func:`verdicts_step`
 writes the four tables of one paper.
 
-``DATA_FILES``, ``load_paper_data``, ``paper_dir`` and ``referenced_tables`` are re-exported from
-:mod:`netrepro.paperdata` for the workflow (``workflow/rules/common.smk``) and the papers' tests.
+Loading and validating the data files is :mod:`netrepro.paperdata`.
 """
 
 from __future__ import annotations
@@ -35,10 +34,6 @@ import pandas as pd
 
 from .errors import ConfigError, InputError
 from .paperdata import ClaimEntry, FindingEntry, PaperData, load_paper_data
-# re-exported: the workflow (common.smk) imports these from here
-from .paperdata import DATA_FILES as DATA_FILES  # noqa: F401
-from .paperdata import paper_dir as paper_dir  # noqa: F401
-from .paperdata import referenced_tables as referenced_tables  # noqa: F401
 
 __all__ = [
     "VERDICTS",

@@ -16,7 +16,7 @@ from netrepro.papers.gainsched.verification import (
 )
 from netrepro.papers.gainsched.feasibility import with_sigma2
 from netrepro.papers.gainsched.model import Gains, sector_cases, theorem1_matrix, zero_gains
-from netrepro.verdicts import load_paper_data
+from netrepro.paperdata import load_paper_data
 
 from .conftest import random_gains
 

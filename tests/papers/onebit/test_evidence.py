@@ -11,7 +11,8 @@ import pytest
 import yaml
 
 from netrepro.papers.onebit import evidence, steps
-from netrepro.verdicts import NOMINAL, load_paper_data, read_evidence, verdicts_step
+from netrepro.paperdata import load_paper_data
+from netrepro.verdicts import NOMINAL, read_evidence, verdicts_step
 
 ROOT = Path(__file__).resolve().parents[3]
 
