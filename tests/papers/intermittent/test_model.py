@@ -96,3 +96,11 @@ def test_corrected_condition_11_is_x_minus_phi_at_the_optimal_gain():
     grid = np.logspace(-3, 6, 2000)
     assert np.max(im.condition_11_corrected(grid, LAM_S, A, R1, R2)) > 0
     assert np.max(im.condition_11_corrected(grid, LAM_S - 0.2, A, R1, R2)) < 0
+
+
+def test_lower_bound_limit_is_where_the_lower_bound_settles():
+    from netrepro.papers.intermittent.model import lower_bound_limit, lower_bound_sequence
+
+    a, R1, lam = 1.5, 0.1, 0.7  # (1 - lambda) a^2 = 0.675 < 1
+    s = lower_bound_sequence(3.0, a, R1, lam, 400)
+    assert abs(lower_bound_limit(a, R1, lam) - s[-1]) <= 1e-12 * s[-1]

@@ -14,6 +14,7 @@ __all__ = [
     "critical_probability",
     "riccati_step",
     "lower_bound_sequence",
+    "lower_bound_limit",
     "upper_bound_sequence",
     "report_estimate_sequence",
     "estimate_with_true_mean",
@@ -88,6 +89,25 @@ def lower_bound_sequence(s0, a, R1, lam, n_steps) -> np.ndarray:
         for k in range(n_steps):
             s[k + 1] = (1.0 - lam) * a * a * s[k] + R1
     return s
+
+
+def lower_bound_limit(a, R1, lam) -> float:
+    """Limit of the lower bound (10): the fixed point s* = R1 / (1 - (1 - lambda) a^2) of s -> (1 - lambda) a^2 s + R1.
+
+    Parameters
+    ----------
+    a, R1 : float
+        System coefficient and process noise variance.
+    lam : float
+        Arrival probability lambda, with (1 - lambda) a^2 < 1 (otherwise s_k diverges).
+
+    Returns
+    -------
+    float
+        s*.
+    """
+    growth = (1.0 - lam) * a * a
+    return R1 / (1.0 - growth)
 
 
 def upper_bound_sequence(r0, a, R1, R2, lam, n_steps) -> np.ndarray:

@@ -37,8 +37,8 @@ from ...errors import InputError
 from ...io import read_table
 from .estimators import conditional_mean_paths
 from .exact import exact_mean, stationary_mean
-from .model import (critical_probability, exact_mean_enumeration, lower_bound_sequence, mare_fixed_point,
-                    report_estimate_sequence, upper_bound_sequence)
+from .model import (critical_probability, exact_mean_enumeration, lower_bound_limit, lower_bound_sequence,
+                    mare_fixed_point, report_estimate_sequence, upper_bound_sequence)
 from .tails import moment_finite_threshold, tail_index, weighted_quantiles
 from .two_sensor import two_sensor_lower_bound, two_sensor_upper_bound
 
@@ -99,7 +99,7 @@ def stationary_mean_step(params, inputs, outputs):
             row.update({"stationary_mean": st["mean"], "stationary_lo": st["lo"], "stationary_hi": st["hi"],
                         "bracket_rel_width": (st["hi"] - st["lo"]) / st["mean"],
                         "method": "exact (Chebyshev backward recursion, rigorous bracket)",
-                        "s_limit": R1 / (1.0 - growth), "r_limit": mare_fixed_point(a, R1, R2, lam),
+                        "s_limit": lower_bound_limit(a, R1, lam), "r_limit": mare_fixed_point(a, R1, R2, lam),
                         "report_estimate_limit": est[-1], "n_iter": st["n_iter"]})
         else:
             row.update({"stationary_mean": np.inf, "stationary_lo": np.inf, "stationary_hi": np.inf,
@@ -283,9 +283,8 @@ def stationary_curve_step(params, inputs, outputs):
     rows = []
     for lam in lams:
         st = stationary_mean(a, R1, [R2], [lam], p0=R2)
-        growth = (1.0 - lam) * a * a
         rows.append({"lam": lam, "stationary_mean": st["mean"], "stationary_lo": st["lo"], "stationary_hi": st["hi"],
-                     "s_limit": R1 / (1.0 - growth), "r_limit": mare_fixed_point(a, R1, R2, lam),
+                     "s_limit": lower_bound_limit(a, R1, lam), "r_limit": mare_fixed_point(a, R1, R2, lam),
                      "tail_index": tail_index(lam, a), "variance_finite": bool(lam > var_from),
                      "report_setting": bool(np.any(np.isclose(lam, report, rtol=0, atol=1e-15)))})
     return {"table": pd.DataFrame(rows)}
