@@ -32,9 +32,18 @@ $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 
 # Console: one line per finished job and the warnings (workflow/profiles/default); each job's
 # full command is in its log (logs/) and its provenance sidecar (*.meta.json).
+# `make report CONFIG=paper-scale [PROFILE=slurm]`: the overlay config/$(CONFIG).yaml on top of
+# config/config.yaml, through the profile workflow/profiles/$(PROFILE) (a cluster profile sets its own
+# job limit; the shard counts come from the profile or SHARDS='{onebit_estimator: 8}').
+CONFIG ?=
+PROFILE ?= default
+SHARDS ?=
+SMK = $(BIN)/snakemake report --profile workflow/profiles/$(PROFILE) $(if $(filter default,$(PROFILE)),-j$(JOBS)) \
+	$(if $(SHARDS),--config 'shards=$(SHARDS)') $(if $(CONFIG),--configfile config/config.yaml config/$(CONFIG).yaml)
+
 report: $(STAMP)
-	$(BIN)/snakemake --profile workflow/profiles/default -j$(JOBS) report
-	$(BIN)/snakemake --profile workflow/profiles/default --report report/snakemake_report.html report
+	$(SMK)
+	$(SMK) --report report/snakemake_report.html
 	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
 
 test: $(STAMP_TEST)

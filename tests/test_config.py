@@ -78,3 +78,58 @@ def test_load_yaml_gives_what_the_pure_python_parser_gives():
     for path in files:
         text = path.read_text()
         assert repr(load_yaml(text)) == repr(yaml.safe_load(text)), path
+
+
+def test_shard_counts_are_validated_and_named():
+    cfg = load("test.yaml")
+    cfg["shards"]["hinf_loop_variants"] = 0
+    with pytest.raises(ConfigError, match=r"shards\.hinf_loop_variants.*minimum of 1"):
+        validate_config(cfg)
+    cfg = load("test.yaml")
+    cfg["shards"]["hinf_loop_variant"] = 3
+    with pytest.raises(ConfigError, match=r"shards\.hinf_loop_variant' = 3 is not a known key"):
+        validate_config(cfg)
+
+
+def test_shard_count_in_a_paper_section_points_to_the_shards_section():
+    cfg = load("test.yaml")
+    cfg["intermittent"]["scalar"]["n_shards"] = 4
+    with pytest.raises(ConfigError, match=r"intermittent\.scalar\.n_shards.*moved to the top-level section 'shards:'"):
+        validate_config(cfg)
+
+
+def test_command_line_shard_counts_become_integers():
+    from netrepro.config import coerce_shard_counts, shard_count
+
+    # what `--config 'shards={a: 8, b: x}'` gives: YAML's base loader keeps scalars as strings
+    cfg = coerce_shard_counts({"shards": {"onebit_estimator": "8", "hinf_kalman_best": "x"}})
+    assert cfg["shards"] == {"onebit_estimator": 8, "hinf_kalman_best": "x"}
+    assert shard_count(cfg, "onebit_estimator") == 8
+    assert shard_count(cfg, "intermittent_monte_carlo") == 1  # not listed: one job
+    with pytest.raises(ConfigError, match=r"shards\.hinf_kalman_best' = 'x'"):
+        validate_config({**load("test.yaml"), "shards": cfg["shards"]})
+
+
+def test_paper_scale_overlay_validates_and_changes_only_known_keys():
+    from snakemake.utils import update_config
+
+    base, overlay = load("config.yaml"), load("paper-scale.yaml")
+    merged = copy.deepcopy(base)
+    update_config(merged, overlay)  # what `--configfile config/config.yaml config/paper-scale.yaml` does
+    validate_config(merged)
+    assert "shards" not in overlay  # shard counts belong to profiles and the command line
+    assert merged["onebit"]["estimator"]["one_minus_alpha"][0] == 1e-5  # Fig 1's alpha, the nominal case
+    # every count the overlay raises is at least 10x the default's
+    assert merged["hinf"]["paired"]["runs"] >= 10 * base["hinf"]["paired"]["runs"]
+    assert merged["intermittent"]["scalar"]["n_paths"] >= 10 * base["intermittent"]["scalar"]["n_paths"]
+    assert merged["markov"]["expectations"]["n_paths"] >= 10 * base["markov"]["expectations"]["n_paths"]
+    assert merged["gainsched"]["simulation"]["n_runs"] >= 10 * base["gainsched"]["simulation"]["n_runs"]
+
+
+def test_overlay_with_an_unknown_key_is_named():
+    from snakemake.utils import update_config
+
+    merged = load("config.yaml")
+    update_config(merged, {"hinf": {"paired": {"runz": 2000}}})
+    with pytest.raises(ConfigError, match=r"hinf\.paired\.runz' = 2000 is not a known key"):
+        validate_config(merged)

@@ -74,7 +74,7 @@ def isolated_env(workdir, env=None):
 
 
 def snakemake(workdir, *args, config="config/rel.yaml", check=True, env=None, timeout=TIMEOUT):
-    cmd = [sys.executable, "-m", "snakemake", "--configfile", config, *args]
+    cmd = [sys.executable, "-m", "snakemake", "--configfile", *config.split(), *args]
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout,
                           env=isolated_env(workdir, env))
     if check and proc.returncode != 0:
@@ -82,20 +82,27 @@ def snakemake(workdir, *args, config="config/rel.yaml", check=True, env=None, ti
     return proc
 
 
-def write_config(workdir, name, **scalar):
-    """config/<name>: the intermittent section of config/test.yaml, with ``scalar`` overrides."""
+def write_config(workdir, name, shards=None, **scalar):
+    """config/<name>: the intermittent section of config/test.yaml, with ``scalar`` overrides and the
+    Monte Carlo's shard count ``shards`` (config/test.yaml's when None)."""
     cfg = yaml.safe_load((workdir / "config/test.yaml").read_text())
     section = cfg["intermittent"]
     schema = yaml.safe_load((workdir / "workflow/schemas/intermittent.schema.yaml").read_text())
     known = schema["properties"]["scalar"]["properties"]
-    section["scalar"].update({k: v for k, v in scalar.items() if k in known})
-    (workdir / "config" / name).write_text(yaml.safe_dump({"papers": ["intermittent"], "intermittent": section}))
+    unknown = set(scalar) - set(known)
+    assert not unknown, f"not keys of intermittent.scalar: {unknown}"
+    section["scalar"].update(scalar)
+    counts = dict(cfg.get("shards", {}))
+    if shards is not None:
+        counts["intermittent_monte_carlo"] = shards
+    (workdir / "config" / name).write_text(
+        yaml.safe_dump({"papers": ["intermittent"], "shards": counts, "intermittent": section}))
 
 
 def fresh_copy(tmp_path_factory, name):
     work = tmp_path_factory.mktemp(name) / "repo"
     shutil.copytree(ROOT, work, ignore=top_level_ignore(ROOT, IGNORE_AT_ROOT))
-    write_config(work, "rel.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=1, n_shards=1)
+    write_config(work, "rel.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=1, shards=1)
     return work
 
 
@@ -142,7 +149,7 @@ def reference(built):
 # ----------------------------------------------------------------------------- part 4: determinism
 def test_j2_other_chunking_and_forceall_give_identical_tables(built, reference, tmp_path_factory):
     work = clone(built, tmp_path_factory, "rel_det")
-    write_config(work, "rel2.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=7, n_shards=3)
+    write_config(work, "rel2.yaml", n_paths=2_000_000, block_size=10_000, n_chunks=7, shards=3)
     snakemake(work, "-j2", "--forceall", *TARGETS, config="config/rel2.yaml")
     again = tables(work)
     for path, data in reference.items():
@@ -172,6 +179,18 @@ def test_bad_configurations_change_nothing(built):
     # a bad top-level value given on the command line
     proc = snakemake(built, "-j2", "--forceall", *TARGETS, "--config", "papers=[nonsense]", check=False)
     assert proc.returncode != 0 and "'nonsense'" in proc.stdout + proc.stderr
+    # a shard count below 1 on the command line, and an overlay (a second --configfile) with a key
+    # the schema does not know: both stop the run before any job, naming the key
+    proc = snakemake(built, "-j2", "--forceall", *TARGETS, "--config", "shards={intermittent_monte_carlo: 0}",
+                     check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "shards.intermittent_monte_carlo" in out and "minimum of 1" in out, out[-3000:]
+    assert "localrule" not in out and "Finished jobid" not in out
+    (built / "config/overlay.yaml").write_text(yaml.safe_dump({"intermittent": {"scalar": {"n_pathz": 10}}}))
+    proc = snakemake(built, "-j2", "--forceall", *TARGETS, config="config/rel.yaml config/overlay.yaml", check=False)
+    out = proc.stdout + proc.stderr
+    assert proc.returncode != 0 and "intermittent.scalar.n_pathz" in out and "not a known key" in out, out[-3000:]
+    assert "localrule" not in out and "Finished jobid" not in out
     assert snapshot(built) == before
 
 

@@ -11,7 +11,7 @@ job, job states from squeue), and checks that
   would be refused), and the run ends with no job left in the queue;
 * the tables equal those of a local run of ``config/test.yaml`` in another scratch copy
   (``netrepro.regression.compare_tables``), although the Slurm run splits the Monte Carlo
-  and the LMI sweep into a different number of shards (``n_shards`` + 1) when the
+  and the LMI sweep into a different number of shards (each count of ``shards:`` + 1) when the
   configuration has that key: results do not depend on the split.
 
 Needs root and the Debian packages munge, slurmctld, slurmd and slurm-client (CI installs
@@ -138,14 +138,10 @@ def test_intermittent_tables_through_slurm(cluster, tmp_path_factory):
     reference = copy_repo(base / "local")
     on_slurm = copy_repo(base / "slurm")
 
-    # the Slurm run uses one shard more than the local one, where the configuration is sharded
+    # the Slurm run uses one shard more than the local one for every sharded step
     cfg = yaml.safe_load((on_slurm / "config/test.yaml").read_text())
-    resharded = []
-    for section in ("scalar", "two_sensor"):
-        part = cfg.get("intermittent", {}).get(section, {})
-        if "n_shards" in part:
-            part["n_shards"] = int(part["n_shards"]) + 1
-            resharded.append(f"intermittent.{section}.n_shards={part['n_shards']}")
+    cfg["shards"] = {step: int(count) + 1 for step, count in cfg.get("shards", {}).items()}
+    resharded = [f"shards.{step}={count}" for step, count in cfg["shards"].items()]
     (on_slurm / "config/slurm_test.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
 
     # the local reference run goes on while the Slurm run waits for its jobs

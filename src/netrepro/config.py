@@ -38,6 +38,8 @@ __all__ = [
     "REQUIRED_PACKAGES",
     "load_schemas",
     "validate_config",
+    "coerce_shard_counts",
+    "shard_count",
     "check_dependencies",
     "require_matrix",
     "require_pd",
@@ -204,6 +206,11 @@ def _format_error(err, describe=None) -> str:
         for name in extra or ["?"]:
             key = ".".join(path + [name])
             value = err.instance.get(name) if isinstance(err.instance, dict) else None
+            if name == "n_shards":
+                lines.append(f"config key '{key}' = {_short(value)} is not a known key: shard counts moved to the "
+                             "top-level section 'shards:' (one entry per sharded step, e.g. shards: "
+                             "{intermittent_monte_carlo: 4}; see config/config.yaml)")
+                continue
             lines.append(f"config key '{key}' = {_short(value)} is not a known key (a typo?). "
                          f"Expected one of: {', '.join(known)}")
         return "\n  ".join(lines)
@@ -267,6 +274,49 @@ def _generic_problems(config: dict) -> list[str]:
 def _schema_requires(schema_dir: Path, slug: str) -> list:
     path = Path(schema_dir) / f"{slug}.schema.yaml"
     return list(_read_schema(path).get("required", [])) if path.is_file() else []
+
+
+def coerce_shard_counts(config: dict) -> dict:
+    """Turn the shard counts given on the command line into integers, in place; return ``config``.
+
+    ``snakemake --config 'shards={step: 8}'`` reads its value with YAML's base loader, which keeps
+    every scalar a string ("8"). Only strings of decimal digits are converted: anything else stays
+    as given, so that validation names it.
+
+    Parameters
+    ----------
+    config : dict
+        The workflow configuration; its ``shards`` mapping, if any, is updated in place.
+
+    Returns
+    -------
+    dict
+        ``config`` itself.
+    """
+    shards = config.get("shards") if isinstance(config, dict) else None
+    if isinstance(shards, dict):
+        for step, count in shards.items():
+            if isinstance(count, str) and count.strip().isdigit():
+                shards[step] = int(count)
+    return config
+
+
+def shard_count(config: dict, step: str) -> int:
+    """Snakemake jobs of the sharded step ``step`` (1 when the configuration does not list it).
+
+    Parameters
+    ----------
+    config : dict
+        The workflow configuration (validated).
+    step : str
+        A key of its ``shards`` section, e.g. ``"onebit_estimator"``.
+
+    Returns
+    -------
+    int
+        The number of shard jobs, at least 1.
+    """
+    return int((config.get("shards") or {}).get(step, 1))
 
 
 def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:

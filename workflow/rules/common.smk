@@ -9,7 +9,12 @@ from snakemake.exceptions import WorkflowError
 
 try:
     from netrepro.codedeps import code_inputs
-    from netrepro.config import check_dependencies, validate_config
+    from netrepro.config import (
+        check_dependencies,
+        coerce_shard_counts,
+        shard_count,
+        validate_config,
+    )
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
@@ -23,6 +28,7 @@ except ImportError as exc:
 
 try:
     check_dependencies()
+    coerce_shard_counts(config)  # `--config 'shards={...}'` arrives as strings
     # the schemas of this workflow copy (not of the installed package's checkout)
     validate_config(config, schema_dir=Path(workflow.current_basedir).parent / "schemas")
     # the claims data files of the papers (issue 15), validated before any job starts
@@ -49,6 +55,11 @@ def enabled(slug):
 def pick(section, *keys):
     """The entries of a config section that a step uses: only these trigger its rerun."""
     return {k: section[k] for k in keys if k in section}
+
+
+def shards(step):
+    """Shard indices of the sharded step ``step`` (config ``shards:``; one shard when not listed)."""
+    return range(shard_count(config, step))
 
 
 def as_json(obj):

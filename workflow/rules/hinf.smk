@@ -268,7 +268,7 @@ rule hinf_loop_variants_shard:
             {
                 "cfg": HCFG,
                 "shard": int(w.shard),
-                "n_shards": HCFG["loop_variants"]["n_shards"],
+                "n_shards": len(shards("hinf_loop_variants")),
             }
         ),
         io=io_json,
@@ -281,7 +281,7 @@ rule hinf_loop_variants:
         code=code("netrepro.papers.hinf.steps:loop_variants_merge_step"),
         shards=expand(
             rules.hinf_loop_variants_shard.output.table,
-            shard=range(HCFG.get("loop_variants", {}).get("n_shards", 1)),
+            shard=shards("hinf_loop_variants"),
         ),
     output:
         table="results/hinf/loop_variants.csv",
@@ -318,7 +318,7 @@ rule hinf_kalman_best_shard:
             {
                 "cfg": HCFG,
                 "shard": int(w.shard),
-                "n_shards": HCFG["kalman_best"]["n_shards"],
+                "n_shards": len(shards("hinf_kalman_best")),
             }
         ),
         io=io_json,
@@ -331,7 +331,7 @@ rule hinf_kalman_best:
         code=code("netrepro.papers.hinf.steps:kalman_best_merge_step"),
         shards=expand(
             rules.hinf_kalman_best_shard.output.table,
-            shard=range(HCFG.get("kalman_best", {}).get("n_shards", 1)),
+            shard=shards("hinf_kalman_best"),
         ),
     output:
         table="results/hinf/kalman_best.csv",

@@ -4,7 +4,7 @@
 # Figures and the notebook are generated (src/netrepro/papers/intermittent/figures.yaml).
 
 ICFG = config.get("intermittent", {})
-# keys the Monte Carlo results depend on (n_chunks and n_shards do not change them)
+# keys the Monte Carlo results depend on (n_chunks and the shard count do not change them)
 MC_KEYS = ("a", "R1", "R2", "Ep0", "lambda_offsets", "horizon", "n_paths", "block_size", "seed")
 
 
@@ -72,7 +72,7 @@ rule intermittent_monte_carlo_shard:
             {
                 **pick(ICFG["scalar"], *MC_KEYS),
                 "shard": int(w.shard),
-                "n_shards": ICFG["scalar"].get("n_shards", 1),
+                "n_shards": len(shards("intermittent_monte_carlo")),
             }
         ),
         io=io_json,
@@ -86,7 +86,7 @@ rule intermittent_monte_carlo:
         exact=rules.intermittent_exact_mean.output.table,
         shards=expand(
             rules.intermittent_monte_carlo_shard.output.sums,
-            shard=range(ICFG.get("scalar", {}).get("n_shards", 1)),
+            shard=shards("intermittent_monte_carlo"),
         ),
     output:
         table="results/intermittent/monte_carlo.csv",
@@ -147,7 +147,7 @@ rule intermittent_two_sensor_region_shard:
             {
                 **pick(ICFG["two_sensor"], "a", "lambda1_grid", "bisection_tol"),
                 "shard": int(w.shard),
-                "n_shards": ICFG["two_sensor"].get("n_shards", 1),
+                "n_shards": len(shards("intermittent_two_sensor_region")),
             }
         ),
         io=io_json,
@@ -160,7 +160,7 @@ rule intermittent_two_sensor_region:
         code=code("netrepro.papers.intermittent.steps:two_sensor_region_merge_step"),
         shards=expand(
             rules.intermittent_two_sensor_region_shard.output.table,
-            shard=range(ICFG.get("two_sensor", {}).get("n_shards", 1)),
+            shard=shards("intermittent_two_sensor_region"),
         ),
     output:
         table="results/intermittent/two_sensor_region.csv",

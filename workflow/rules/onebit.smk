@@ -42,7 +42,6 @@ ONEBIT_KEYS = {
         "vector_check",
     ),
 }
-ONEBIT_SHARDS = OCFG.get("estimator", {}).get("n_shards", 2)
 
 
 rule onebit_efq:
@@ -146,7 +145,7 @@ rule onebit_estimator_shard:
             {
                 **pick(OCFG, *ONEBIT_KEYS["estimator"]),
                 "shard": int(w.shard),
-                "n_shards": ONEBIT_SHARDS,
+                "n_shards": len(shards("onebit_estimator")),
             }
         ),
         io=io_json,
@@ -157,7 +156,7 @@ rule onebit_estimator_shard:
 rule onebit_estimator:
     input:
         code=code("netrepro.papers.onebit.steps:estimator_step"),
-        shards=expand(rules.onebit_estimator_shard.output.runs, shard=range(ONEBIT_SHARDS)),
+        shards=expand(rules.onebit_estimator_shard.output.runs, shard=shards("onebit_estimator")),
     output:
         table="results/onebit/estimator_mse.csv",
         ratios="results/onebit/estimator_ratios.csv",
