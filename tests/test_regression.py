@@ -131,6 +131,25 @@ def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
     assert main(["compare", *args, "--html", ""]) == 0
 
 
+
+def test_recorded_paper_scale_run_is_neither_compared_nor_removed_by_update(tmp_path, capsys):
+    from netrepro.regression import main
+
+    _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
+    recorded = tmp_path / "ref" / "paper-scale" / "claims" / "p.csv"
+    recorded.parent.mkdir(parents=True)
+    recorded.write_text("claim_id,verdict\nc,reproduced\n")
+    scale_table = tmp_path / "res" / "scale" / "verdicts_by_scale.csv"  # derived from committed data: unchecked
+    scale_table.parent.mkdir(parents=True)
+    scale_table.write_text("paper,claim_id\np,c\n")
+    args = ["--reference", str(tmp_path / "ref"), "--results", str(tmp_path / "res"), "--figures", "", "--platform-rules", ""]
+    assert main(["compare", *args, "--html", ""]) == 0
+    assert main(["update", *args]) == 0
+    assert recorded.read_text() == "claim_id,verdict\nc,reproduced\n"
+    assert not (tmp_path / "ref" / "scale").exists()
+    count, problems = compare_trees(tmp_path / "ref", tmp_path / "res")
+    assert (count, problems) == (1, [])
+
 def test_clearing_an_old_difference_page_touches_nothing_else(tmp_path):
     from netrepro.figurecheck import clear_difference_page
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import re
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -154,10 +153,24 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
     return problems
 
 
+# results/scale/: the comparison with the recorded paper-scale run (its staleness follows every code
+# edit, and its verdicts are the claims tables, which have references of their own)
+_UNCHECKED_RESULT_DIRS = ("shards", "scale", "regeneration")
+# tests/reference/paper-scale/: a recorded run at another configuration (netrepro.scale), not a reference
+_RECORDED_RUNS = ("paper-scale",)
+
+
 def _result_tables(results_dir: Path) -> list[Path]:
-    """The result tables that have references: all CSVs but timings and shards (merged tables are checked)."""
+    """The result tables that have references: all CSVs but timings, shards (merged tables are checked)
+    and the scale comparison."""
     return [t for t in sorted(Path(results_dir).rglob("*.csv"))
-            if t.name != "benchmarks.csv" and "shards" not in t.relative_to(results_dir).parts]
+            if t.name != "benchmarks.csv" and not set(_UNCHECKED_RESULT_DIRS) & set(t.relative_to(results_dir).parts)]
+
+
+def _reference_tables(reference_dir: Path) -> list[Path]:
+    """The reference tables (every CSV under the folder but the recorded runs of other configurations)."""
+    return [p for p in sorted(Path(reference_dir).rglob("*.csv"))
+            if p.relative_to(reference_dir).parts[0] not in _RECORDED_RUNS]
 
 
 def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, details=None,
@@ -170,13 +183,12 @@ def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, d
     ``details``: a list that receives ``{"table", "problems", "cells"}`` per differing table.
     """
     rules = load_platform_rules(platform_rules)
-    unknown = sorted(set(rules) - {p.relative_to(reference_dir).as_posix()
-                                   for p in Path(reference_dir).rglob("*.csv")})
+    unknown = sorted(set(rules) - {p.relative_to(reference_dir).as_posix() for p in _reference_tables(reference_dir)})
     if unknown:
         raise ValueError(f"platform rules name tables without a reference: {', '.join(unknown)}")
     problems, count = [], 0
     details = [] if details is None else details
-    for ref in sorted(Path(reference_dir).rglob("*.csv")):
+    for ref in _reference_tables(reference_dir):
         rel = ref.relative_to(reference_dir)
         got = Path(results_dir) / rel
         count += 1
@@ -199,10 +211,11 @@ def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, d
 
 def _update_tables(reference: Path, results: Path) -> list[str]:
     """Replace the reference tables by the result tables; returns what changed (added, removed, changed)."""
-    old = {p.relative_to(reference).as_posix(): p.read_bytes() for p in reference.rglob("*.csv")} \
+    old = {p.relative_to(reference).as_posix(): p.read_bytes() for p in _reference_tables(reference)} \
         if reference.is_dir() else {}
     new = {t.relative_to(results).as_posix(): t.read_bytes() for t in _result_tables(results)}
-    shutil.rmtree(reference, ignore_errors=True)
+    for rel in old:  # the recorded runs of other configurations (tests/reference/paper-scale/) stay
+        (reference / rel).unlink()
     for rel, data in new.items():
         target = reference / rel
         target.parent.mkdir(parents=True, exist_ok=True)

@@ -185,3 +185,16 @@ def report_inputs(wildcards):
         named[f"{slug}_figure_list"] = spec["figure_list"]
         named[f"{slug}_notebook"] = spec["notebook"]
     return named
+
+
+# the recorded paper-scale run (issue 31): `python -m netrepro scale-record`; the report's panel
+# "Does scale change a verdict?" compares this run's claims with it, where it exists
+SCALE_REFERENCE = "tests/reference/paper-scale"
+SCALE_RECORDED = Path(SCALE_REFERENCE, "provenance.json").is_file()
+
+
+def scale_sources(wildcards):
+    """The recorded source files that still exist: an edit of one reruns the comparison (staleness)."""
+    recorded = json.loads(Path(SCALE_REFERENCE, "provenance.json").read_text())
+    paths = {p for files in recorded.get("code", {}).values() for p in files}
+    return sorted(p for p in paths if Path(p).is_file())

@@ -11,12 +11,37 @@ from netrepro.provenance import params_hash
 report: "../report/workflow.rst"
 
 
+rule scale_verdicts:
+    input:
+        code=code("netrepro.scale:scale_step"),
+        claims=[spec["claims"] for spec in PAPER_OUTPUTS.values()],
+        findings=[spec["findings"] for spec in PAPER_OUTPUTS.values()],
+        provenance=f"{SCALE_REFERENCE}/provenance.json",
+        reference=sorted(str(p) for p in Path(SCALE_REFERENCE).glob("*/*.csv")),
+        sources=scale_sources,
+    output:
+        table="results/scale/verdicts_by_scale.csv",
+        findings="results/scale/findings_by_scale.csv",
+        stale="results/scale/stale_sources.csv",
+    log:
+        "logs/scale_verdicts.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json({"reference": SCALE_REFERENCE}),
+        io=io_json,
+    shell:
+        step("netrepro.scale:scale_step")
+
+
 rule report:
     input:
         unpack(report_inputs),
         code=code("netrepro.report.build:build_index"),
         # titles and citations: a title fix reruns the report, and nothing of any paper
         registry="src/netrepro/papers.yaml",
+        scale=rules.scale_verdicts.output if SCALE_RECORDED else [],
     output:
         html="report/index.html",
         files=directory("report/files"),
@@ -32,11 +57,17 @@ rule report:
             {
                 "papers": PAPER_OUTPUTS,
                 "order": [slug for slug in config["papers"] if slug in PAPER_OUTPUTS],
-                "config_hash": params_hash(config),
+                # the science's hash: shard counts split the work and change no table
+                "config_hash": params_hash({k: v for k, v in config.items() if k != "shards"}),
                 "config": {slug: config.get(slug, {}) for slug in PAPER_OUTPUTS},
                 "configfiles": [os.path.relpath(f) for f in workflow.overwrite_configfiles or []],
                 "machine": f"{platform.system()} {platform.machine()}",
                 "benchmarks": "results/benchmarks.csv",
+                "scale": (
+                    {**rules.scale_verdicts.output, "reference": SCALE_REFERENCE}
+                    if SCALE_RECORDED
+                    else {}
+                ),
             }
         ),
         io=io_json,

@@ -21,7 +21,7 @@ from ..summary import scorecard
 from .markup import read_csv, relocate_json, render, stylesheet
 from .sections import table_view
 from .panel import provenance_chain, rule_name
-from .sections import paper_section, scorecard_html
+from .sections import paper_section, scale_html, scorecard_html
 from .site import Site
 
 __all__ = ["build_index"]
@@ -38,7 +38,8 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         ``config`` (the papers' configuration sections, to name the configuration key of each
         parameter), ``order`` (the papers in the order of the configuration; the JSON of
         ``papers`` has its keys sorted), ``configfiles`` (given with ``--configfile``),
-        ``machine``, ``benchmarks`` (path of an optional benchmark table).
+        ``machine``, ``benchmarks`` (path of an optional benchmark table), ``scale`` (the paths of
+        the verdicts-by-scale tables and of the recorded paper-scale run, when one is recorded).
     inputs : dict
         The rule's inputs (read through ``params``; listed so that Snakemake orders the jobs).
     outputs : dict
@@ -75,7 +76,7 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         "path": bench_path, "html": Markup(render("table.html", table=table_view(bench_frame),
                                                   table_id="benchmarks-table"))}
     page = render("index.html", css=stylesheet(), papers=list(papers), run=run, versions=versions, bench=bench,
-                  scorecard=Markup(scorecard_html(score, papers)),
+                  scorecard=Markup(scorecard_html(score, papers)), scale=Markup(scale_html(params.get("scale") or {})),
                   sections=[Markup(paper_section(slug, spec, claims[slug], ctx)) for slug, spec in papers.items()],
                   references=Markup(references_html(papers)))
     sidecars = _run_sidecars(papers)

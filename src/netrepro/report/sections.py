@@ -18,7 +18,7 @@ from .markup import img, read_csv, render, rst_html
 from .notebooks import figure_captions, figure_sort_key
 from .panel import provenance_panel, rule_name
 
-__all__ = ["table_view", "claims_html", "summary_html", "figure_html", "paper_section", "scorecard_html"]
+__all__ = ["table_view", "claims_html", "summary_html", "figure_html", "paper_section", "scorecard_html", "scale_html"]
 
 # Text tables shown cell by cell (besides the claims, which have their own layout)
 _TEXT_TABLES = (
@@ -257,3 +257,44 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
     return render("scorecard.html", total={k: int(total[k]) for k in counted}, shown=shown,
                   untestable=[v for v in shown if v not in TESTABLE_VERDICTS], show_other=int(total["other"]) > 0,
                   rows=rows, pct="" if pd.isna(pct) else f"{pct:.1f} %")
+
+
+def scale_html(scale: dict) -> str:
+    """The panel "Does scale change a verdict?" (issue 31), or ``""`` without a recorded run.
+
+    Parameters
+    ----------
+    scale : dict
+        Paths from the report rule: ``table`` (``verdicts_by_scale.csv``), ``findings``,
+        ``stale`` (:func:`netrepro.scale.scale_step`) and ``reference`` (the recorded run's folder,
+        holding ``provenance.json``).
+
+    Returns
+    -------
+    str
+        The panel: the recorded run's identity, whether its tables are stale, and every claim and
+        finding whose verdict or robust flag differs between this run and the paper-scale run.
+    """
+    def text_table(path):
+        return pd.read_csv(path, dtype=str, keep_default_na=False) if path and Path(path).is_file() else None
+
+    if not scale or text_table(scale.get("table")) is None:
+        return ""
+    claims, findings, stale = (text_table(scale.get(k)) for k in ("table", "findings", "stale"))
+    prov_path = Path(scale["reference"]) / "provenance.json"
+    prov = json.loads(prov_path.read_text()) if prov_path.is_file() else {}
+
+    def changed(frame):
+        return frame[frame["changed"].str.lower() == "true"]
+
+    wall = prov.get("wall_time_s")
+    return render("scale.html", prov=prov, prov_path=prov_path.as_posix(),
+                  wall=f"{float(wall) / 60:.1f} min" if wall else "not recorded",
+                  n_claims=len(claims), n_findings=0 if findings is None else len(findings),
+                  claims=changed(claims).to_dict(orient="records"),
+                  findings=[] if findings is None else changed(findings).to_dict(orient="records"),
+                  values_only=int(((claims["changed"].str.lower() != "true")
+                                   & claims["what_changed"].str.contains("value")).sum()),
+                  stale=[] if stale is None else stale.to_dict(orient="records"),
+                  stale_papers=[] if stale is None else sorted(set(stale["paper"])),
+                  table=scale["table"])

@@ -422,11 +422,43 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
         keep = v2 - lo2 < (value - lower)[bad]
         best_lam[bad[keep]] = pol[keep]
         value, lower = fused_trace_bounds(Mf, best_lam)
+    failing = value - lower > tol * np.abs(value)
+    if failing.any():  # rare (none in the default runs): the certificate would fail; try harder before raising
+        _rescue_degenerate(Mf, sf, lf, best_lam, np.nonzero(failing)[0])
+        value, lower = fused_trace_bounds(Mf, best_lam)
     value, lower, best_lam = value.reshape(lead), lower.reshape(lead), best_lam.reshape(lead + (n,))
     if not np.all(value - lower <= tol * np.abs(value)):
         worst = float(np.max((value - lower) / np.abs(value)))
         raise ArithmeticError(f"min_fused_trace_exact: relative Frank-Wolfe gap {worst:.3g} above tolerance {tol:g}")
     return value, best_lam
+
+
+def _rescue_degenerate(Mf, sf, lf, best_lam, bad, steps: int = 10) -> None:
+    """Polish the instances whose Frank-Wolfe gap still exceeds the tolerance; update ``best_lam`` in place.
+
+    Seen at 2000 paired runs of the evasive loop: agents whose informations ``M_j^{-1}`` nearly coincide
+    make a face of the hull nearly flat, and the best closed-form point of its supports then sits on an
+    edge while the optimum needs the third, almost identical agent (relative gaps 1e-11 to 1.1e-9). Two
+    tries, each kept only where it lowers the gap: more Newton steps on the current support, and Newton on
+    the support enlarged by each absent agent (given weight 1e-9 to enter it), where that support has at
+    most 3 agents. The certificate that follows is unchanged.
+    """
+    value, lower = fused_trace_bounds(Mf[bad], best_lam[bad])
+    gap = value - lower
+    starts = [best_lam[bad]]
+    k_of = (best_lam[bad] > 0).sum(-1)
+    for j in range(best_lam.shape[-1]):
+        grown = best_lam[bad].copy()
+        absent = (grown[:, j] == 0) & (k_of < 3)
+        if absent.any():
+            grown[absent, j] = 1e-9
+            starts.append(grown / grown.sum(-1, keepdims=True))
+    for start in starts:
+        pol = _newton_polish(sf[bad], lf[bad], start, steps=steps)
+        v2, lo2 = fused_trace_bounds(Mf[bad], pol)
+        better = v2 - lo2 < gap
+        best_lam[bad[better]] = pol[better]
+        gap = np.where(better, v2 - lo2, gap)
 
 
 def fused_trace_bounds(Minv, lam):
