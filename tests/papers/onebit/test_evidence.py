@@ -31,7 +31,7 @@ def test_low_snr_cases():
 
 
 def test_errata_residuals(cfg):
-    rows = {r["quantity"]: r["value"] for r in evidence.errata_rows(cfg)}
+    rows = {r["quantity"]: r["value"] for r in evidence.errata_rows(dict(cfg, _at=load_paper_data("onebit").settings()))}
     for e in ("E1", "E2", "E3", "E4", "E5", "E6"):
         assert rows[f"{e}.residual_corrected"] < 1e-10, e
         assert rows[f"{e}.residual_printed"] > 1e-3, e
