@@ -161,7 +161,7 @@ def _fig_comparison_rows(scen, paired, summ, pa, z_sig, cfg):
                          "value": _z_rule(r.z, z_sig), "note": f"{r.tag} (ratio {r.ratio:.3f}, z = {r.z:+.1f})"})
     judged = pa[(pa["scenario"] == scen) | (pa["scenario"].str.match(f"{scen}_(gamma_c|K_p)") & (pa["agent"] < 0))]
     counts = judged["tag"].value_counts()
-    rows[0]["note"] += (f"; settings (100 runs each, |z| > {z_sig:g}): " + ", ".join(
+    rows[0]["note"] += (f"; settings ({cfg['fig2_horizon']['runs']} runs each, |z| > {z_sig:g}): " + ", ".join(
         f"{counts.get(t, 0)} {t}" for t in ("holds", "not significant", "reversed"))
         + "; mean over agents: " + ", ".join(f"H={r.horizon} ratio {r.ratio:.3f} {r.tag}" for r in
                                              pa[(pa["scenario"] == scen) & (pa["agent"] < 0)].itertuples()))
@@ -259,7 +259,8 @@ def _noise_gain_rows(summ, sens, pa, cfg):
         ratio = g.set_index("scenario")["ratio_dec_local"]
         if {"fig2", "fig3"} <= set(ratio.index):
             key = SWEEP_KEYS.get(par, par)
-            rows.append({"quantity": "fig23.gain_larger_at_low_noise", "variant": f"{key}={val:g} (H=120)",
+            rows.append({"quantity": "fig23.gain_larger_at_low_noise",
+                         "variant": f"{key}={val:g} (H={cfg['sensitivity']['horizon']})",
                          "value": bool(ratio["fig3"] < ratio["fig2"])})
     # issue 28: per agent and per horizon (the paper shows one agent), and the mean over agents at every horizon
     both = pa[pa["scenario"].isin(["fig2", "fig3"])].pivot_table(index=["agent", "horizon"], columns="scenario",
@@ -270,7 +271,8 @@ def _noise_gain_rows(summ, sens, pa, cfg):
         ok = bool(r["fig3"] < r["fig2"])
         n_ok += ok
         rows.append({"quantity": "fig23.gain_larger_at_low_noise", "variant": f"fig2_horizon: {who}, H={h}",
-                     "value": ok, "note": f"dec/local ratio W=0.001: {r['fig3']:.3f}, W=0.01: {r['fig2']:.3f}"})
+                     "value": ok, "note": f"dec/local ratio W={cfg['scenarios']['fig3']['W']:g}: {r['fig3']:.3f}, "
+                             f"W={cfg['scenarios']['fig2']['W']:g}: {r['fig2']:.3f}"})
     rows[0]["note"] += f"; per agent and horizon (per_agent.csv): larger advantage at low noise in {n_ok} of {len(both)}"
     return rows, adv
 
@@ -347,9 +349,10 @@ def _gain_rows(cfg, traj):
 
 
 def _sweet_spot_rows(cfg, summ, at):
-    r_tr, r_det, step = sweet_spot_grid(NoiseModel.from_config(cfg["noise"]), float(at["r_max"]), float(at["r_step"]))
+    r_max = float(at["r_max"])
+    r_tr, r_det, step = sweet_spot_grid(NoiseModel.from_config(cfg["noise"]), r_max, float(at["r_step"]))
     rows = [{"quantity": "noise.sweet_spot", "value": r_tr,
-             "note": f"argmin over r in [0, 60] (step {step:g}) of tr M(r) {r_tr:g} and of det M(r) {r_det:g}"}]
+             "note": f"argmin over r in [0, {r_max:g}] (step {step:g}) of tr M(r) {r_tr:g} and of det M(r) {r_det:g}"}]
     md = summ.loc[("static_mobile", "decentralized")]
     ev = summ.loc[("evasive_hinf", "decentralized")]
     rows.append({"quantity": "motion.to_sweet_spot", "value": float(md["range_error_end"]),
@@ -383,7 +386,7 @@ def _premise_rows(pe, evp, z_sig, gamma):
     return rows
 
 
-def _loop_rows(lv: pd.DataFrame) -> list[dict]:
+def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
     """Issue 28, part 1: the closed-loop consensus variants against the evasive target (loop_variants.csv)."""
     ev = lv[lv["target"] == "evasive"].set_index(["loop", "comparison"])
     rnd = lv[lv["target"] == "random"].set_index(["loop", "comparison"])
@@ -448,7 +451,7 @@ def _loop_rows(lv: pd.DataFrame) -> list[dict]:
                          "value": bool(r["connected_fraction"] == 1.0),
                          "note": f"connected {r['connected_fraction']:.0%} of late steps"})
     rows.append({"quantity": "fig6.topology_changes", "value": float(ev.loc[("pi", "same_paths"), "topology_changes"]),
-                 "note": "mean topology changes per run (300 steps) of the graph (25) against the evasive target: "
+                 "note": f"mean topology changes per run ({horizon} steps) of the graph (25) against the evasive target: "
                          + ", ".join(f"{d} {ev.loc[(d, 'same_paths'), 'topology_changes']:.0f}" for d in designs + ["local_loop"])})
     return rows
 
@@ -494,7 +497,8 @@ def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
     controls = [t for t in targets if t in ("drift", "evasive_noise")]
     rows.append({"quantity": "premise.control_targets", "value": bool(controls and all(pattern(t) for t in controls)),
                  "note": "the pattern of the evasive target (H-infinity beats the Kalman filter designed for W, loses to it "
-                         "designed for 1.5 W or more and at the best settings) at the control targets: "
+                         f"designed for {kb.loc[kb['W_factor_b'] > 1.0, 'W_factor_b'].min():g} W or more and at the best "
+                         "settings) at the control targets: "
                          + ", ".join(f"{t} {'same' if pattern(t) else 'different'}" for t in controls)})
     return rows
 
@@ -510,7 +514,8 @@ def _abstract_rows(pe, summ, z_sig, conn_frac):
          "note": (f"evasive target, same trajectories and measurements, {int(h['runs'])} runs: late error decentralized "
                   f"{h['error_a']:.3f} vs local {h['error_b']:.3f} (paired z = {h['z']:+.1f}, decentralized better in "
                   f"{h['frac_a_better']:.0%} of runs); against the random-walk target on the same agents' paths the "
-                  f"decentralized filter wins (z = {rnd['z']:+.1f}). The Fig-6 scenario with its own agents (60 runs): "
+                  f"decentralized filter wins (z = {rnd['z']:+.1f}). The Fig-6 scenario with its own agents "
+                  f"({int(summ.loc[('evasive_hinf', 'local'), 'n_runs'])} runs): "
                   f"local {loc:.3f}, decentralized {dec:.3f}. The network is connected in only {conn_frac:.0%} of its "
                   f"steps")},
         {"quantity": "abstract.multiagent_beats_local_evasive", "variant": "filter.gamma=inf (Kalman filters)",
@@ -632,7 +637,8 @@ def evidence_step(params, inputs, outputs):
     pe = pd.read_csv(inputs["paired_evasive"])
     rows += _premise_rows(pe, pd.read_csv(inputs["evader_paired"]), z_sig, float(cfg["filter"]["gamma"]))
     rows += _abstract_rows(pe, summ, z_sig, ev_frac)
-    rows += _loop_rows(pd.read_csv(inputs["loop_variants"]))
+    loop_horizon = int(cfg["scenarios"][cfg["loop_variants"]["scenario"]]["horizon"])
+    rows += _loop_rows(pd.read_csv(inputs["loop_variants"]), loop_horizon)
     rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]))
     ev_conv = pd.read_csv(inputs["evader"])
     rows.append({"quantity": "evader.convergence", "value": float(ev_conv.loc[ev_conv["configured"], "certified_fraction"].iloc[0]),
