@@ -293,11 +293,10 @@ def _network_effect(net: pd.DataFrame) -> str:
     """Does disconnection explain the decentralized filter's loss? Per target: connectivity, paired z, correlation."""
     parts = []
     for target, g in net.groupby("target", sort=False):
-        d = g["decentralized"] - g["local"]
-        _, _, z = paired_z(g["decentralized"], g["local"])
+        diff, _, z = paired_z(g["decentralized"], g["local"])
         r = difference_correlation(g["decentralized"], g["local"], g["connected_fraction"])
         parts.append(f"{target} target ({len(g)} runs): graph connected in {g['connected_fraction'].mean():.0%} of the "
-                     f"late steps, decentralized minus local late error {d.mean():+.3f} (paired z = {z:+.1f}), "
+                     f"late steps, decentralized minus local late error {diff:+.3f} (paired z = {z:+.1f}), "
                      f"correlation over runs of that difference with the connected fraction {r:+.2f}")
     return "connectivity check (evasive_network.csv): " + "; ".join(parts)
 
