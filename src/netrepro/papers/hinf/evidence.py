@@ -9,6 +9,11 @@ Quantities (``variant`` ``nominal`` unless stated): the errata residuals ``E<n>.
 / ``.residual_corrected``; ``reconstruction.<key>`` (configured value, sweep summary); and the claim
 quantities, each with its variants across the range of what we had to choose (horizon, agent shown,
 integral gain, settling threshold, attenuation level gamma, evader solver).
+
+Assembly only (issue 29): every number is read from the result tables or computed by the math
+modules (:mod:`.analysis` for the errata residuals, the steady-state gains, the sweet spot and the
+settling comparison; :mod:`.model` for paired z-scores and advantages); the claims' settings are
+their ``at`` fields in ``claims.yaml``.
 """
 
 from __future__ import annotations
