@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from netrepro.errors import ConfigError
-from netrepro.paperdata import CAUSAL_WORDING, FindingEntry, load_claims, load_findings, load_paper_data
+from netrepro.paperdata import CAUSAL_WORDING, FindingEntry, load_claims, load_errata, load_findings, load_paper_data
 
 GOOD = """
 - id: C1
@@ -247,3 +247,36 @@ def test_every_finding_of_a_paper_has_a_rule_evidence_and_prior_work(slug):
     data = load_paper_data(slug)
     for f in data.findings:
         assert f.rule_reason and f.evidence_quantities and f.prior_work, f.finding_id
+
+
+# ----------------------------------------------------------------------------- settings ('at') of errata (issue 29)
+E1_AT = "  impact: \"the gain and every MSE that uses it\"\n"
+
+
+def test_errata_settings_load_as_a_dict_and_every_entry_has_one(tmp_path):
+    root = write_paper(tmp_path, errata=[(E1_AT, E1_AT + "  at: {p: 0.5, K: 200}\n")])
+    data = load_paper_data("p", root)
+    assert [e["at"] for e in data.errata] == [{"p": 0.5, "K": 200}, {}]
+    assert load_errata(root / "errata.yaml")[0]["at"] == {"p": 0.5, "K": 200}
+    assert load_errata(tmp_path / "missing.yaml") == []
+
+
+def test_errata_settings_that_are_not_a_mapping_are_rejected_naming_the_field(tmp_path):
+    root = write_paper(tmp_path, errata=[(E1_AT, E1_AT + "  at: 200\n")])
+    with pytest.raises(ConfigError, match=r"entry 0 \(id 'E1'\): field 'at' 200 is not of type 'object'"):
+        load_paper_data("p", root)
+
+
+def test_settings_gather_claims_findings_and_errata_by_id(tmp_path):
+    root = write_paper(tmp_path, errata=[(E1_AT, E1_AT + "  at: {K: 200}\n")],
+                       claims=[("  nominal: \"horizon 200\"", "  nominal: \"horizon 200\"\n  at: {a: 1.5}")],
+                       findings=[("  figure: fig1\n", "  figure: fig1\n  at: {snr_db: [0, 5]}\n")])
+    assert load_paper_data("p", root).settings() == {"C1": {"a": 1.5}, "F1": {"snr_db": [0, 5]}, "E1": {"K": 200}}
+
+
+def test_an_id_with_settings_in_two_files_is_refused(tmp_path):
+    root = write_paper(tmp_path, errata=[(E1_AT, E1_AT + "  at: {K: 200}\n")],
+                       claims=[("- id: C3", "- id: E1"), ("  erratum_id: E1\n", "  at: {a: 1}\n")])
+    data = load_paper_data("p", root)
+    with pytest.raises(ConfigError, match="id 'E1' has settings .* in both claims.yaml and errata.yaml"):
+        data.settings()

@@ -22,7 +22,8 @@ workflow loads them when it starts); :mod:`netrepro.verdicts` judges them agains
           depends_on: [horizon]
 
 ``errata.yaml``
-    id, location, kind (``equation | prose | notation | typesetting``), printed, corrected, impact.
+    id, location, kind (``equation | prose | notation | typesetting``), printed, corrected, impact,
+    and (optional) the settings at which the erratum is demonstrated (``at``, as for claims).
 ``reconstructions.yaml``
     key, reason, range (over which dependent claims and findings are re-judged), optional
     value/sensitivity.
@@ -34,7 +35,8 @@ workflow loads them when it starts); :mod:`netrepro.verdicts` judges them agains
     table (and figure) that shows it.
 
 Cross-checks across files: every ``depends_on`` names a reconstruction key, every claim's
-``erratum_id`` an erratum; ids are unique per file.
+``erratum_id`` an erratum; ids are unique per file, and an id whose entry has settings (``at``)
+is not used by an entry of another file that has settings too (:meth:`PaperData.settings`).
 """
 
 from __future__ import annotations
@@ -60,6 +62,7 @@ __all__ = [
     "paper_dir",
     "load_claims",
     "load_findings",
+    "load_errata",
     "load_paper_data",
     "referenced_tables",
 ]
@@ -228,7 +231,7 @@ class PaperData:
         The claims of ``claims.yaml``, in the file's order.
     errata : list of dict
         The entries of ``errata.yaml`` (``id``, ``location``, ``kind``, ``printed``, ``corrected``,
-        ``impact``).
+        ``impact``, ``at``: a dict, empty when the file gives no settings).
     reconstructions : list of dict
         The entries of ``reconstructions.yaml`` (``key``, ``reason``, ``range``, ...), whose keys
         the claims' and findings' ``depends_on`` name.
@@ -245,6 +248,32 @@ class PaperData:
     def tables_read(self) -> list[str]:
         """The result tables (other than the evidence table) that the claims read."""
         return sorted({e.ours["table"] for e in self.claims if e.ours.get("table")})
+
+    def settings(self) -> dict:
+        """The ``at`` settings of every claim, finding and erratum that has some, by id.
+
+        Returns
+        -------
+        dict
+            ``{id: {setting: value}}`` over claims, findings and errata (entries without ``at`` left out).
+
+        Raises
+        ------
+        ConfigError
+            If two entries with settings share an id (the evidence step would not know whose they are).
+        """
+        out, owner = {}, {}
+        entries = [("claims.yaml", c.claim_id, c.at) for c in self.claims]
+        entries += [("findings.yaml", f.finding_id, f.at) for f in self.findings]
+        entries += [("errata.yaml", e["id"], e["at"]) for e in self.errata]
+        for file, ident, at in entries:
+            if not at:
+                continue
+            if ident in out:
+                raise ConfigError(f"paper {self.slug!r}: id {ident!r} has settings ('at') in both {owner[ident]} and "
+                                  f"{file}; the evidence step reads settings by id, so give one of them another id")
+            out[ident], owner[ident] = dict(at), file
+        return out
 
 
 def paper_dir(slug: str) -> Path:
@@ -447,6 +476,29 @@ def load_findings(path: str | Path) -> list[FindingEntry]:
     return entries
 
 
+def load_errata(path: str | Path) -> list[dict]:
+    """Read and validate a paper's ``errata.yaml`` (no file: no errata).
+
+    Parameters
+    ----------
+    path : str or Path
+        The data file.
+
+    Returns
+    -------
+    list of dict
+        The entries in file order; each has ``at`` (the settings at which the erratum is demonstrated,
+        read by the evidence step; ``{}`` when the entry gives none).
+
+    Raises
+    ------
+    ConfigError
+        Naming the file, the entry (index and id) and the field, for a malformed file; a duplicate id.
+    """
+    entries = _load_list(Path(path), "errata")
+    return [dict(e, at=dict(e.get("at") or {})) for e in entries]
+
+
 def _load_list(path: Path, kind: str) -> list[dict]:
     if not path.is_file():
         return []
@@ -480,7 +532,7 @@ def load_paper_data(slug: str, root: str | Path | None = None) -> PaperData:
     root = Path(root) if root is not None else paper_dir(slug)
     claims_path, findings_path = root / "claims.yaml", root / "findings.yaml"
     claims = load_claims(claims_path)
-    errata = _load_list(root / "errata.yaml", "errata")
+    errata = load_errata(root / "errata.yaml")
     reconstructions = _load_list(root / "reconstructions.yaml", "reconstructions")
     findings = load_findings(findings_path)
     keys = {r["key"] for r in reconstructions}

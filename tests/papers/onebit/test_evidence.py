@@ -31,10 +31,35 @@ def test_low_snr_cases():
 
 
 def test_errata_residuals(cfg):
-    rows = {r["quantity"]: r["value"] for r in evidence.errata_rows(cfg)}
+    rows = {r["quantity"]: r["value"] for r in evidence.errata_rows(dict(cfg, _at=load_paper_data("onebit").settings()))}
     for e in ("E1", "E2", "E3", "E4", "E5", "E6"):
         assert rows[f"{e}.residual_corrected"] < 1e-10, e
         assert rows[f"{e}.residual_printed"] > 1e-3, e
+
+
+def test_errata_settings_come_from_errata_yaml(cfg):
+    """E4 and E5 are demonstrated at the 'at' settings of errata.yaml: other settings give other residuals and notes.
+
+    E4 against an independent recursion: the printed (32) misses exactly the newest innovation, so its relative
+    error at step k is sigma_z^2 / Var_k with Var_k = alpha^2 Var_{k-1} + sigma_z^2, Var_0 = sigma_0^2."""
+    at = load_paper_data("onebit").settings()
+    assert at["E4"] == {"one_minus_alpha": 1.0e-3, "sigma_z2": 0.01, "K": 200}
+    assert at["E5"] == {"one_minus_alpha": 1.0e-2, "snr_db": 0.0, "sigma_eta": 1.0, "K": 300}
+    eps, s, K = 0.2, 0.5, 40
+    other = dict(at, E4={"one_minus_alpha": eps, "sigma_z2": s, "K": K},
+                 E5={"one_minus_alpha": 0.05, "snr_db": -3.0, "sigma_eta": 2.0, "K": 50})
+    rows = {(r["quantity"]): r for r in evidence.errata_rows(dict(cfg, _at=other))}
+    var, worst = cfg["sigma_theta0"] ** 2, 0.0
+    for _ in range(K):
+        var = (1 - eps) ** 2 * var + s
+        worst = max(worst, s / var)
+    assert rows["E4.residual_printed"]["value"] == pytest.approx(worst, rel=1e-9)
+    assert "k = 1..40" in rows["E4.residual_printed"]["note"] and "alpha = 1 - 0.2, sigma_z^2 = 0.5" in \
+        rows["E4.residual_printed"]["note"]
+    assert "(alpha = 0.95, stationary SNR = -3 dB, sigma_eta = 2, K = 50)" in rows["E5.residual_printed"]["note"]
+    assert rows["E5.residual_corrected"]["value"] < 1e-10 and rows["E5.residual_printed"]["value"] > 1e-3
+    nominal = {r["quantity"]: r for r in evidence.errata_rows(dict(cfg, _at=at))}
+    assert "(alpha = 1 - 1e-3, sigma_z^2 = 0.01, sigma_0 = 1)" in nominal["E4.residual_printed"]["note"]
 
 
 def test_paper_data_loads():

@@ -23,6 +23,8 @@ Modules
     The multi-agent system of Section VI: scenarios and their Monte Carlo simulation.
 ``steps``
     Pipeline steps writing ``results/hinf/*.csv``.
+``analysis``
+    What the evidence quotes beyond the tables: errata residuals, steady-state gain norms, the sweet spot.
 ``evidence``
     Our side of the claims, errata, findings and reconstructions (``results/evidence/``).
 ``figures``

@@ -9,6 +9,11 @@ Quantities (``variant`` ``nominal`` unless stated): the errata residuals ``E<n>.
 / ``.residual_corrected``; ``reconstruction.<key>`` (configured value, sweep summary); and the claim
 quantities, each with its variants across the range of what we had to choose (horizon, agent shown,
 integral gain, settling threshold, attenuation level gamma, evader solver).
+
+Assembly only (issue 29): every number is read from the result tables or computed by the math
+modules (:mod:`.analysis` for the errata residuals, the steady-state gains, the sweet spot and the
+settling comparison; :mod:`.model` for paired z-scores and advantages); the claims' settings are
+their ``at`` fields in ``claims.yaml``.
 """
 
 from __future__ import annotations
@@ -21,12 +26,11 @@ import pandas as pd
 
 from ...paperdata import load_claims
 from ...verdicts import erratum_evidence, evidence_frame
-from .algebra import central_difference, rotation
-from .filters import gain_norms, steady_state_prior
+from .analysis import (E9_RADII, ERRATA_POINT, difference_correlation, disturbance_weight, errata_residuals,
+                       information_at_positions, mean_gain_norms, order_violation, settles_first, sweet_spot_grid)
+from .filters import FilterDoesNotExist
 from .model import advantage, paired_z, settle_step
-from .motion import control_law, printed_control_law, printed_sigma_gradient, sigma_gradient
-from .noise import (NoiseModel, dinfo_dr_reading, geometry, noise_covariance, noise_information, noise_variances,
-                    printed_dinfo_dtheta, sample_noise)
+from .noise import NoiseModel
 
 __all__ = ["evidence_step", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS"]
 
@@ -51,10 +55,6 @@ RECONSTRUCTION_CONFIG = {
 
 
 # --------------------------------------------------------------------------- small pure helpers
-def _rel(a, b) -> float:
-    return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / np.linalg.norm(b))
-
-
 def _get(cfg, dotted):
     parts = dotted.split(".")
     if "*" in parts:
@@ -111,95 +111,29 @@ def evader_text(ev: pd.DataFrame) -> str:
 
 # --------------------------------------------------------------------------- errata
 def _errata_rows(cfg) -> list[dict]:
-    """Residuals of every printed equation against an independent computation (finite differences, sampling)."""
+    """Residuals of every printed equation against an independent computation (:func:`.analysis.errata_residuals`)."""
     model = NoiseModel.from_config(cfg["noise"])
-    rng = np.random.default_rng(int(cfg["errata"]["seed"]))
-    r0, th0 = 27.0, 0.9
+    n = int(cfg["errata"]["n_samples"])
+    res = errata_residuals(model, float(cfg["filter"]["gamma"]), int(cfg["errata"]["seed"]), n)
+    r0, th0 = ERRATA_POINT
     rows = []
 
-    def add(eid, printed, corrected, note):
+    def add(eid, note):
+        printed, corrected = res[eid][:2]
         rows.extend(erratum_evidence(eid, float(printed), float(corrected), note))
 
-    # E1: eq (3) is the square root of the covariance, not the noise vector
-    n = int(cfg["errata"]["n_samples"])
-    emp = np.cov(sample_noise(rng, np.full(n, r0), np.full(n, th0), model).T)
-    fr, fb = noise_variances(r0, model)
-    printed = rotation(th0) @ np.diag([math.sqrt(fr), math.sqrt(fb)])
-    add("E1", _rel(printed, emp), _rel(noise_covariance(r0, th0, model), emp),
-        f"relative Frobenius distance to the empirical covariance of {n} sampled m_i at r={r0:g}, theta={th0:g}")
-    # E2, E3: eqs (15)-(16) against finite differences of Sigma = Delta (I + S Delta - g L Delta)^-1
-    ag = rng.normal(scale=20, size=(4, 2))
-    x = np.array([1.0, 2.0])
-    r, th = geometry(x, ag)
-    g2 = float(cfg["filter"]["gamma"]) ** -2
-    Lbar = np.eye(2)
-    Delta = np.array([[0.3, 0.05], [0.05, 0.2]])
-    eye = np.eye(2)
-
-    def sigma_of(ri):
-        rr = r.copy()
-        rr[0] = ri
-        S_ = noise_information(rr, th, model).sum(0)
-        return Delta @ np.linalg.inv(eye + S_ @ Delta - g2 * Lbar @ Delta)
-
-    Mi, dMr, dMt = noise_information(r, th, model, derivatives=True)
-    S = Mi.sum(0)
-    fd = central_difference(sigma_of, r[0])
-    sig_true = sigma_of(r[0])
-    sig_printed = Delta @ np.linalg.inv(eye - g2 * Lbar @ Delta - S @ Delta)
-    add("E2", _rel(sig_printed, sig_true), _rel(sigma_gradient(Delta, Delta, S, S, g2, Lbar)[0], sig_true),
-        "relative distance of Delta Omega^-1 to Sigma of eq (6) (4 sensors, Delta fixed)")
-    _, corr = sigma_gradient(Delta, np.zeros((2, 2)), S, dMr[0], g2, Lbar)
-    prin = printed_sigma_gradient(Delta, np.zeros((2, 2)), S, dMr[0], g2, Lbar)
-    add("E3", _rel(prin, fd), _rel(corr, fd),
-        "relative distance to the central finite difference of Sigma w.r.t. r_1 (eq (16) as printed for the printed form)")
-    # E4: bearing derivative of (17)-(18)
-    radii = (5.0, model.a1, 27.0, 45.0)
-    res_p, res_c = [], []
-    for rr in radii:
-        fdt = central_difference(lambda t: noise_information(rr, t, model), th0)
-        _, _, dt = noise_information(rr, th0, model, derivatives=True)
-        res_p.append(_rel(printed_dinfo_dtheta(rr, th0, model), fdt))
-        res_c.append(_rel(dt, fdt))
-    where = ", ".join(f"{x:g}" for x in radii)
-    add("E4", max(res_p), max(res_c),
-        f"max over r in {{{where}}} of the relative distance to the central finite difference of M^-1 w.r.t. theta")
-    # E5: direction of the control law (12)
-    p0 = ag[0]
-
-    def J_of(p):
-        aa = ag.copy()
-        aa[0] = p
-        rr, tt = geometry(x, aa)
-        S_ = noise_information(rr, tt, model).sum(0)
-        return np.trace(Delta @ np.linalg.inv(eye + S_ @ Delta - g2 * Lbar @ Delta))
-
-    grad = np.array([central_difference(lambda s: J_of(p0 + s * e), 0.0) for e in eye])
-    _, sr = sigma_gradient(Delta, np.zeros((2, 2)), S, dMr[0], g2, Lbar)
-    _, st = sigma_gradient(Delta, np.zeros((2, 2)), S, dMt[0], g2, Lbar)
-    u_c = control_law(np.trace(sr), np.trace(st), r[0], th[0], 1.0)
-    u_p = printed_control_law(np.trace(sr), np.trace(st), r[0], th[0], 1.0)
-    desc = -grad / np.linalg.norm(grad)
-    add("E5", 1 - u_p @ desc / np.linalg.norm(u_p), 1 - u_c @ desc / np.linalg.norm(u_c),
-        "1 - cos(angle) between u_i and the steepest-descent direction -grad_p J (finite differences of J = tr Sigma)")
-    # E6: the decentralized motion law with M^-1 replaced by C~ (printed) or N C~ (as in eq (9))
-    N = len(ag)
-    C_tilde = S / N
-    _, s_cent = sigma_gradient(Delta, np.zeros((2, 2)), S, dMr[0], g2, Lbar)
-    _, s_print = sigma_gradient(Delta, np.zeros((2, 2)), C_tilde, dMr[0], g2, Lbar)
-    _, s_corr = sigma_gradient(Delta, np.zeros((2, 2)), N * C_tilde, dMr[0], g2, Lbar)
-    sig_print = Delta @ np.linalg.inv(eye + C_tilde @ Delta - g2 * Lbar @ Delta)
-    add("E6", _rel(s_print, s_cent), _rel(s_corr, s_cent),
-        f"relative distance of the gradient Sigma^r_1 of (15) computed from the exact average C~ (printed) or N C~ to the "
-        f"centralized one ({N} sensors, Delta fixed); Sigma itself is off by {_rel(sig_print, sig_true):.2f} with C~")
-    # E9: reading of V and R in eq (17): V = M_i, R = diag(f_r, f_b); the other reading, R = diag(sqrt f_r, sqrt f_b)
-    # (the matrix of eq (3)), against finite differences of M^-1 w.r.t. r
-    res_right, res_other = [], []
-    for rr in (5.0, 27.0, 45.0):
-        fdr = central_difference(lambda z: noise_information(z, th0, model), rr)
-        res_right.append(_rel(dinfo_dr_reading(rr, th0, model, "variances"), fdr))
-        res_other.append(_rel(dinfo_dr_reading(rr, th0, model, "square_roots"), fdr))
-    add("E9", max(res_other), max(res_right), "max over r in {5, 27, 45} of the relative distance of the range "
+    add("E1", f"relative Frobenius distance to the empirical covariance of {n} sampled m_i at r={r0:g}, theta={th0:g}")
+    add("E2", "relative distance of Delta Omega^-1 to Sigma of eq (6) (4 sensors, Delta fixed)")
+    add("E3", "relative distance to the central finite difference of Sigma w.r.t. r_1 (eq (16) as printed for the "
+        "printed form)")
+    where = ", ".join(f"{x:g}" for x in res["E4_radii"])
+    add("E4", f"max over r in {{{where}}} of the relative distance to the central finite difference of M^-1 w.r.t. "
+        "theta")
+    add("E5", "1 - cos(angle) between u_i and the steepest-descent direction -grad_p J (finite differences of "
+        "J = tr Sigma)")
+    add("E6", f"relative distance of the gradient Sigma^r_1 of (15) computed from the exact average C~ (printed) or "
+        f"N C~ to the centralized one (4 sensors, Delta fixed); Sigma itself is off by {res['E6'][2]:.2f} with C~")
+    add("E9", "max over r in {" + ", ".join(f"{x:g}" for x in E9_RADII) + "} of the relative distance of the range "
         "derivative (17) to the finite difference of M^-1: 'printed' = R read as diag(sqrt f_r, sqrt f_b) of eq (3), "
         "'corrected' = R = diag(f_r, f_b), V = M_i")
     return rows
@@ -232,7 +166,7 @@ def _fig_comparison_rows(scen, paired, summ, pa, z_sig, cfg):
                          "value": _z_rule(r.z, z_sig), "note": f"{r.tag} (ratio {r.ratio:.3f}, z = {r.z:+.1f})"})
     judged = pa[(pa["scenario"] == scen) | (pa["scenario"].str.match(f"{scen}_(gamma_c|K_p)") & (pa["agent"] < 0))]
     counts = judged["tag"].value_counts()
-    rows[0]["note"] += (f"; settings (100 runs each, |z| > {z_sig:g}): " + ", ".join(
+    rows[0]["note"] += (f"; settings ({cfg['fig2_horizon']['runs']} runs each, |z| > {z_sig:g}): " + ", ".join(
         f"{counts.get(t, 0)} {t}" for t in ("holds", "not significant", "reversed"))
         + "; mean over agents: " + ", ".join(f"H={r.horizon} ratio {r.ratio:.3f} {r.tag}" for r in
                                              pa[(pa["scenario"] == scen) & (pa["agent"] < 0)].itertuples()))
@@ -276,8 +210,7 @@ def _settle_rows(errors, thresholds, nominal_threshold):
              "ML": series("static_mobile", "local"), "MD": series("static_mobile", "decentralized")}
 
     def quicker(a, b, thr):
-        ka, kb = settle_step(cells[a], thr), settle_step(cells[b], thr)
-        return ka >= 0 and (kb < 0 or ka < kb), ka, kb
+        return settles_first(cells[a], cells[b], thr)
 
     rows = []
     ok, ka, kb = quicker("MD", "SL", nominal_threshold)
@@ -331,7 +264,8 @@ def _noise_gain_rows(summ, sens, pa, cfg):
         ratio = g.set_index("scenario")["ratio_dec_local"]
         if {"fig2", "fig3"} <= set(ratio.index):
             key = SWEEP_KEYS.get(par, par)
-            rows.append({"quantity": "fig23.gain_larger_at_low_noise", "variant": f"{key}={val:g} (H=120)",
+            rows.append({"quantity": "fig23.gain_larger_at_low_noise",
+                         "variant": f"{key}={val:g} (H={cfg['sensitivity']['horizon']})",
                          "value": bool(ratio["fig3"] < ratio["fig2"])})
     # issue 28: per agent and per horizon (the paper shows one agent), and the mean over agents at every horizon
     both = pa[pa["scenario"].isin(["fig2", "fig3"])].pivot_table(index=["agent", "horizon"], columns="scenario",
@@ -342,7 +276,8 @@ def _noise_gain_rows(summ, sens, pa, cfg):
         ok = bool(r["fig3"] < r["fig2"])
         n_ok += ok
         rows.append({"quantity": "fig23.gain_larger_at_low_noise", "variant": f"fig2_horizon: {who}, H={h}",
-                     "value": ok, "note": f"dec/local ratio W=0.001: {r['fig3']:.3f}, W=0.01: {r['fig2']:.3f}"})
+                     "value": ok, "note": f"dec/local ratio W={cfg['scenarios']['fig3']['W']:g}: {r['fig3']:.3f}, "
+                             f"W={cfg['scenarios']['fig2']['W']:g}: {r['fig2']:.3f}"})
     rows[0]["note"] += f"; per agent and horizon (per_agent.csv): larger advantage at low noise in {n_ok} of {len(both)}"
     return rows, adv
 
@@ -363,49 +298,36 @@ def _network_effect(net: pd.DataFrame) -> str:
     """Does disconnection explain the decentralized filter's loss? Per target: connectivity, paired z, correlation."""
     parts = []
     for target, g in net.groupby("target", sort=False):
-        d = g["decentralized"] - g["local"]
-        _, _, z = paired_z(g["decentralized"], g["local"])
-        r = float(np.corrcoef(d, g["connected_fraction"])[0, 1]) if d.std() > 0 and g["connected_fraction"].std() > 0 \
-            else float("nan")
+        diff, _, z = paired_z(g["decentralized"], g["local"])
+        r = difference_correlation(g["decentralized"], g["local"], g["connected_fraction"])
         parts.append(f"{target} target ({len(g)} runs): graph connected in {g['connected_fraction'].mean():.0%} of the "
-                     f"late steps, decentralized minus local late error {d.mean():+.3f} (paired z = {z:+.1f}), "
+                     f"late steps, decentralized minus local late error {diff:+.3f} (paired z = {z:+.1f}), "
                      f"correlation over runs of that difference with the connected fraction {r:+.2f}")
     return "connectivity check (evasive_network.csv): " + "; ".join(parts)
 
 
 def _gain_rows(cfg, traj):
-    """'Motion limits filter gains': steady-state gains at the start and end geometry of the Fig-5 agents."""
+    """'Motion limits filter gains': steady-state gains at the start and end geometry of the Fig-5 agents
+    (:func:`.analysis.mean_gain_norms`)."""
     model = NoiseModel.from_config(cfg["noise"])
     W = float(cfg["scenarios"]["static_mobile"]["W_filter"])
-    Lbar = np.asarray(cfg["filter"]["L"]).T @ np.asarray(cfg["filter"]["Q"]) @ np.asarray(cfg["filter"]["L"])
+    Lbar = disturbance_weight(cfg["filter"]["L"], cfg["filter"]["Q"])
     sm = traj[traj["scenario"] == "static_mobile"]
     kmax = int(sm["k"].max())
 
-    def geometry_at(k):
+    def positions_at(k):
         g = sm[sm["k"] == k]
         tgt = g[g["who"] == "target"].sort_values("run")[["x", "y"]].to_numpy()
         ag = g[g["who"] != "target"]
         runs = sorted(ag["run"].unique())
         P = np.stack([ag[ag["run"] == r].sort_values("who", key=lambda s: s.astype(int))[["x", "y"]].to_numpy()
                       for r in runs])
-        d = tgt[:, None, :] - P
-        return noise_information(np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0]), model)
+        return information_at_positions(tgt, P, model)
 
-    info = {"start": geometry_at(0), "end": geometry_at(kmax)}
+    info = {"start": positions_at(0), "end": positions_at(kmax)}
 
     def norms(gamma):
-        g2 = 0.0 if not np.isfinite(gamma) else gamma ** -2
-        out = {}
-        for when, Mi in info.items():
-            D_loc = steady_state_prior(Mi, W, g2, Lbar)
-            if np.linalg.eigvalsh(np.linalg.inv(D_loc) + Mi - g2 * Lbar).min() <= 0:
-                raise np.linalg.LinAlgError("the local filter does not exist at this gamma (gamma < gamma_0)")
-            K_loc, Kt_loc = gain_norms(D_loc, Mi, Mi)
-            S = Mi.sum(1)
-            D_c = steady_state_prior(S, W, g2, Lbar)
-            K_c, Kt_c = gain_norms(D_c, S, Mi[:, 0])
-            out[when] = (float(K_loc.mean()), float(Kt_loc.mean()), float(K_c.mean()), float(Kt_c.mean()))
-        return out
+        return {when: mean_gain_norms(Mi, W, gamma, Lbar) for when, Mi in info.items()}
 
     gamma = float(cfg["filter"]["gamma"])
     nom = norms(gamma)
@@ -421,7 +343,7 @@ def _gain_rows(cfg, traj):
             continue
         try:
             v = norms(float(g))
-        except np.linalg.LinAlgError:
+        except (FilterDoesNotExist, np.linalg.LinAlgError):
             continue
         if not all(np.isfinite(x) and x > 0 for x in v["start"] + v["end"]):
             continue
@@ -431,13 +353,10 @@ def _gain_rows(cfg, traj):
 
 
 def _sweet_spot_rows(cfg, summ, at):
-    model = NoiseModel.from_config(cfg["noise"])
-    r = np.arange(0.0, float(at["r_max"]) + 0.5 * float(at["r_step"]), float(at["r_step"]))
-    M = noise_covariance(r, np.zeros_like(r), model)
-    r_tr = float(r[np.argmin(np.trace(M, axis1=-2, axis2=-1))])
-    r_det = float(r[np.argmin(np.linalg.det(M))])
+    r_max = float(at["r_max"])
+    r_tr, r_det, step = sweet_spot_grid(NoiseModel.from_config(cfg["noise"]), r_max, float(at["r_step"]))
     rows = [{"quantity": "noise.sweet_spot", "value": r_tr,
-             "note": f"argmin over r in [0, 60] (step {r[1] - r[0]:g}) of tr M(r) {r_tr:g} and of det M(r) {r_det:g}"}]
+             "note": f"argmin over r in [0, {r_max:g}] (step {step:g}) of tr M(r) {r_tr:g} and of det M(r) {r_det:g}"}]
     md = summ.loc[("static_mobile", "decentralized")]
     ev = summ.loc[("evasive_hinf", "decentralized")]
     rows.append({"quantity": "motion.to_sweet_spot", "value": float(md["range_error_end"]),
@@ -471,7 +390,7 @@ def _premise_rows(pe, evp, z_sig, gamma):
     return rows
 
 
-def _loop_rows(lv: pd.DataFrame) -> list[dict]:
+def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
     """Issue 28, part 1: the closed-loop consensus variants against the evasive target (loop_variants.csv)."""
     ev = lv[lv["target"] == "evasive"].set_index(["loop", "comparison"])
     rnd = lv[lv["target"] == "random"].set_index(["loop", "comparison"])
@@ -536,7 +455,7 @@ def _loop_rows(lv: pd.DataFrame) -> list[dict]:
                          "value": bool(r["connected_fraction"] == 1.0),
                          "note": f"connected {r['connected_fraction']:.0%} of late steps"})
     rows.append({"quantity": "fig6.topology_changes", "value": float(ev.loc[("pi", "same_paths"), "topology_changes"]),
-                 "note": "mean topology changes per run (300 steps) of the graph (25) against the evasive target: "
+                 "note": f"mean topology changes per run ({horizon} steps) of the graph (25) against the evasive target: "
                          + ", ".join(f"{d} {ev.loc[(d, 'same_paths'), 'topology_changes']:.0f}" for d in designs + ["local_loop"])})
     return rows
 
@@ -582,7 +501,8 @@ def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
     controls = [t for t in targets if t in ("drift", "evasive_noise")]
     rows.append({"quantity": "premise.control_targets", "value": bool(controls and all(pattern(t) for t in controls)),
                  "note": "the pattern of the evasive target (H-infinity beats the Kalman filter designed for W, loses to it "
-                         "designed for 1.5 W or more and at the best settings) at the control targets: "
+                         f"designed for {kb.loc[kb['W_factor_b'] > 1.0, 'W_factor_b'].min():g} W or more and at the best "
+                         "settings) at the control targets: "
                          + ", ".join(f"{t} {'same' if pattern(t) else 'different'}" for t in controls)})
     return rows
 
@@ -598,7 +518,8 @@ def _abstract_rows(pe, summ, z_sig, conn_frac):
          "note": (f"evasive target, same trajectories and measurements, {int(h['runs'])} runs: late error decentralized "
                   f"{h['error_a']:.3f} vs local {h['error_b']:.3f} (paired z = {h['z']:+.1f}, decentralized better in "
                   f"{h['frac_a_better']:.0%} of runs); against the random-walk target on the same agents' paths the "
-                  f"decentralized filter wins (z = {rnd['z']:+.1f}). The Fig-6 scenario with its own agents (60 runs): "
+                  f"decentralized filter wins (z = {rnd['z']:+.1f}). The Fig-6 scenario with its own agents "
+                  f"({int(summ.loc[('evasive_hinf', 'local'), 'n_runs'])} runs): "
                   f"local {loc:.3f}, decentralized {dec:.3f}. The network is connected in only {conn_frac:.0%} of its "
                   f"steps")},
         {"quantity": "abstract.multiagent_beats_local_evasive", "variant": "filter.gamma=inf (Kalman filters)",
@@ -684,7 +605,7 @@ def evidence_step(params, inputs, outputs):
     noise_rows, adv = _noise_gain_rows(summ, sens, pa, cfg)
     rows += noise_rows
     rows += erratum_evidence(
-        "E_speed", max(0.0, adv["fig3"] - adv["fig2"]), max(0.0, adv["fig2"] - adv["fig3"]),
+        "E_speed", order_violation(adv["fig2"], adv["fig3"]), order_violation(adv["fig3"], adv["fig2"]),
         f"advantage (local/decentralized late error) at W={cfg['scenarios']['fig2']['W']:g}: "
         f"{adv['fig2']:.3f}, at W={cfg['scenarios']['fig3']['W']:g}: {adv['fig3']:.3f}; residual = how "
         f"far the order each form states is violated")
@@ -720,7 +641,8 @@ def evidence_step(params, inputs, outputs):
     pe = pd.read_csv(inputs["paired_evasive"])
     rows += _premise_rows(pe, pd.read_csv(inputs["evader_paired"]), z_sig, float(cfg["filter"]["gamma"]))
     rows += _abstract_rows(pe, summ, z_sig, ev_frac)
-    rows += _loop_rows(pd.read_csv(inputs["loop_variants"]))
+    loop_horizon = int(cfg["scenarios"][cfg["loop_variants"]["scenario"]]["horizon"])
+    rows += _loop_rows(pd.read_csv(inputs["loop_variants"]), loop_horizon)
     rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]))
     ev_conv = pd.read_csv(inputs["evader"])
     rows.append({"quantity": "evader.convergence", "value": float(ev_conv.loc[ev_conv["configured"], "certified_fraction"].iloc[0]),

@@ -18,9 +18,10 @@ key of ``reconstructions.yaml`` (issue 27, convention 2):
   SNR regime (``evidence.low_regime_max_db``, ``evidence.medium_regime_max_db``; first nominal);
 - ``estimator``: the other simulated alphas and the two halves of the runs.
 
-Settings of the findings' evidence (which SNRs a note quotes) are the ``at:`` fields of
-``findings.yaml`` (input ``findings_file``). No statement, paper value or tolerance is held here;
-notes are computed.
+Settings of the evidence (which SNRs a note quotes, where an erratum is demonstrated) are the
+``at:`` fields of ``claims.yaml``, ``findings.yaml`` and ``errata.yaml`` beside the input
+``findings_file``, by id (:meth:`netrepro.paperdata.PaperData.settings`). No statement, paper value
+or tolerance is held here; notes are computed.
 """
 
 from __future__ import annotations
@@ -111,8 +112,27 @@ def _value_rows(quantity: str, cases, fn, note: str = "") -> list:
     return rows
 
 
+def _compact(x: float) -> str:
+    """``1e-3`` for a power of ten below 0.01 (as the notes print 1 - alpha), else ``format(x, 'g')``."""
+    mantissa, exponent = f"{x:.0e}".split("e")
+    return f"{mantissa}e{int(exponent)}" if float(f"{x:.0e}") == x and x < 0.01 else f"{x:g}"
+
+
 def errata_rows(params) -> list:
-    """Residuals ``E<i>.residual_printed`` / ``.residual_corrected`` of each erratum, with the computed demonstration."""
+    """Residuals ``E<i>.residual_printed`` / ``.residual_corrected`` of each erratum, with the computed demonstration.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration section with ``_at``: the settings of the claims, findings and
+        errata by id (:meth:`netrepro.paperdata.PaperData.settings`); E4 and E5 are demonstrated at
+        the settings of their ``at`` fields in ``errata.yaml``.
+
+    Returns
+    -------
+    list of dict
+        Evidence rows (:func:`netrepro.verdicts.erratum_evidence`).
+    """
     vc = vector_check(params["vector_check"])
     rows = []
 
@@ -125,19 +145,23 @@ def errata_rows(params) -> list:
     add("E2", vc[("smoothing", "(16) as printed")], vc[("smoothing", "(16) corrected")], demo + " (RTS P_{l|K})")
     add("E3", vc[("smoothing", "(17)-(19) as printed")], vc[("smoothing", "(17)-(19) corrected")],
         demo + " (RTS P_{l|K} via (17))")
-    e4p, e4c = variance_sum_check(1e-3, 0.01, params["sigma_theta0"], 200)
-    add("E4", e4p, e4c, "max relative error over k = 1..200 against the recursion Var_k = alpha^2 Var_{k-1} + "
-        f"sigma_z^2 (alpha = 1 - 1e-3, sigma_z^2 = 0.01, sigma_0 = {params['sigma_theta0']:g})")
-    eps5 = 1e-2
-    s5 = float(sigma_z2_from_snr(0.0, eps5))
-    efq5 = float(expected_fisher_1bit(stationary_variance(eps5, s5)))
-    r27, r38_unq, _ = rw_scalar_check(eps5, s5, 1.0, 300)
-    _, r38, r37q = rw_scalar_check(eps5, s5, efq5, 300)
+    at4 = params["_at"]["E4"]  # the settings of the demonstration (errata.yaml, field 'at')
+    eps4, s4, k4 = float(at4["one_minus_alpha"]), float(at4["sigma_z2"]), int(at4["K"])
+    e4p, e4c = variance_sum_check(eps4, s4, params["sigma_theta0"], k4)
+    add("E4", e4p, e4c, f"max relative error over k = 1..{k4} against the recursion Var_k = alpha^2 Var_{{k-1}} + "
+        f"sigma_z^2 (alpha = 1 - {_compact(eps4)}, sigma_z^2 = {s4:g}, sigma_0 = {params['sigma_theta0']:g})")
+    at5 = params["_at"]["E5"]
+    eps5, snr5, se5, k5 = (float(at5["one_minus_alpha"]), float(at5["snr_db"]), float(at5["sigma_eta"]),
+                           int(at5["K"]))
+    s5 = float(sigma_z2_from_snr(snr5, eps5, se5))
+    efq5 = float(expected_fisher_1bit(stationary_variance(eps5, s5) / se5**2)) / se5**2
+    r27, r38_unq, _ = rw_scalar_check(eps5, s5, 1.0 / se5**2, k5)
+    _, r38, r37q = rw_scalar_check(eps5, s5, efq5, k5)
     add("E5", r37q, max(r38, r38_unq, r27),
-        f"scalar random walk (alpha = 0.99, stationary SNR = 0 dB, sigma_eta = 1, K = 300): max relative error of "
-        f"1/J_{{l|K,q}} against the RTS smoother with noise variance 1/E[F_q] (E[F_q] = {efq5:.6g}). (37) read alone: "
-        f"{r37q:.3g}; (36) with (37)x(38) read as one equation: {r38:.3g}; with E[F_q] -> 1/sigma_eta^2: (38) "
-        f"{r38_unq:.3g}, (27) {r27:.3g}")
+        f"scalar random walk (alpha = {1 - eps5:g}, stationary SNR = {snr5:g} dB, sigma_eta = {se5:g}, K = {k5}): max "
+        f"relative error of 1/J_{{l|K,q}} against the RTS smoother with noise variance 1/E[F_q] (E[F_q] = {efq5:.6g}). "
+        f"(37) read alone: {r37q:.3g}; (36) with (37)x(38) read as one equation: {r38:.3g}; with E[F_q] -> "
+        f"1/sigma_eta^2: (38) {r38_unq:.3g}, (27) {r27:.3g}")
     p, c = prior_check(np.asarray(params["vector_check"]["P0"], dtype=float))
     add("E6", p, c, "2-D prior N(0, P0) of onebit.vector_check: relative error of inv(J_{0|0}) against P0")
     return rows
@@ -478,11 +502,10 @@ def _reconstruction_rows(params) -> list:
 
 
 def _paper_side(path) -> tuple:
-    """``({id: at}, {claim id: ClaimEntry})`` of the claims and findings files beside ``path`` (default: this package's)."""
+    """``({id: at}, {claim id: ClaimEntry})`` of the claims, findings and errata files beside ``path``
+    (default: this package's)."""
     data = load_paper_data("onebit", Path(path).parent if path else None)
-    at = {c.claim_id: dict(c.at) for c in data.claims if c.at}
-    at.update({f.finding_id: dict(f.at) for f in data.findings if f.at})
-    return at, {c.claim_id: c for c in data.claims}
+    return data.settings(), {c.claim_id: c for c in data.claims}
 
 
 def evidence_step(params, inputs, outputs):
