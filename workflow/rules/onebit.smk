@@ -230,6 +230,7 @@ rule onebit_evidence:
         alpha_threshold=rules.onebit_alpha_scan.output.threshold,
         shards=rules.onebit_estimator.input.shards,
         findings_file="src/netrepro/papers/onebit/findings.yaml",
+        errata_file="src/netrepro/papers/onebit/errata.yaml",
         claims_file="src/netrepro/papers/onebit/claims.yaml",
     output:
         table="results/evidence/onebit.csv",
