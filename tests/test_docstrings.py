@@ -162,7 +162,7 @@ def _returns_value(func) -> bool:
 
 PENDING = {line.strip() for line in (Path(__file__).parent / "data" / "docstring_pending.txt").read_text().splitlines()
            if line.strip() and not line.startswith("#")}
-PENDING_STRICT = False
+PENDING_STRICT = True
 
 
 def _public_objects():
