@@ -109,7 +109,29 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def BenchRow(benchmark, metric, ours, reference, ratio, unit) -> dict:  # noqa: N802 (a row constructor)
-    """One row of the benchmark table."""
+    """One row of the benchmark table.
+
+    Parameters
+    ----------
+    benchmark : str
+        What is benchmarked (``riccati_iid_n1``, ``pipeline``, ...).
+    metric : str
+        What is measured (``path_steps_per_s``, ``max_rel_diff``, ...).
+    ours : float
+        Our implementation's value.
+    reference : float
+        The reference's value (the loop, solver or budget compared against; NaN if none).
+    ratio : float
+        The improvement factor, oriented so that > 1 favours ours (reference/ours for times,
+        ours/reference for rates); NaN where undefined.
+    unit : str
+        Unit of ``ours`` and ``reference``.
+
+    Returns
+    -------
+    dict
+        The row, keys ``benchmark, metric, ours, reference, ratio, unit`` (the numbers as float).
+    """
     return dict(benchmark=benchmark, metric=metric, ours=float(ours), reference=float(reference),
                 ratio=float(ratio), unit=unit)
 
@@ -123,6 +145,20 @@ def median_time(fn, repeats: int = 5, min_time: float = 0.0) -> float:
 
     With ``min_time`` > 0 each timed sample loops ``fn`` until at least that long has passed
     and returns the time per call.
+
+    Parameters
+    ----------
+    fn : callable
+        Called with no arguments; its result is discarded.
+    repeats : int, default 5
+        Number of timed samples.
+    min_time : float, default 0.0
+        Minimum duration of one sample, in seconds.
+
+    Returns
+    -------
+    float
+        Median seconds per call.
     """
     fn()
     samples = []
@@ -195,8 +231,27 @@ def blas_peak(native: bool = True, size: int = 2048, repeats: int = 5) -> dict:
 
     ``native=True`` unsets ``OPENBLAS_CORETYPE`` and ``OPENBLAS_L2_SIZE`` (together, in the child
     only) so OpenBLAS picks its own kernel for this processor; ``native=False`` keeps the
-    environment as it is (the kernel the pipeline's steps run with). Returns the best-of-repeats
-    ``gflops_1_thread`` and ``gflops_all_threads`` and the BLAS libraries with their kernels.
+    environment as it is (the kernel the pipeline's steps run with).
+
+    Parameters
+    ----------
+    native : bool, default True
+        Whether to unset the two OpenBLAS variables in the child.
+    size : int, default 2048
+        Order of the square matrices multiplied.
+    repeats : int, default 5
+        Timed products; the best is kept.
+
+    Returns
+    -------
+    dict
+        The best-of-repeats ``gflops_1_thread`` and ``gflops_all_threads``, the BLAS libraries
+        with their kernels, and ``env``: the two variables as the child saw them.
+
+    Raises
+    ------
+    RuntimeError
+        If the child process fails (its stderr tail in the message).
     """
     env = dict(os.environ)
     if native:
@@ -213,7 +268,26 @@ def blas_peak(native: bool = True, size: int = 2048, repeats: int = 5) -> dict:
 
 # ============================================================================ exact E(p_k) (intermittent)
 def bench_exact_mean(n_paths: int, horizon: int, repeats: int) -> list[dict]:
-    """Exact E(p_k), k <= horizon (both configured lambdas), against the conditional Monte Carlo it replaces."""
+    """Exact E(p_k), k <= horizon, against the conditional Monte Carlo estimator it replaces.
+
+    The scalar system of the intermittent paper (a = 1.5, R1 = 0.1, R2 = 0.5, E p_0 = 10) at
+    lambda = lambda_c + 0.1 and lambda_c - 0.1 (lambda_c = 1 - 1/a^2).
+
+    Parameters
+    ----------
+    n_paths : int
+        Monte Carlo paths per lambda (blocks of 20000, seed 7).
+    horizon : int
+        Last step k.
+    repeats : int
+        Timed samples of the exact computation (the estimator gets half as many, at least one).
+
+    Returns
+    -------
+    list of dict
+        Two :func:`BenchRow` rows: times, and the exact computation's relative error bound
+        against the estimator's largest relative 95% half-width.
+    """
     from .engines.montecarlo import run_monte_carlo
     from .papers.intermittent.exact import exact_mean
     from .papers.intermittent.model import critical_probability
@@ -333,9 +407,34 @@ def reference_covariance_loop(P0, A, Q, c, r, arrivals, floats: bool = False) ->
     """Per-path Python loop of the intermittent Riccati recursion with one scalar sensor (the reference).
 
     ``P_{k+1} = A (P_k - gamma_k P_k c^T c P_k / (c P_k c^T + r)) A^T + Q``, path by path and
-    step by step with small numpy matrices (the textbook form, any n); ``floats=True`` (n = 1
-    only) runs the same recursion on plain Python floats, the fastest per-path loop there is.
-    Returns ``P_T`` for every path, shape ``(N, n, n)``.
+    step by step with small numpy matrices (the textbook form, any n, the updated covariance
+    symmetrised as the engine's dense form does); ``floats=True`` (n = 1 only) runs the same
+    recursion on plain Python floats, the fastest per-path loop there is.
+
+    Parameters
+    ----------
+    P0 : array_like
+        Initial covariance, ``(n, n)`` or broadcastable to it (a scalar for n = 1).
+    A, Q : array_like
+        System and process-noise covariance matrices, ``(n, n)`` (scalars for n = 1).
+    c : array_like
+        Output row, ``n`` entries.
+    r : float
+        Measurement noise variance.
+    arrivals : ndarray of bool, shape (N, T)
+        ``gamma_k`` per path and step (True: the measurement arrives).
+    floats : bool, default False
+        Use the plain-float loop (requires n = 1).
+
+    Returns
+    -------
+    ndarray, shape (N, n, n)
+        ``P_T`` for every path.
+
+    Raises
+    ------
+    ValueError
+        If ``floats=True`` and n > 1.
     """
     A = np.atleast_2d(np.asarray(A, dtype=float))
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
@@ -390,7 +489,38 @@ def _arrivals(kind: str, rng, N: int, T: int):
 
 def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak_gflops: float,
                   dims=(1, 2, 3), kinds=("iid", "ge"), rows_out=None) -> list[dict]:
-    """Batched covariance recursions against the per-path loop; flops and fraction of peak."""
+    """Batched covariance recursions against the per-path loop; flops and fraction of peak.
+
+    For each arrival kind and state dimension: path-steps per second of
+    :func:`netrepro.engines.riccati.covariance_paths` (single-threaded BLAS) against
+    :func:`reference_covariance_loop`, against the engine's numpy kernel, the dense batched
+    form (n > 1) and the float loop (n = 1); flops per path-step, the achieved fraction of
+    ``peak_gflops``, and the largest relative difference of ``P_T`` on the reference paths.
+
+    Parameters
+    ----------
+    n_paths : int
+        Paths of the batched run.
+    horizon : int
+        Steps per path.
+    ref_paths : int
+        Paths of the per-path loops (the first ``ref_paths`` of the same arrivals).
+    repeats : int
+        Timed samples of ours (the references get half as many, at least one).
+    peak_gflops : float
+        Single-thread GEMM rate to compare with (from :func:`blas_peak`).
+    dims : tuple of int, default (1, 2, 3)
+        State dimensions.
+    kinds : tuple of str, default ("iid", "ge")
+        Arrival processes: i.i.d. Bernoulli or Gilbert-Elliott.
+    rows_out : list, optional
+        A list the rows are appended to (and returned); default a new list.
+
+    Returns
+    -------
+    list of dict
+        :func:`BenchRow` rows.
+    """
     from .engines.riccati import Sensor, covariance_paths, packed_flops_per_step
 
     rows = [] if rows_out is None else rows_out
@@ -444,7 +574,28 @@ def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak
 
 
 def reference_ge_loop(rng, n_paths: int, horizon: int, p: float, q: float) -> np.ndarray:
-    """Gilbert-Elliott arrivals path by path, step by step (the reference sampler)."""
+    """Gilbert-Elliott arrivals path by path, step by step (the reference sampler).
+
+    The first state is drawn from the stationary law (arrival with probability ``q/(p+q)``).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the uniform draws (``horizon`` per path).
+    n_paths : int
+        Number of paths.
+    horizon : int
+        Steps per path.
+    p : float
+        Probability of going from arrival (good) to loss (bad) in one step.
+    q : float
+        Probability of going from loss back to arrival in one step.
+
+    Returns
+    -------
+    ndarray of bool, shape (n_paths, horizon)
+        True where the packet arrives.
+    """
     pi1 = q / (p + q)
     out = np.empty((n_paths, horizon), dtype=bool)
     for i in range(n_paths):
@@ -459,7 +610,26 @@ def reference_ge_loop(rng, n_paths: int, horizon: int, p: float, q: float) -> np
 
 
 def bench_channels(n_paths: int, horizon: int, ref_paths: int, repeats: int) -> list[dict]:
-    """Vectorised Gilbert-Elliott sampling against a per-path loop (same law; different streams)."""
+    """Vectorised Gilbert-Elliott sampling against a per-path loop (same law; different streams).
+
+    Both sample with p = 0.2, q = 0.6.
+
+    Parameters
+    ----------
+    n_paths : int
+        Paths of the vectorised sampler.
+    horizon : int
+        Steps per path.
+    ref_paths : int
+        Paths of :func:`reference_ge_loop`.
+    repeats : int
+        Timed samples of ours (the reference gets half as many, at least one).
+
+    Returns
+    -------
+    list of dict
+        One :func:`BenchRow`: path-steps per second.
+    """
     from .engines.channels import gilbert_elliott_arrivals
 
     t_ours = median_time(lambda: gilbert_elliott_arrivals(np.random.default_rng(1), n_paths, horizon, 0.2, 0.6),
@@ -476,7 +646,36 @@ def _two_sensor_modes():
 
 
 def bench_lmi(n_sweep: int, grid_points: int, tol: float, repeats: int) -> list[dict]:
-    """Parametrised LMI solved across a sweep vs rebuilt per point; solves per bisection curve."""
+    """Parametrised LMI solved across a sweep vs rebuilt per point; solves per bisection curve.
+
+    Sweeps: a two-sensor scalar system and a one-sensor n = 2 system, each over ``n_sweep``
+    arrival weights. Curve: the two-sensor stability region (intermittent, Figs 4-5) by
+    bisection on ``grid_points`` values of lambda_1, warm-started, plain, and bracketed from
+    the closed-form lower bound (what the pipeline runs).
+
+    Parameters
+    ----------
+    n_sweep : int
+        Points of each sweep.
+    grid_points : int
+        Points of the bisection curve.
+    tol : float
+        Bisection tolerance on lambda_2.
+    repeats : int
+        Timed samples of the parametrised sweep (the rebuilt one gets half as many, at least one).
+
+    Returns
+    -------
+    list of dict
+        :func:`BenchRow` rows: solves per second, solves per curve (against the plain bisection
+        and the fewest possible), curve times and the largest threshold gap.
+
+    Raises
+    ------
+    AssertionError
+        If the parametrised and rebuilt LMIs certify differently, or a bracketed bisection
+        returns another threshold than the plain one.
+    """
     from .engines.channels import arrival_patterns
     from .engines.lmi import MareStabilizabilityLMI, sweep_thresholds
 
@@ -596,7 +795,22 @@ def _fisher_functions():
 
 
 def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: int) -> tuple[list[dict], str]:
-    """Expected 1-bit Fisher information on an SNR grid: vectorised vs per-point adaptive quadrature."""
+    """Expected 1-bit Fisher information on an SNR grid: vectorised vs per-point adaptive quadrature.
+
+    Parameters
+    ----------
+    snr_start, snr_stop, snr_step : float
+        The SNR grid in dB, ``snr_stop`` included.
+    repeats : int
+        Timed samples of the vectorised form (at least 0.05 s each; quadrature gets half as many samples).
+
+    Returns
+    -------
+    rows : list of dict
+        :func:`BenchRow` rows: grid points per second and the largest relative difference.
+    source : str
+        Where the two implementations came from (the onebit package, or the local equivalents).
+    """
     vectorised, quadrature, source = _fisher_functions()
     snr_db = np.arange(snr_start, snr_stop + snr_step / 2, snr_step)
     v = 10.0 ** (snr_db / 10.0)
@@ -623,9 +837,21 @@ JOB_IMPORTS = "numpy, scipy.linalg, pandas, numba, cvxpy, matplotlib.pyplot"
 
 
 def bench_job_exit(repeats: int) -> list[dict]:
-    """Wall time of one job process (start, a step's imports, exit) ending through
-    :func:`netrepro.runner.exit_process` against the interpreter's normal exit (its teardown frees
-    every imported module: what each of a cold build's ~100 jobs paid before)."""
+    """Wall time of one job process ending through :func:`netrepro.runner.exit_process` against a normal exit.
+
+    Each process starts, imports what a step imports (``JOB_IMPORTS``) and exits; the normal
+    exit's teardown frees every imported module: what each of a cold build's ~100 jobs paid before.
+
+    Parameters
+    ----------
+    repeats : int
+        Timed processes of each kind.
+
+    Returns
+    -------
+    list of dict
+        One :func:`BenchRow`: seconds per job.
+    """
     env = _env_with_src(ROOT / "src")
     codes = {"ours": f"import {JOB_IMPORTS}\nfrom netrepro.runner import exit_process\nexit_process(0)",
              "reference": f"import {JOB_IMPORTS}\nimport netrepro.runner"}
@@ -793,6 +1019,32 @@ def bench_pipeline(scratch: Path | None = None, config: str = "config/config.yam
 
     Runs in a scratch copy of the repository (never in this checkout's own ``results/``), with
     ``PYTHONPATH`` pointing at the copy's ``src/`` so the copy's package is the one that runs.
+    Stops after the cold build if it fails (its row NaN, the log tail in the information).
+
+    Parameters
+    ----------
+    scratch : Path, optional
+        Folder in which the scratch copy is made (default: the system's temporary folder).
+    config : str, default "config/config.yaml"
+        Configuration file of the build, relative to the copy.
+    jobs : int, default 2
+        Snakemake's ``-j``.
+    change_key : str, default "intermittent.two_sensor.check_offset"
+        Dotted configuration key multiplied by ``change_factor`` before the single-figure rerun.
+    change_factor : float, default 0.5
+        The factor.
+    figure_target : str, default "intermittent_fig5"
+        Snakemake target rebuilt after the change.
+    keep : bool, default False
+        Keep the scratch copy.
+
+    Returns
+    -------
+    rows : list of dict
+        :func:`BenchRow` rows (times against their budgets of 600 s, 5 s, 30 s; peak memory; the
+        three slowest jobs against their steps' compute time).
+    info : dict
+        Scratch location, log, return codes, per-job times, the parameter change.
     """
     base = Path(tempfile.mkdtemp(prefix="netrepro-bench-", dir=scratch))
     work = base / "repo"
@@ -854,7 +1106,29 @@ def _progress(msg):
 
 def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = None, keep_scratch: bool = False,
             only=None) -> tuple[pd.DataFrame, dict]:
-    """Every benchmark in one run; returns the table and the sidecar information."""
+    """Every benchmark in one run; returns the table and the sidecar information.
+
+    Parameters
+    ----------
+    quick : bool, default False
+        Small sizes (``SIZES["quick"]``) and no pipeline benchmark.
+    pipeline : bool, default True
+        Run :func:`bench_pipeline` (never with ``quick``).
+    scratch : Path, optional
+        Folder of the pipeline's scratch copy.
+    keep_scratch : bool, default False
+        Keep the pipeline's scratch copy.
+    only : set of str, optional
+        Benchmarks to run (riccati, channels, lmi, fisher, exact_mean, gainsched, markov, grid,
+        job_exit, pipeline); default all. The BLAS peak is always measured.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        One row per measurement, columns ``COLUMNS``.
+    info : dict
+        Machine, versions, sizes, load averages, BLAS peaks and the benchmarks' extra information.
+    """
     sizes = SIZES["quick" if quick else "full"]
     reps = sizes["repeats"]
     info = {"quick": quick, "python": sys.version.split()[0], "numpy": np.__version__,
@@ -910,6 +1184,18 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro.bench``: run the benchmarks and write the table and its ``.meta.json``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro.bench", description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="results/benchmarks.csv", help="CSV to write (plus <out>.meta.json)")
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")

@@ -90,16 +90,52 @@ def _single(value):
 
 
 def iso(timestamp: float) -> str:
-    """A POSIX time as ISO 8601 in UTC (``2026-11-23T04:15:17+00:00``)."""
+    """A POSIX time as ISO 8601 in UTC (``2026-11-23T04:15:17+00:00``).
+
+    Parameters
+    ----------
+    timestamp : float
+        Seconds since the epoch; truncated to whole seconds.
+
+    Returns
+    -------
+    str
+        The time in ISO 8601 with the ``+00:00`` offset.
+    """
     return _dt.datetime.fromtimestamp(timestamp, _dt.timezone.utc).isoformat(timespec="seconds")
 
 
 def data_id(path: str) -> str:
-    """The crate identifier of a pipeline file (its copy under ``files/data/``)."""
+    """The crate identifier of a pipeline file (its copy under ``files/data/``).
+
+    Parameters
+    ----------
+    path : str
+        Repository-relative path of the file.
+
+    Returns
+    -------
+    str
+        ``files/data/<path>`` (POSIX separators).
+    """
     return f"files/data/{Path(path).as_posix()}"
 
 
 def action_id(rule: str, index: int) -> str:
+    """The crate identifier of the ``CreateAction`` of one job.
+
+    Parameters
+    ----------
+    rule : str
+        Name of the Snakemake rule of the job.
+    index : int
+        Position of the job in the crate's sorted job list.
+
+    Returns
+    -------
+    str
+        ``#job-<index, 3 digits>-<rule>``.
+    """
     return f"#job-{index:03d}-{rule}"
 
 
@@ -134,6 +170,8 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
 
     Parameters
     ----------
+    crate_root : str or Path
+        The report folder; file entities' sizes and checksums are read below it.
     sidecars : dict
         Pipeline file (repository-relative path, copied to ``files/data/<path>``) -> its
         provenance sidecar.
@@ -146,7 +184,14 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     pages : list of str
         Crate-relative report pages (``index.html``, the notebooks).
     versions : dict
-        Package -> version of the software that computed the results.
+        Package -> version of the software that computed the results (``None`` versions are left out).
+    out : str or Path, optional
+        Where to write the metadata; default ``<crate_root>/ro-crate-metadata.json``.
+
+    Returns
+    -------
+    Path
+        The metadata file written (mode 0644).
     """
     root = Path(crate_root)
     graph: list[dict] = []

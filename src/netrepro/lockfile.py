@@ -26,7 +26,19 @@ _HASH = re.compile(r"--hash=(sha256:[0-9a-f]{64})")
 
 @dataclass(frozen=True)
 class Pin:
-    """One locked package: name, exact version, environment marker (or ""), hashes."""
+    """One locked package: name, exact version, environment marker (or ""), hashes.
+
+    Parameters
+    ----------
+    name : str
+        Package name as written in the lock file.
+    version : str
+        Exact pinned version.
+    marker : str
+        PEP 508 environment marker, ``""`` if none.
+    hashes : tuple of str
+        The ``--hash`` values, as ``algorithm:hex``.
+    """
 
     name: str
     version: str
@@ -39,12 +51,34 @@ class Pin:
 
 
 def normalize(name: str) -> str:
-    """A package name as PEP 503 compares it (``Foo_Bar`` -> ``foo-bar``)."""
+    """A package name as PEP 503 compares it (``Foo_Bar`` -> ``foo-bar``).
+
+    Parameters
+    ----------
+    name : str
+        Package name.
+
+    Returns
+    -------
+    str
+        Lower case, each run of ``-``, ``_``, ``.`` replaced by one ``-``.
+    """
     return re.sub(r"[-_.]+", "-", name).lower()
 
 
 def read_lock(path: str | Path) -> dict[str, Pin]:
-    """The pins of a lock file written by ``uv pip compile --generate-hashes``, by normalized name."""
+    """The pins of a lock file written by ``uv pip compile --generate-hashes``, by normalized name.
+
+    Parameters
+    ----------
+    path : str or Path
+        The lock file (``name==version [; marker]`` lines, each followed by indented ``--hash`` lines).
+
+    Returns
+    -------
+    dict of str to Pin
+        :func:`normalize`'d name -> its pin.
+    """
     pins: dict[str, Pin] = {}
     current = None
     for line in Path(path).read_text().splitlines():
@@ -63,7 +97,23 @@ def read_lock(path: str | Path) -> dict[str, Pin]:
 
 
 def conda_env(lock: str | Path, out: str | Path, python: str = "3.11") -> Path:
-    """Write the conda environment of the rules with the exact pins of ``lock``."""
+    """Write the conda environment of the rules with the exact pins of ``lock``.
+
+    Parameters
+    ----------
+    lock : str or Path
+        Lock file read by :func:`read_lock`.
+    out : str or Path
+        Environment file to write (conda-forge Python and pip, the pins as pip requirements
+        sorted by normalized name, then the package itself as ``-e ../..``).
+    python : str, default "3.11"
+        Python version of the environment.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
     pins = read_lock(lock)
     lines = [
         "# Software of every rule (used with --sdm conda; the default route is `make`, which builds .venv/).",
@@ -84,6 +134,18 @@ def conda_env(lock: str | Path, out: str | Path, python: str = "3.11") -> Path:
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro.lockfile conda-env LOCK OUT``: write the conda environment file.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro.lockfile")
     sub = parser.add_subparsers(dest="command", required=True)
     env = sub.add_parser("conda-env", help="write the conda environment file with the pins of a lock file")

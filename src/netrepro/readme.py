@@ -46,6 +46,19 @@ def results_table(root: str | Path = ".", papers=None) -> str:
     """The Markdown table: per paper figures, claims by verdict (testable and not), errata, findings, reconstructions.
 
     The counts are :func:`netrepro.summary.scorecard`'s, so README and report agree.
+
+    Parameters
+    ----------
+    root : str or Path, default "."
+        The checkout whose ``results/`` and ``figures/`` are read.
+    papers : iterable of str, optional
+        Paper slugs, in row order; default every paper of the registry. A paper without a claims
+        table gets a "not built" row.
+
+    Returns
+    -------
+    str
+        The Markdown table (header, one row per paper, a total row when any paper is built), no final newline.
     """
     root = Path(root)
     registry = load_registry()
@@ -81,7 +94,25 @@ def results_table(root: str | Path = ".", papers=None) -> str:
 
 
 def rewrite(readme: str, table: str) -> str:
-    """``readme`` with the text between the markers replaced by ``table``."""
+    """``readme`` with the text between the results markers replaced by ``table``.
+
+    Parameters
+    ----------
+    readme : str
+        The README text, holding the lines :data:`START` and :data:`END`.
+    table : str
+        The new content (from :func:`results_table`).
+
+    Returns
+    -------
+    str
+        The README with ``START``, ``table`` and ``END`` on their own lines.
+
+    Raises
+    ------
+    ValueError
+        If either marker is missing.
+    """
     if START not in readme or END not in readme:
         raise ValueError(f"README has no results markers: add the lines\n{START}\n{END}")
     head, rest = readme.split(START, 1)
@@ -134,6 +165,18 @@ def rewrite_figures(readme: str, table: str) -> str:
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro.readme [README] [--root DIR] [--check]``: rewrite the results and figure tables.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 1 with ``--check`` when the README is out of date.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro.readme", description=__doc__.split("\n")[0])
     parser.add_argument("readme", nargs="?", default="README.md")
     parser.add_argument("--root", default=".", help="checkout whose results/ and figures/ are read")

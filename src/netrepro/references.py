@@ -39,6 +39,16 @@ def load_references(path: str | Path = REGISTRY_FILE) -> dict:
     """Slug -> reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``underlying``).
 
     The ``citation`` of every paper of the registry ``path``.
+
+    Parameters
+    ----------
+    path : str or Path, default REGISTRY_FILE
+        The paper registry (``src/netrepro/papers.yaml``).
+
+    Returns
+    -------
+    dict
+        Paper slug -> its ``citation`` entry.
     """
     return {slug: entry["citation"] for slug, entry in load_registry(path).items()}
 
@@ -49,7 +59,18 @@ def _author(person: dict) -> str:
 
 
 def format_reference(ref: dict) -> str:
-    """One reference as plain text: ``Wei, G., Wang, Z. (2011). Title. Venue.``"""
+    """One reference as plain text: ``Wei, G.; Wang, Z. (2011). Title. Venue.``
+
+    Parameters
+    ----------
+    ref : dict
+        A reference with ``title`` and optional ``authors``, ``year``, ``venue``.
+
+    Returns
+    -------
+    str
+        Authors separated by ``"; "``, the year in parentheses, title and venue.
+    """
     authors = "; ".join(_author(a) for a in ref.get("authors", []))
     year = f" ({ref['year']})" if ref.get("year") else ""
     venue = f" {ref['venue']}." if ref.get("venue") else ""
@@ -57,7 +78,19 @@ def format_reference(ref: dict) -> str:
 
 
 def references_html(slugs) -> str:
-    """The report's "Cite the originals" section for the papers ``slugs``."""
+    """The report's "Cite the originals" section for the papers ``slugs``.
+
+    Parameters
+    ----------
+    slugs : iterable of str
+        Paper slugs, in list order; a slug without a citation in the registry is skipped.
+
+    Returns
+    -------
+    str
+        An HTML ``<section id="cite">`` with one escaped list item per paper (and the works it
+        reproduces); an unchecked venue is flagged.
+    """
     refs = load_references()
     items = []
     for slug in slugs:
@@ -77,7 +110,19 @@ def references_html(slugs) -> str:
 
 
 def cff_reference(ref: dict) -> dict:
-    """A reference in the Citation File Format (``references`` entry)."""
+    """A reference in the Citation File Format (``references`` entry).
+
+    Parameters
+    ----------
+    ref : dict
+        A registry reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``affiliation``).
+
+    Returns
+    -------
+    dict
+        The CFF entry: the venue as ``journal`` (article), ``conference.name`` (conference paper)
+        or ``notes`` (otherwise); the affiliation appended to ``notes``.
+    """
     out = {"type": ref["type"], "title": ref["title"], "authors": [dict(a) for a in ref["authors"]]}
     if ref.get("year"):
         out["year"] = int(ref["year"])
@@ -94,7 +139,14 @@ def cff_reference(ref: dict) -> dict:
 
 
 def citation_cff() -> dict:
-    """The content of ``CITATION.cff``: this software, with the reproduced papers as references."""
+    """The content of ``CITATION.cff``: this software, with the reproduced papers as references.
+
+    Returns
+    -------
+    dict
+        The CFF document: this software's metadata and, as ``references``, each paper of the
+        registry followed by the works it reproduces.
+    """
     refs = load_references()
     references = []
     for ref in refs.values():
@@ -111,6 +163,18 @@ def citation_cff() -> dict:
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro.references [OUT]``: write ``CITATION.cff`` from the paper registry.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro.references",
                                      description="write CITATION.cff from the paper registry (papers.yaml)")
     parser.add_argument("out", nargs="?", default="CITATION.cff")

@@ -51,7 +51,23 @@ def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, l
     """``table -> [rule, ...]`` from ``tests/platform_dependent.yaml`` (empty if there is none).
 
     Every rule names its table, columns, check and reason; a malformed rule stops the
-    comparison with a message naming it.
+    comparison with a message naming it. Figure entries (a ``figure`` and no ``table``) are
+    skipped: :func:`netrepro.figurecheck.load_figure_rules` reads them.
+
+    Parameters
+    ----------
+    path : Path or str or None, default PLATFORM_RULES
+        The rules file; ``None`` or a missing file gives no rules.
+
+    Returns
+    -------
+    dict of str to list of dict
+        Table path (relative to the results folder) -> its rules, in file order.
+
+    Raises
+    ------
+    ValueError
+        For an entry lacking ``table``, ``columns``, ``check`` or ``reason``, or with an unknown check.
     """
     if path is None or not Path(path).is_file():
         return {}
@@ -115,9 +131,34 @@ def _plain(value):
 def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=(), cells=None) -> list[str]:
     """Differences between two CSV tables, as readable strings (empty when they agree).
 
-    ``rules`` are this table's entries of ``tests/platform_dependent.yaml``: in the rows and
-    columns they cover, their weaker check replaces the comparison of values. ``cells``: a list
-    that receives ``(row, column, result, reference)`` of the differing cells (at most 50 per column).
+    Numeric columns agree where ``numpy.isclose(result, reference, rtol, atol)`` (NaN equals
+    NaN, equal infinities agree); text cells where their words are the same and their numbers
+    agree by the same rule. Measured-time columns (``VOLATILE_COLUMNS``) and the claims tables'
+    ``note`` are skipped.
+
+    Parameters
+    ----------
+    reference : Path
+        The committed reference table.
+    result : Path
+        The table of this build.
+    rtol, atol : float
+        Relative and absolute tolerances (default ``RTOL``, ``ATOL``).
+    rules : sequence of dict, default ()
+        This table's entries of ``tests/platform_dependent.yaml``: in the rows and columns they
+        cover, their weaker check replaces the comparison of values.
+    cells : list, optional
+        Receives ``(row, column, result, reference)`` of the differing cells (at most 50 per column).
+
+    Returns
+    -------
+    list of str
+        One line per differing column; a single line if the columns or the row counts differ.
+
+    Raises
+    ------
+    ValueError
+        If a rule names a column the table lacks.
     """
     ref, got = pd.read_csv(reference), pd.read_csv(result)
     problems = []
@@ -177,10 +218,34 @@ def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, d
                   **tol) -> tuple[int, list[str]]:
     """Compare every reference table with its result; returns (number compared, problems).
 
-    ``platform_rules``: the file of platform-dependent values (``None``: compare all strictly;
-    the command line passes ``tests/platform_dependent.yaml``). A result table without a
-    reference is a problem (a new table needs ``update``, else it would never be checked).
-    ``details``: a list that receives ``{"table", "problems", "cells"}`` per differing table.
+    A result table without a reference is a problem (a new table needs ``update``, else it
+    would never be checked); so is a reference table whose result is missing.
+
+    Parameters
+    ----------
+    reference_dir : Path
+        The reference tables (``tests/reference``).
+    results_dir : Path
+        The build's tables (``results``), same layout.
+    platform_rules : Path or str, optional
+        The file of platform-dependent values (``None``: compare all strictly; the command line
+        passes ``tests/platform_dependent.yaml``).
+    details : list, optional
+        Receives ``{"table", "problems", "cells"}`` per differing table.
+    **tol
+        ``rtol``, ``atol`` passed to :func:`compare_tables`.
+
+    Returns
+    -------
+    count : int
+        Number of reference tables compared.
+    problems : list of str
+        Every difference found.
+
+    Raises
+    ------
+    ValueError
+        If the platform rules name a table that has no reference.
     """
     rules = load_platform_rules(platform_rules)
     unknown = sorted(set(rules) - {p.relative_to(reference_dir).as_posix() for p in _reference_tables(reference_dir)})
@@ -226,6 +291,18 @@ def _update_tables(reference: Path, results: Path) -> list[str]:
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro.regression {compare,update}``: compare the build with the references, or refresh them.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0, or (``compare``) 1 when a table or figure differs or nothing was compared.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro.regression", description=__doc__.splitlines()[0])
     parser.add_argument("command", choices=["compare", "update"])
     parser.add_argument("--reference", default="tests/reference")

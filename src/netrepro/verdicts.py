@@ -112,6 +112,17 @@ class Judgement:
 def evidence_frame(rows) -> pd.DataFrame:
     """The evidence table of a paper from ``dict(quantity, value, note='', variant='nominal')`` rows.
 
+    Parameters
+    ----------
+    rows : iterable of dict
+        One dict per row with keys ``quantity`` and ``value``, optional ``variant`` (default
+        ``"nominal"``) and ``note`` (default ``""``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``quantity, variant, value, note``, rows in the given order.
+
     Raises
     ------
     ValueError
@@ -167,7 +178,24 @@ def _parse(value):
 
 
 def read_evidence(path: str | Path) -> dict:
-    """``{quantity: {variant: (value, note)}}`` from an evidence table."""
+    """``{quantity: {variant: (value, note)}}`` from an evidence table.
+
+    Parameters
+    ----------
+    path : str or Path
+        An evidence CSV (``results/evidence/<slug>.csv``); every cell is read as text.
+
+    Returns
+    -------
+    dict
+        Quantity -> variant -> ``(value, note)``, the value parsed from its text (number,
+        boolean or text); a repeated (quantity, variant) keeps the last row.
+
+    Raises
+    ------
+    InputError
+        If a column of ``quantity, variant, value, note`` is missing.
+    """
     frame = pd.read_csv(path, dtype=str, keep_default_na=False)
     missing = set(EVIDENCE_COLUMNS) - set(frame.columns)
     if missing:
