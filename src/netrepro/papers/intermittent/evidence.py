@@ -467,7 +467,25 @@ def _claim_settings(claims, claim_id) -> dict:
 
 
 def evidence_step(params, inputs, outputs):
-    """Step of rule ``intermittent_evidence``: every quantity of ``results/evidence/intermittent.csv``."""
+    """Step of rule ``intermittent_evidence``: every quantity of ``results/evidence/intermittent.csv``.
+
+    Parameters
+    ----------
+    params : dict
+        ``scalar`` (``a``, ``R1``, ``R2``, ``Ep0``, ``lambda_offsets``), ``two_sensor`` (``a``,
+        ``sigma2``, ``bisection_tol``, ``check_lambda1``) and ``evidence`` (the settings of the evidence
+        quantities: ``settle_readings``, ``p0_spreads``, ``long_horizon``, ``sample_path_level``, ...).
+    inputs : dict
+        ``bounds``, ``region``, ``simulation``, ``stationary``, ``curve`` and ``tails`` (the
+        intermittent result tables) and ``claims`` (``claims.yaml``, read for claim C15's settings).
+    outputs : dict
+        ``table`` (``results/evidence/intermittent.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}`` from :func:`netrepro.verdicts.evidence_frame`.
+    """
     sc, ts, ev = params["scalar"], params["two_sensor"], params["evidence"]
     a, R1, R2 = sc["a"], sc["R1"], sc["R2"]
     bounds = read_table(inputs["bounds"])

@@ -64,7 +64,28 @@ def _lambdas(cfg):
 
 
 def exact_mean_step(params, inputs, outputs):
-    """Step: exact E(p_k) at every k <= horizon (exact.exact_mean), validated against enumeration for k <= exact_horizon."""
+    """Step: exact E(p_k) at every k <= horizon (exact.exact_mean), validated against enumeration for k <= exact_horizon.
+
+    E(p_k) of the scalar recursion (6) at each configured lambda; the enumeration of all 2^k
+    arrival sequences (model.exact_mean_enumeration) is an independent check.
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` (E p_0) and ``lambda_offsets`` (lambda = lambda_c + offset),
+        ``horizon`` and ``exact_horizon`` (last k of the enumeration).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/exact_mean.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"max_rel_diff_vs_enumeration": float}}``: per lambda
+        and k, ``mean_exact``, its rigorous ``rel_error_bound``, ``mean_enumeration`` (NaN beyond
+        ``exact_horizon``) and their relative difference.
+    """
     frames = []
     worst = 0.0
     for lam, _ in _lambdas(params):
@@ -84,8 +105,28 @@ def exact_mean_step(params, inputs, outputs):
 
 
 def stationary_mean_step(params, inputs, outputs):
-    """Step: lim E(p_k) for each lambda (exact bracket where pi_0 a^2 < 1), next to the limits of s_k, r_k and
-    the report's estimate."""
+    """Step: lim E(p_k) for each lambda (exact bracket where (1 - lambda) a^2 < 1), next to the limits of s_k, r_k and
+    the report's estimate.
+
+    Where (1 - lambda) a^2 >= 1 the lower bound (10) diverges, so E(p_k) does too: the row holds
+    ``inf``. The report's estimate is taken at k = 2000.
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` (E p_0) and ``lambda_offsets`` (lambda = lambda_c + offset).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/stationary_mean.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per lambda: ``loss_growth`` (1 - lambda) a^2, the stationary
+        mean with its bracket, the limits of (10) and (9), the report estimate's limit and the
+        number of backward iterations.
+    """
     a, R1, R2, p0 = params["a"], params["R1"], params["R2"], params["Ep0"]
     rows = []
     for lam, label in _lambdas(params):
@@ -124,7 +165,24 @@ def _scalar_simulator(params, lam):
 
 
 def monte_carlo_shard_step(params, inputs, outputs):
-    """Step: block sums of one Monte Carlo shard (both lambdas); merged by :func:`monte_carlo_merge_step`."""
+    """Step: block sums of one Monte Carlo shard (both lambdas); merged by :func:`monte_carlo_merge_step`.
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` (E p_0) and ``lambda_offsets`` (lambda = lambda_c + offset),
+        ``horizon``, ``n_paths``, ``block_size``, ``seed`` (lambda i uses ``seed + i``), and this
+        shard's index ``shard`` of ``n_shards``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``sums``: the ``.npz`` file of block sums, one entry ``lam<i>`` per lambda.
+
+    Returns
+    -------
+    dict
+        ``{"provenance": {"blocks": [...]}}``: the block indices of this shard (no table).
+    """
     blocks = shard_blocks(params["n_paths"], params["block_size"], params["n_shards"], params["shard"])
     named = {}
     for i, (lam, _) in enumerate(_lambdas(params)):
@@ -135,9 +193,29 @@ def monte_carlo_shard_step(params, inputs, outputs):
 
 
 def monte_carlo_merge_step(params, inputs, outputs):
-    """Step: merge the shards (in block order, so any shard count gives identical results) into the
-    plain and conditional Monte Carlo estimates of E(p_k) with 95% bands, and their z-scores against the
-    exact E(p_k) (a cross-check of the estimators)."""
+    """Step: merge the shards into the plain and conditional Monte Carlo estimates of E(p_k), with z-scores.
+
+    The shards are merged in block order, so any shard count gives identical results; the
+    estimates get 95% bands, and their z-scores against the exact E(p_k) cross-check the estimators.
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` (E p_0) and ``lambda_offsets`` (lambda = lambda_c + offset)
+        and ``horizon`` (the other Monte Carlo keys are those of the shards).
+    inputs : dict
+        ``shards`` (the ``.npz`` block sums of :func:`monte_carlo_shard_step`) and ``exact``
+        (``results/intermittent/exact_mean.csv``).
+    outputs : dict
+        ``table`` (``results/intermittent/monte_carlo.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: per lambda and k the conditional and plain means with 95% bands,
+        the largest plain sample, the number of paths, the exact mean, standard errors and z-scores
+        (0 where the standard error is 0).
+    """
     shards = [load_sums(path) for path in inputs["shards"]]
     exact = read_table(inputs["exact"])
     frames = []
@@ -161,7 +239,25 @@ def monte_carlo_merge_step(params, inputs, outputs):
 
 
 def scalar_bounds_step(params, inputs, outputs):
-    """Step: the Figs 1-2 table (bounds, report estimate, exact E(p_k) at every k, the Monte Carlo cross-check)."""
+    """Step: the Figs 1-2 table (bounds, report estimate, exact E(p_k) at every k, the Monte Carlo cross-check).
+
+    Parameters
+    ----------
+    params : dict
+        The scalar system's ``a``, ``R1``, ``R2``, ``Ep0`` (E p_0) and ``lambda_offsets`` (lambda = lambda_c + offset)
+        and ``horizon``.
+    inputs : dict
+        ``exact`` (``results/intermittent/exact_mean.csv``) and ``mc`` (``results/intermittent/monte_carlo.csv``).
+    outputs : dict
+        ``table`` (``results/intermittent/scalar_bounds.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: per lambda and k, the lower bound s_k (10), the upper bound r_k (9),
+        the report's estimate (as corrected and as printed), the exact mean (``mean_lo = mean_hi =
+        mean``) with its error bound, and the Monte Carlo columns.
+    """
     exact = read_table(inputs["exact"])
     mc = read_table(inputs["mc"])
     a, R1, R2, p0, T = params["a"], params["R1"], params["R2"], params["Ep0"], params["horizon"]
@@ -187,7 +283,26 @@ def scalar_bounds_step(params, inputs, outputs):
 
 
 def two_sensor_region_shard_step(params, inputs, outputs):
-    """Step: lower bound (closed form) and LMI upper bound (bisection) on one shard of the lambda1 grid."""
+    """Step: lower bound (closed form) and LMI upper bound (bisection) on one shard of the lambda1 grid.
+
+    The shard takes every ``n_shards``-th point of the grid, starting at ``shard``, so that shards
+    near and far from lambda1 = 0 get balanced work.
+
+    Parameters
+    ----------
+    params : dict
+        ``a``, ``lambda1_grid`` (number of points on [0, 1]), ``bisection_tol``, ``shard`` and ``n_shards``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/shards/two_sensor_region_<shard>.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"lmi_solves": int}}``: the columns of
+        :func:`two_sensor.two_sensor_upper_bound` with ``lambda2c_lower`` inserted second.
+    """
     # every n-th grid point, so that shards near and far from lambda1 = 0 get balanced work
     grid = np.linspace(0.0, 1.0, params["lambda1_grid"])[params["shard"]::params["n_shards"]]
     upper = pd.DataFrame(two_sensor_upper_bound(grid, params["a"], params["bisection_tol"]))
@@ -196,7 +311,27 @@ def two_sensor_region_shard_step(params, inputs, outputs):
 
 
 def two_sensor_region_merge_step(params, inputs, outputs):
-    """Step: the Figs 4-5 table, concatenating the lambda1 shards."""
+    """Step: the Figs 4-5 table, concatenating the lambda1 shards.
+
+    Parameters
+    ----------
+    params : dict
+        ``lambda1_grid``: the number of grid points the shards must cover.
+    inputs : dict
+        ``shards``: the tables of :func:`two_sensor_region_shard_step`.
+    outputs : dict
+        ``table`` (``results/intermittent/two_sensor_region.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"total_lmi_solves": int}}``, rows sorted by lambda1.
+
+    Raises
+    ------
+    InputError
+        If the shards do not cover the grid exactly once.
+    """
     table = pd.concat([read_table(p) for p in inputs["shards"]], ignore_index=True).sort_values("lambda1",
                                                                                                   kind="stable")
     expected = np.linspace(0.0, 1.0, params["lambda1_grid"])
@@ -207,8 +342,28 @@ def two_sensor_region_merge_step(params, inputs, outputs):
 
 
 def two_sensor_simulation_step(params, inputs, outputs):
-    """Step: E(p_k) of the two-sensor recursion (14) on both sides of the boundary at lambda1 = check_lambda1:
-    exact (exact.exact_mean) with the conditional Monte Carlo as a cross-check (z-scores)."""
+    """Step: E(p_k) of the two-sensor recursion (14) on both sides of the boundary at lambda1 = check_lambda1.
+
+    Exact (exact.exact_mean) with the conditional Monte Carlo as a cross-check (z-scores), at
+    lambda2 = lower boundary -/+ ``check_offset`` (clipped to [0, 1]), from p_0 = 1.
+
+    Parameters
+    ----------
+    params : dict
+        ``a``, ``R1``, ``sigma2`` (the two sensors' noise variances), ``check_lambda1``,
+        ``check_offset``, ``check_horizon``, ``check_paths``, ``block_size`` and ``seed`` (side i uses ``seed + i``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/intermittent/two_sensor_simulation.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: per side and k the exact mean and its error bound, the predicted
+        growth (1 - lambda1)(1 - lambda2) a^2, the stationary mean (``inf`` where the growth is >= 1)
+        and the Monte Carlo mean, band and z-score.
+    """
     a, R1 = params["a"], params["R1"]
     var1, var2 = params["sigma2"]
     lam1 = params["check_lambda1"]

@@ -10,7 +10,20 @@ __all__ = ["check_config"]
 
 
 def check_config(section: dict) -> None:
-    """Checks a schema cannot express: matrix shapes agree, Q >= 0, R > 0, Sigma0 >= 0, (C, A) observable."""
+    """Checks a schema cannot express: matrix shapes agree, Q >= 0, R > 0, Sigma0 >= 0, (C, A) observable.
+
+    Parameters
+    ----------
+    section : dict
+        The ``markov`` section of the configuration; each entry of its ``examples`` is checked.
+
+    Raises
+    ------
+    ConfigError
+        Naming the configuration key: a matrix that is not a matrix, shapes that disagree with
+        ``A`` (n x n) and ``C`` (m x n), Q or Sigma0 not positive semidefinite, R not positive
+        definite, or (C, A) not observable.
+    """
     for name, ex in section.get("examples", {}).items():
         A = require_matrix(f"markov.examples.{name}.A", ex["A"], square=True)
         n = A.shape[0]

@@ -69,31 +69,47 @@ def _trailing_run_weights(p, q, k):
 
 
 def rb_mean_norm(system, Sigma0, p, q, arrivals, P=None, which="norm", kernel="compiled"):
-    """Conditional (Rao-Blackwellised) estimator of ``E||P_k||`` integrating the trailing loss run.
+    r"""Conditional (Rao-Blackwellised) estimator of ``E||P_k||`` integrating the trailing loss run.
 
     With ``l = max{i <= k-1 : gamma_i = 1}`` the last reception before ``k``,
     ``P_k = h^{k-1-l}(P_{l+1})`` (eq. 4) and, by the Markov property (eq. 3),
     ``P(l = i | gamma_1..gamma_i, gamma_i = 1) = p (1-q)^{k-2-i}`` for ``i < k-1`` (1 for ``i = k-1``). So
 
-    .. math:: E\\|P_k\\| = \\sum_{i=1}^{k-1} E\\big[1\\{\\gamma_i = 1\\}\\, w_{k,i}\\, \\|h^{k-1-i}(P_{i+1})\\|\\big]
+    .. math:: E\|P_k\| = \sum_{i=1}^{k-1} E\big[1\{\gamma_i = 1\}\, w_{k,i}\, \|h^{k-1-i}(P_{i+1})\|\big]
 
     and the per-path sum is an unbiased estimator whose loss-run tail (the growth
     ``|lambda_A|^{2j} (1-q)^j``) is computed exactly instead of sampled. ``gamma_1 = 1`` is required.
 
     Parameters
     ----------
-    arrivals : bool array ``(N, T)`` with ``arrivals[:, 0]`` all True.
-    P : optional ``(N, T+1, n, n)`` covariances ``P_1..P_{T+1}`` along the same paths.
+    system : LinearSystem
+        The system (eqs. 1-2).
+    Sigma0 : array_like
+        ``P_1``, ``(n, n)``.
+    p : float
+        Failure rate ``P(gamma_{k+1}=0 | gamma_k=1)``.
+    q : float
+        Recovery rate ``P(gamma_{k+1}=1 | gamma_k=0)``.
+    arrivals : ndarray of bool, shape (N, T)
+        ``gamma_1..gamma_T`` per path, with ``arrivals[:, 0]`` all True.
+    P : ndarray, shape (N, T+1, n, n), optional
+        Covariances ``P_1..P_{T+1}`` along the same paths; computed from ``arrivals`` if omitted.
     which : {"norm", "trace"}
         The functional of ``P_k``.
     kernel : {"compiled", "numpy"}
         ``"compiled"`` (n = 2, 3): :func:`.kernels.rb_norm_kernel`, the same arithmetic path by path
         (equal to the numpy form bit for bit where numpy's small products use FMAs, as OpenBLAS's do);
-        ``"numpy"``: the batched numpy reference below.
+        ``"numpy"``: the batched numpy reference below (also used for other n).
 
     Returns
     -------
-    ndarray ``(N, T+1)``: per-path estimator values for ``k = 1..T+1`` (average over axis 0).
+    ndarray ``(N, T+1)``
+        Per-path estimator values for ``k = 1..T+1`` (average over axis 0); column 0 is ``||P_1||``.
+
+    Raises
+    ------
+    InputError
+        If some path has ``gamma_1 = 0``.
     """
     arrivals = np.asarray(arrivals, dtype=bool)
     if not arrivals[:, 0].all():

@@ -214,12 +214,19 @@ def rb_norm_kernel(P, arrivals, A, Q, W, which_trace, out):
 
     Parameters
     ----------
-    P : ``(N, T+1, n, n)`` covariances ``P_1..P_{T+1}`` along each path.
-    arrivals : bool ``(N, T)``.
-    A, Q : ``(n, n)``.
-    W : ``(T+1, T)``: ``W[k-1, i-1]`` the weight of the last reception ``i`` for ``P_k``.
-    which_trace : bool, trace instead of the norm.
-    out : ``(N, T+1)``, filled.
+    P : ndarray, shape (N, T+1, n, n)
+        Covariances ``P_1..P_{T+1}`` along each path (C-contiguous float64).
+    arrivals : ndarray of bool, shape (N, T)
+        ``gamma_1..gamma_T`` per path.
+    A, Q : ndarray, shape (n, n)
+        System matrix and process noise covariance.
+    W : ndarray, shape (T+1, T)
+        ``W[k-1, i-1]``: the weight of the last reception ``i`` for ``P_k`` (the probability of
+        the trailing loss run).
+    which_trace : bool
+        The trace of ``P_k`` instead of its norm.
+    out : ndarray, shape (N, T+1)
+        Filled in place.
 
     Returns
     -------

@@ -225,16 +225,24 @@ def loss_factor(A, q) -> np.ndarray:
 
 
 def H_matrix(A, C, K, p, q) -> np.ndarray:
-    """``H(K)`` of Theorem 1, eq. (7).
+    r"""``H(K)`` of Theorem 1, eq. (7).
 
     .. math::
-        H(K) = qp[(A\\otimes A)^{-1} - (1-q)I]^{-1} \\sum_{i=1}^{l_o-1}
-               \\overline{(A^i + K^{(i)}C^{(i)})} \\otimes (A^i + K^{(i)}C^{(i)}) (1-p)^{i-1}
+        H(K) = qp[(A\otimes A)^{-1} - (1-q)I]^{-1} \sum_{i=1}^{l_o-1}
+               \overline{(A^i + K^{(i)}C^{(i)})} \otimes (A^i + K^{(i)}C^{(i)}) (1-p)^{i-1}
 
     Parameters
     ----------
+    A : array_like
+        System matrix, ``(n, n)``.
+    C : array_like
+        Output matrix, ``(m, n)``.
     K : list of arrays
         ``K[i-1]`` is ``K^{(i)}`` of shape ``(n, m i)``, ``i = 1 .. l_o - 1``.
+    p : float
+        Failure rate ``P(gamma_{k+1}=0 | gamma_k=1)``.
+    q : float
+        Recovery rate ``P(gamma_{k+1}=1 | gamma_k=0)``.
 
     Returns
     -------

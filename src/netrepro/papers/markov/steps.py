@@ -115,7 +115,31 @@ def _reference(name, ex, q):
 
 # ----------------------------------------------------------------------------- Theorem 5 curves
 def critical_curves_step(params, inputs, outputs):
-    """Proposition 1 (eq. 8) and Theorem 5 (eq. 12) curves p(q) for every example, plus the LMI benchmark."""
+    """Proposition 1 (eq. 8) and Theorem 5 (eq. 12) curves p(q) for every example, plus the LMI benchmark.
+
+    On each example's q grid (from the necessary bound 1 - 1/|lambda|^2 plus ``q_margin`` to
+    1 - ``q_margin``): Proposition 1's bound, Theorem 5's certified bisection for its lower bound
+    on p (up to ``p_uncapped_max`` when l_o = 2, else 1), and the closed-form reference curve.
+    The benchmark times the parametrised LMI against one rebuilt for every solve.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each)
+        and ``curves`` (``q_points``, ``q_margin``, ``bisection_tol``, ``p_uncapped_max``, ``benchmark_solves``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/markov/critical_curves.csv``) and ``benchmark``
+        (``results/markov/lmi_benchmark.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "benchmark": DataFrame, "provenance": {"n_solves": int}}``: one row
+        per example and q (bounds capped at 1 and uncapped, the bisection's bracket, statuses and
+        evidence), and three timing rows per example.
+    """
     cc = params["curves"]
     rows, bench = [], []
     for name, ex in params["examples"].items():
@@ -165,7 +189,25 @@ def critical_curves_step(params, inputs, outputs):
 
 
 def lmi_checks_step(params, inputs, outputs):
-    """Point checks of Theorem 2 (iv) and Theorem 5 that the paper states (Section 5)."""
+    """Point checks of Theorem 2 (iv) and Theorem 5 that the paper states (Section 5).
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each)
+        and ``checks`` (``points``: name, example, p, q of each LMI solve; ``tight``: name, example,
+        q of each tight bisection; ``tight_tol``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/markov/lmi_checks.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per point check and two per tight check (at the
+        bisection's lower and upper ends), with the solve's status, verdict, evidence and margins.
+    """
     ck = params["checks"]
     rows = []
     for item in ck["points"]:
@@ -227,7 +269,28 @@ def tight_variants_step(params, inputs, outputs):
 
 
 def iid_line_step(params, inputs, outputs):
-    """The i.i.d. line p + q = 1 (Remark 4): Sinopoli's bounds on lambda_c and Theorem 5's crossing."""
+    """The i.i.d. line p + q = 1 (Remark 4): Sinopoli's bounds on lambda_c and Theorem 5's crossing.
+
+    Per example: the lower bound 1 - 1/|lambda|^2, Sinopoli's LMI upper bound (certified
+    bisection, its infeasible end raised where a lower bound certifies divergence), the q at which
+    Theorem 5's LMI becomes feasible on the line, and the reference lambda_c where the example has
+    one; ``consistent`` checks the reference lies within the bounds (to ``tol``).
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each)
+        and ``iid`` (``tol``: the bisections' tolerance).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/markov/iid_line.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per example.
+    """
     from ...engines.certify import bisect_certified  # scipy.sparse: only the LMI steps need the engine
 
     tol = params["iid"]["tol"]
@@ -264,8 +327,28 @@ def iid_line_step(params, inputs, outputs):
 
 
 def exact_moments_step(params, inputs, outputs):
-    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1 (see :func:`.exact.exact_moments`;
-    on the decoupled blocks where :func:`.exact.find_split` finds a split, Example II)."""
+    """Exact E||P_k|| polynomials over all channel paths, k <= depth + 1.
+
+    See :func:`.exact.exact_moments`; computed on the decoupled blocks where :func:`.exact.find_split`
+    finds a split (Example II).
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each)
+        and ``exact`` (``depth``: the number of tree levels).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/markov/exact_moments.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: columns ``example, depth, n11, n10, n01, n00, sum_norm,
+        sum_trace`` (the rows of :class:`.exact.ExactMoments`), with a ``depth = 0`` row holding
+        ``||P_1||`` and ``tr P_1``; read back by :func:`load_moments`.
+    """
     frames = []
     for name, ex in params["examples"].items():
         em = exact_moments_auto(_system(ex), np.asarray(ex["Sigma0"], float), params["exact"]["depth"])
@@ -283,7 +366,20 @@ def exact_moments_step(params, inputs, outputs):
 
 
 def load_moments(table: pd.DataFrame, example: str) -> ExactMoments:
-    """Rebuild :class:`~netrepro.papers.markov.exact.ExactMoments` from ``exact_moments.csv``."""
+    """Rebuild :class:`~netrepro.papers.markov.exact.ExactMoments` from ``exact_moments.csv``.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of :func:`exact_moments_step`.
+    example : str
+        The example whose rows are read.
+
+    Returns
+    -------
+    ExactMoments
+        The polynomials for depths 1..max depth, and ``||P_1||``, ``tr P_1`` from the ``depth = 0`` row.
+    """
     sub = table[table["example"] == example]
     head = sub[sub["depth"] == 0].iloc[0]
     cols = ["n11", "n10", "n01", "n00", "sum_norm", "sum_trace"]
@@ -367,6 +463,24 @@ def stability_map_step(params, inputs, outputs):
     ``dist_critical`` is the distance to the true critical curve (every point at ``>= far`` must be decided).
     The former estimator map (exact extrapolation, long-horizon conditional estimator) is kept as a
     cross-check (``verdict_estimator``); ``map_sensitivity.csv`` re-decides both across their thresholds.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each),
+        ``map`` (the grid ``p_min, p_max, p_points, q_min, q_max, q_points``, ``far``, ``certify``
+        margins, the estimator map's settings and ``sensitivity``) and ``estimator`` (``interval_z``).
+    inputs : dict
+        ``moments`` (``results/markov/exact_moments.csv``).
+    outputs : dict
+        ``table`` (``results/markov/stability_map.csv``) and ``sensitivity``
+        (``results/markov/map_sensitivity.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "sensitivity": DataFrame}``: one row per example and grid point,
+        and the re-decisions across thresholds.
     """
     table = pd.read_csv(inputs["moments"])
     mp = params["map"]
@@ -414,7 +528,30 @@ def _estimator_check(system, S0, example, p, q, em, n, horizon, rng, z):
 
 
 def sample_paths_step(params, inputs, outputs):
-    """Sample paths, Monte Carlo bands, plain and conditional means, exact means for Figs 3-6."""
+    """Sample paths, Monte Carlo bands, plain and conditional means, exact means for Figs 3-6.
+
+    Per figure case: the first path's ``||P_k||`` and ``gamma_k``, the 5/50/95% quantiles and the
+    plain mean over ``n_paths`` paths, the conditional estimator (:func:`.estimators.rb_mean_norm`)
+    on the first ``rb_paths`` paths up to ``rb_horizon``, and the exact mean where the tree reaches.
+    Per estimator point: the plain and conditional estimators against the exact value and each other.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each),
+        ``paths`` (``horizon``, ``n_paths``, ``rb_paths``, ``rb_horizon``, ``seed``, ``cases``:
+        figure, example, p, q; ``estimator_points``: example, p, q) and ``estimator`` (``interval_z``).
+    inputs : dict
+        ``moments`` (``results/markov/exact_moments.csv``).
+    outputs : dict
+        ``table`` (``results/markov/sample_paths.csv``) and ``check`` (``results/markov/estimator_check.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "check": DataFrame}``: one row per case and k = 1..horizon + 1
+        (NaN where a column does not reach), and one row per estimator point.
+    """
     sp = params["paths"]
     table = pd.read_csv(inputs["moments"])
     rows, checks = [], []
@@ -483,6 +620,23 @@ def expectations_step(params, inputs, outputs):
     derived rate (:func:`.expectations.two_step_rate`) if its backtest from
     ``backtest_k0`` brackets the exact values with monotone ratios (:func:`.expectations.asymptote_backtest`);
     otherwise ``not_trustworthy``. The decisions and their numbers go to the provenance.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples`` (``A``, ``C``, ``Q``, ``R``, ``Sigma0``, ``reference`` of each),
+        ``paths`` (``horizon``, ``cases``), ``expectations`` (``split_depth``, ``n_paths``, ``z_max``,
+        ``rel_tol``, ``backtest_k0``, ``seed``) and ``estimator`` (``interval_z``, ``deterministic_rtol``).
+    inputs : dict
+        ``moments`` (``results/markov/exact_moments.csv``).
+    outputs : dict
+        ``table`` (``results/markov/expectations.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": dict}``: columns ``example, p, q, k, mean_norm, lo, hi,
+        method, limit, limit_lo, limit_hi``; the provenance holds each figure's decisions.
     """
     sp, xc, es = params["paths"], params["expectations"], params["estimator"]
     table = pd.read_csv(inputs["moments"])
