@@ -11,7 +11,21 @@ __all__ = ["check_config"]
 
 
 def check_config(section: dict) -> None:
-    """Checks the schema cannot express: matrix shapes that agree, sector ordering, p bounds."""
+    """Checks the schema cannot express: matrix shapes that agree, sector ordering, p bounds.
+
+    Parameters
+    ----------
+    section : dict
+        The ``gainsched`` section of the configuration (``system``, ``paper_gains``,
+        ``simulation``, ``performance``).
+
+    Raises
+    ------
+    ConfigError
+        Naming the key: an invalid system or printed gains (shapes, sector ordering F1 < F2,
+        p bounds in (0, 1), sigma2 >= 0, a missing key), ``simulation.x0`` / ``xf0`` without
+        n entries, or ``performance.initial_cov`` not a symmetric positive semidefinite n x n matrix.
+    """
     try:
         sys = system_from_config(section["system"])
         gains_from_dict(section["paper_gains"], sys)

@@ -68,10 +68,13 @@ class Theorem3Solution:
     objective : float
         t, or gamma of the performance design.
     solver_feasible : bool
+        The solver's opinion (information): status ``optimal``, and for feasibility problems a margin above ``margin_tol``.
     values : dict
         Variable name -> ndarray (empty when the solver returned no point).
     solve_time_s : float
+        Wall time of the solve, in seconds (NaN if not recorded).
     n_scalar_variables : int
+        Number of scalar decision variables of the problem.
 
     Returns
     -------
@@ -629,12 +632,16 @@ def certified_cost(values: dict, X0, p1: float, p2: float) -> float:
     Parameters
     ----------
     values : dict
+        A performance solution's values (``Theorem3Solution.values``), holding Q̄0 and Q̄p.
     X0 : ndarray (2n, 2n)
+        E z̄(0) z̄(0)^T, the initial second moment of [x; x_f] with x_f(0) = 0.
     p1, p2 : float
+        Bounds of p(k) (7).
 
     Returns
     -------
     float
+        The guaranteed cost max(tr(Q̄(p1) X0), tr(Q̄(p2) X0)).
     """
     X0 = np.asarray(X0, dtype=float)
     return max(float(np.trace((values["Q0"] + p * values["Qp"]) @ X0)) for p in (p1, p2))
@@ -672,6 +679,7 @@ def certificate_from_solution(values: dict, realisation: str = "identity_T") -> 
     values : dict
         A Theorem 3 solution.
     realisation : str
+        One of :data:`REALISATIONS` (see :func:`recover_gains`).
 
     Returns
     -------
@@ -696,16 +704,20 @@ def congruence_residual(sys: System, values: dict, pairs, realisation: str = "id
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     values : dict
         A Theorem 3 solution.
     pairs : iterable of (float, float)
         (p(k), p(k+1)) pairs.
     realisation : str
+        One of :data:`REALISATIONS` (see :func:`recover_gains`).
     gamma3_top : {"HC", "zero"}
+        Upper row of Γ3 in the vertices (24): H̄^i C, or 0 (the misreading; see the module docstring).
 
     Returns
     -------
     float
+        Largest absolute entry of the difference over all pairs.
     """
     from .model import theorem1_matrix
 
@@ -762,7 +774,9 @@ class FixedGainsVertexLMI:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        The filter parameters of (9) to certify.
     eps : float
         Q0, Qp >= eps I in the proposing problem (the question itself is strict).
     bound : float
@@ -895,6 +909,7 @@ def zero_diagonal_blocks(coefficients) -> list:
     Parameters
     ----------
     coefficients : netrepro.engines.certify.LMICoefficients
+        Constant and variable coefficients ``F0``, ``F`` of each named block.
 
     Returns
     -------

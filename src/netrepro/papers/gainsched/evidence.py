@@ -43,10 +43,12 @@ def feasible_flag(verdict: str):
     Parameters
     ----------
     verdict : str
+        ``"feasible"``, ``"infeasible"`` or anything else (undecided).
 
     Returns
     -------
     bool or None
+        True, False, or None for an undecided verdict.
     """
     return {"feasible": True, "infeasible": False}.get(str(verdict))
 
@@ -84,6 +86,24 @@ def evidence_step(params, inputs, outputs):
     Reads the design, stability, exact-moment, sensitivity, scheduling and vertex-LMI tables and the
     claims' ``at:`` settings; recomputes only light quantities through :mod:`.verification`
     (second-moment radii and growth rates across sigma^2, horizon and omega, residuals of the errata).
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi``, ``simulation``,
+        ``stability``, ``sensitivity`` and ``evidence`` (``horizons``, ``omegas``, ``missing_runs``,
+        ``missing_seed``: the re-judged ranges) sections.
+    inputs : dict
+        ``gains``, ``designs``, ``solutions``, ``theorem1``, ``exact``, ``exact_mse``,
+        ``sensitivity``, ``limits``, ``scheduling``, ``vertex`` (the gainsched result tables),
+        ``claims`` and ``findings`` (the paper's YAML files).
+    outputs : dict
+        ``table`` (``results/evidence/gainsched.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}`` from :func:`netrepro.verdicts.evidence_frame`.
     """
     from .design import certificate_from_solution, congruence_residual
 

@@ -63,11 +63,14 @@ def with_sigma2(sys: System, sigma2: float) -> System:
     Parameters
     ----------
     sys : System
+        The plant.
     sigma2 : float
+        The new variance of w(k) of (1).
 
     Returns
     -------
     System
+        A copy of ``sys`` with ``sigma2`` replaced.
     """
     return dataclasses.replace(sys, sigma2=float(sigma2))
 
@@ -261,11 +264,14 @@ def plant_vertex_radius(sys: System, sigma2: float) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3) (its ``sigma2`` is replaced where a ``sigma2`` is given).
     sigma2 : float
+        Variance of the multiplicative noise w(k) of (1).
 
     Returns
     -------
     float
+        The largest spectral radius (>= 1: no quadratic mean-square decay at some vertex).
     """
     rho = 0.0
     for F in sector_cases(sys).values():
@@ -292,7 +298,9 @@ def plant_necessary_fails(sys: System, sigma2: float, sector: str = "condition3"
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3) (its ``sigma2`` is replaced where a ``sigma2`` is given).
     sigma2 : float
+        Variance of the multiplicative noise w(k) of (1).
     sector : {"condition3", "componentwise"}
         The paper's class (3) (:func:`sector_class_radius`) or componentwise sectors
         (:func:`plant_vertex_radius`).
@@ -312,7 +320,9 @@ def necessary_condition(sys: System, sigma2: float, sector: str = "condition3"):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3) (its ``sigma2`` is replaced where a ``sigma2`` is given).
     sigma2 : float
+        Variance of the multiplicative noise w(k) of (1).
     sector : {"condition3", "componentwise"}
         Which class the criterion is for (Theorems 1-3: the paper's class (3)).
 
@@ -355,6 +365,7 @@ class PlantLMI:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3) (its ``sigma2`` is replaced where a ``sigma2`` is given).
     margin_cap : float
         The solver maximises t (blocks <= -t I, P >= t I, L >= t) with t <= margin_cap.
     bound : float
@@ -444,9 +455,11 @@ def necessary_limit(sys: System, lo: float, hi: float, tol: float = 1e-6, sector
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3) (its ``sigma2`` is replaced where a ``sigma2`` is given).
     lo, hi : float
         The radius must be below the threshold at ``lo`` and at or above it at ``hi``.
     tol : float
+        Stop when the bracket is narrower than ``tol``.
     sector : {"condition3", "componentwise"}
         The class whose linear gains are searched (see :func:`plant_necessary_fails`).
 

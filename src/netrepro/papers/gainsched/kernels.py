@@ -43,13 +43,19 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
     Parameters
     ----------
     A, B, C, D, Z : ndarray
+        Plant matrices of (1), (2), (6) (n x n, n x nz, m x n, n x n, nz x n).
     d1, d2 : ndarray (nz,)
+        Diagonals of the sector bounds F1, F2 of (3).
     kind : int
+        Index of the nonlinearity's kind in :data:`KINDS`.
     G0, Gf, H0, Hf : ndarray
+        Filter parameters of (9) (n x n, n x n, n x m, n x m); unused without gains.
     has_gains : bool
         False: x_f = 0 throughout (the trivial estimate).
     p_seq : ndarray (K,)
+        p(0..K-1).
     x0, xf0 : ndarray (runs, n)
+        Initial plant and filter states.
     u, g : ndarray (K, runs)
         Uniform and standard normal draws of each step.
     sd : float
@@ -58,6 +64,7 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
     Returns
     -------
     ndarray (runs, K+1, n)
+        The estimation errors e(k) = x(k) - x_f(k).
     """
     R, n = x0.shape
     m = C.shape[0]

@@ -130,7 +130,9 @@ class Gains:
     Parameters
     ----------
     G0, Gf : ndarray (n, n)
+        G(p) = G0 + p Gf, the filter's state matrix (9).
     H0, Hf : ndarray (n, m)
+        H(p) = H0 + p Hf, the filter's measurement gain (9).
 
     Returns
     -------
@@ -283,7 +285,9 @@ def augmented(sys: System, gains: Gains, p: float):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     p : float
         p(k).
 
@@ -314,8 +318,11 @@ def sector_nonlinearity(z, F1, F2, kind: str = "sine_mid"):
     Parameters
     ----------
     z : ndarray (..., nz)
+        Arguments Z x, one per row.
     F1, F2 : ndarray (nz, nz), diagonal
+        Sector bounds of (3); only their diagonals are used.
     kind : str
+        One of ``"sine_mid"`` (default), ``"lower"``, ``"upper"``.
 
     Returns
     -------
@@ -346,6 +353,7 @@ def sector_split(f, z, F1, F2):
     f, z : ndarray (..., nz)
         Values of the nonlinearity and its argument.
     F1, F2 : ndarray (nz, nz)
+        Sector bounds of (3); F = F2 - F1.
 
     Returns
     -------
@@ -365,6 +373,7 @@ def sector_cases(sys: System) -> dict:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
 
     Returns
     -------
@@ -394,6 +403,7 @@ def p_schedule(k, p1: float, p2: float, omega: float):
     p1, p2 : float
         Bounds of (7).
     omega : float
+        Angular frequency of the sine, per time step (radians).
 
     Returns
     -------
@@ -425,7 +435,9 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     Q_now, Q_next : ndarray or cvxpy expression (2n, 2n)
         Q(p(k)) and Q(p(k+1)).
     S : ndarray or cvxpy expression (2n, 2n)
@@ -478,6 +490,7 @@ class Theorem1Result:
     margin : float
         Maximised t.
     solver_feasible : bool
+        The solver's own opinion (information; the verdict decides).
     Q0, Qp, S : ndarray or None
         The certificate candidate Q(p) = Q0 + p Qp (27) and S.
     n_pairs : int
@@ -518,7 +531,9 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     n_grid : int
         Grid points per axis of (p(k), p(k+1)) in [p1, p2]^2.
     margin_tol : float
@@ -590,7 +605,9 @@ def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, 
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     Q0, Qp, S : ndarray (2n, 2n)
         Certificate of (12), (27).
     n_fine : int
@@ -635,7 +652,9 @@ def second_moment_operator(sys: System, gains: Gains, p: float, F):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     p : float
         Frozen p(k).
     F : ndarray (nz, nz)
@@ -659,13 +678,18 @@ def frozen_radius(sys: System, gains: Gains, p: float, F) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     p : float
+        Frozen p(k) = p(k+1) = p.
     F : ndarray (nz, nz)
+        Linear gain of f(z) = F z (inside the sector).
 
     Returns
     -------
     float
+        The spectral radius.
     """
     from ...engines.lmi import second_moment_radius
 
@@ -683,13 +707,18 @@ def scheduled_growth_rate(sys: System, gains: Gains, p_seq, F) -> float:
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     p_seq : array_like (K,)
+        p(0..K-1).
     F : ndarray (nz, nz)
+        Linear gain of f(z) = F z (inside the sector).
 
     Returns
     -------
     float
+        The geometric-mean growth factor per step (< 1: E||z(k)||^2 decays).
     """
     nn = 2 * sys.n
     prod = np.eye(nn * nn)
@@ -719,6 +748,7 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains or None
         ``None`` is the trivial estimate x_f = 0.
     p_seq : ndarray (K,)
@@ -726,6 +756,7 @@ def simulate(sys: System, gains: Gains | None, p_seq, x0, rng: np.random.Generat
     x0 : ndarray (runs, n)
         Initial states.
     rng : numpy.random.Generator
+        Source of the draws, in the order of :func:`draw_noise`.
     nonlinearity : str
         Kind of :func:`sector_nonlinearity`.
     xf0 : ndarray (n,) or None
@@ -766,9 +797,11 @@ def draw_noise(rng: np.random.Generator, n_steps: int, runs: int):
     Parameters
     ----------
     rng : numpy.random.Generator
+        Source of the draws.
     n_steps : int
         K, the length of p(0..K-1).
     runs : int
+        Number of Monte Carlo runs.
 
     Returns
     -------
@@ -793,13 +826,19 @@ def simulate_draws(sys: System, gains: Gains | None, p_seq, x0, draws, nonlinear
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains or None
+        Filter (9); ``None`` is the trivial estimate x_f = 0.
     p_seq : ndarray (K,)
+        p(0..K-1); the result has K+1 time points.
     x0 : ndarray (runs, n)
+        Initial states.
     draws : tuple of ndarray (K, runs)
         ``(u, g)`` of :func:`draw_noise`.
     nonlinearity : str
+        Kind of :func:`sector_nonlinearity`.
     xf0 : ndarray (n,) or None
+        Initial filter state (default 0); ignored for the trivial estimate.
 
     Returns
     -------
@@ -938,7 +977,9 @@ def lyapunov_difference_bounds(sys: System, gains: Gains, Q0, Qp, p: float, pn: 
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and the bounds of p(k) (7).
     gains : Gains
+        Filter parameters G0, Gf, H0, Hf of (9).
     Q0, Qp : ndarray (2n, 2n)
         The Lyapunov matrix Q(p) = Q0 + p Qp of (27).
     p, pn : float

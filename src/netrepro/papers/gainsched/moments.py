@@ -36,6 +36,7 @@ def linear_gains(sys: System) -> dict:
     Parameters
     ----------
     sys : System
+        The plant; its sector bounds F1, F2 of (3) are used.
 
     Returns
     -------
@@ -51,6 +52,7 @@ def mode_matrices(sys: System, gains: Gains, p_seq, F):
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6) and its sector (3).
     gains : Gains
         Filter (9); G(p(k)), H(p(k)) are evaluated at each p(k).
     p_seq : array_like (K,)
@@ -85,8 +87,11 @@ def initial_moment(x_mean, x_cov, xf0) -> np.ndarray:
     Parameters
     ----------
     x_mean : array_like (n,)
+        Mean of x(0).
     x_cov : array_like (n, n)
+        Covariance of x(0).
     xf0 : array_like (n,)
+        The filter's initial state x_f(0).
 
     Returns
     -------
@@ -114,6 +119,7 @@ def second_moments(M1, M0, W, p_seq, sigma2: float, X0):
     W : ndarray (B, 2n, 2n) or (2n, 2n)
         Multiplicative-noise matrix.
     p_seq : array_like (K,)
+        p(0..K-1): the arrival probabilities weighting M1 and M0.
     sigma2 : float
         E w^2.
     X0 : ndarray (B, 2n, 2n) or (2n, 2n)
@@ -122,6 +128,7 @@ def second_moments(M1, M0, W, p_seq, sigma2: float, X0):
     Returns
     -------
     ndarray (B, K+1, 2n, 2n) (or (K+1, 2n, 2n) without batch)
+        X(0..K).
     """
     single = np.ndim(M1) == 3
     M1, M0 = np.atleast_3d(M1), np.atleast_3d(M0)
@@ -146,10 +153,12 @@ def error_mse(X) -> np.ndarray:
     Parameters
     ----------
     X : ndarray (..., 2n, 2n)
+        Second moments E z̄ z̄^T (any leading shape).
 
     Returns
     -------
     ndarray (...)
+        E||e||^2 per matrix.
     """
     X = np.asarray(X, dtype=float)
     n = X.shape[-1] // 2

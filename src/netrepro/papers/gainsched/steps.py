@@ -78,7 +78,20 @@ def _sys(params) -> System:
 
 # ----------------------------------------------------------------------------- gains tables
 def gains_table(design: str, gains: Gains) -> pd.DataFrame:
-    """Long table ``design, matrix, row, col, value`` of one design's G0, Gf, H0, Hf (9)."""
+    """Long table ``design, matrix, row, col, value`` of one design's G0, Gf, H0, Hf (9).
+
+    Parameters
+    ----------
+    design : str
+        Name of the design (the ``design`` column).
+    gains : Gains
+        Its filter parameters G0, Gf, H0, Hf of (9).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per matrix entry (row-major within each matrix).
+    """
     rows = []
     for name, mat in gains.as_dict().items():
         mat = np.atleast_2d(mat)
@@ -88,7 +101,27 @@ def gains_table(design: str, gains: Gains) -> pd.DataFrame:
 
 
 def gains_from_table(table: pd.DataFrame, design: str, sys: System) -> Gains:
-    """Inverse of :func:`gains_table` for one design."""
+    """Inverse of :func:`gains_table` for one design.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A gains table (``results/gainsched/gains.csv``, columns ``design, matrix, row, col, value``).
+    design : str
+        The design to read.
+    sys : System
+        The plant; its n and m give the matrices' shapes (entries missing from the table are 0).
+
+    Returns
+    -------
+    Gains
+        The design's G0, Gf, H0, Hf of (9).
+
+    Raises
+    ------
+    GainschedError
+        If the table has no row of ``design``.
+    """
     sub = table[table["design"] == design]
     if sub.empty:
         raise GainschedError(f"design {design!r} is not in the gains table")
@@ -104,7 +137,22 @@ def gains_from_table(table: pd.DataFrame, design: str, sys: System) -> Gains:
 
 # ----------------------------------------------------------------------------- Monte Carlo helpers
 def p_sequence(params, sys, horizon=None):
-    """The configured scheduling sequence p(0..K-1) (Section IV), K = ``simulation.horizon`` by default."""
+    """The configured scheduling sequence p(0..K-1) (Section IV), K = ``simulation.horizon`` by default.
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration; reads ``simulation.horizon`` and ``simulation.sine_omega``.
+    sys : System
+        The plant; its bounds p1, p2 of (7).
+    horizon : int, optional
+        K, overriding ``simulation.horizon``.
+
+    Returns
+    -------
+    ndarray (K,)
+        p(k) = p1 + (p2 - p1)|sin(omega k)|, k = 0..K-1 (:func:`.model.p_schedule`).
+    """
     sim = params["simulation"]
     K = int(sim["horizon"] if horizon is None else horizon)
     return p_schedule(np.arange(K), sys.p1, sys.p2, float(sim["sine_omega"]))
@@ -120,6 +168,25 @@ def design_step(params, inputs, outputs):
 
     Writes ``gains`` (design, matrix, row, col, value) and ``designs`` (one row
     per design: solver status, margin, objective, solve time, realisation).
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi`` (``eps``, ``bound``,
+        ``qp_positive``, ``margin_cap``, ``gamma3_top``), ``performance`` (``initial_cov``),
+        ``tuning`` (``horizon``, ``n_runs``, ``seed``, ``maxiter``) and ``simulation`` sections.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``gains``, ``designs`` and ``solutions`` (``results/gainsched/gains.csv``,
+        ``designs.csv``, ``lmi_solutions.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"gains", "designs", "solutions": DataFrame, "provenance": {"solver_status": ...}}``;
+        ``solutions`` holds every Theorem 3 variable entry by entry (problem, variable, row, col,
+        value), read back by :func:`load_solutions`.
     """
     from .design import Theorem3, certified_cost, recover_gains, recover_output_gains
 
@@ -220,7 +287,18 @@ def _decide_point(prob, sol, sys):
 
 
 def load_solutions(path) -> dict:
-    """LMI solutions stored by :func:`design_step` (``lmi_solutions.csv``): problem -> {variable: ndarray}."""
+    """LMI solutions stored by :func:`design_step` (``lmi_solutions.csv``): problem -> {variable: ndarray}.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``lmi_solutions.csv`` table (problem, variable, row, col, value).
+
+    Returns
+    -------
+    dict
+        Problem name -> variable name -> matrix (shape from the largest row and column index).
+    """
     sols = read_table(path)
     out = {}
     for name, sub in sols.groupby("problem", sort=False):
@@ -257,6 +335,21 @@ def stability_step(params, inputs, outputs):
     Theorem 1 solve (status, margin), the fine-grid maximum eigenvalue, the
     check of the Theorem 3 certificate itself (rebuilt Q, S of (23), (27)),
     and the growth rate of E||z||^2 along the scheduled p(k).
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``lmi`` (``check_grid`` and the Theorem 1
+        solve settings), ``stability`` (``n_p``: points of the p grid) and ``simulation`` sections.
+    inputs : dict
+        ``gains`` (``results/gainsched/gains.csv``) and ``solutions`` (``lmi_solutions.csv``).
+    outputs : dict
+        ``stability`` and ``theorem1`` (``results/gainsched/stability.csv``, ``theorem1.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"stability": DataFrame, "theorem1": DataFrame}``.
     """
     from .design import certificate_from_solution, output_certificate, recover_gains, recover_output_gains
 
@@ -313,6 +406,24 @@ def simulation_step(params, inputs, outputs):
     second moments are in ``exact_moments.csv`` (:func:`exact_moments_step`). With a
     multiplicative noise ||e||^2 is heavy-tailed: the standard errors are sample
     standard errors and understate the uncertainty where the fourth moment is large.
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``simulation`` (``horizon``, ``sine_omega``,
+        ``n_runs``, ``x0``, ``xf0``, ``seed``, ``band``, ``nonlinearity``) and ``performance``
+        (``initial_cov``) sections.
+    inputs : dict
+        ``gains`` (``results/gainsched/gains.csv``).
+    outputs : dict
+        ``errors``, ``error_summary`` and ``paths`` (``results/gainsched/errors.csv``,
+        ``error_summary.csv``, ``sample_paths.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"errors", "error_summary", "paths": DataFrame}``; ``paths`` is the first run's e1, e2
+        and p(k) per design (fixed x0).
     """
     sys = _sys(params)
     sim = params["simulation"]
@@ -369,6 +480,23 @@ def exact_moments_step(params, inputs, outputs):
     per k. The designs named in ``simulation.flipped`` are repeated as ``<design>_flipped``: the
     same filter with the opposite sign of its state (H -> -H, :func:`.model.realisation` with
     J = -I); ``performance`` (performance.csv) keeps the designs of the gains table.
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system`` and ``simulation`` (``horizon``, ``sine_omega``,
+        ``x0``, ``xf0``, ``flipped``) sections.
+    inputs : dict
+        ``gains`` and ``designs`` (``results/gainsched/gains.csv``, ``designs.csv``).
+    outputs : dict
+        ``table``, ``per_k`` and ``performance`` (``results/gainsched/exact_moments.csv``,
+        ``exact_mse.csv``, ``performance.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table", "per_k", "performance": DataFrame}``; ``performance`` has per design its
+        certified cost beside ``sum_mse_<initial state>_<F>`` and the worst over F.
     """
     sys = _sys(params)
     sim = params["simulation"]
@@ -436,6 +564,21 @@ def sensitivity_step(params, inputs, outputs):
     makes the plant's second-moment radius reach 1, :func:`.feasibility.worst_sector_gain`).
     For class (3) the plant's limit lies between the ``plant`` row's feasible end and the
     ``plant_necessary`` row's infeasible end.
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi`` and ``sensitivity``
+        (``sigma2_grid``, ``sigma2_zoom``, and the bisection bracket ``sigma2_lo``, ``sigma2_hi``, ``tol``) sections.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``limits`` (``results/gainsched/sensitivity.csv``, ``feasibility_limit.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "limits": DataFrame}``.
     """
     from ...engines.certify import bisect_certified
 
@@ -624,6 +767,21 @@ def timing_step(params, inputs, outputs):
     states with the example's p bounds; keeps status, compile and solver time,
     and a power-law fit of solver time against the number of scalar variables
     (columns ``fit_exponent``, ``extrapolated_1000_s``, identical on every row).
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system`` (its p bounds), ``lmi`` (``eps``, ``bound``,
+        ``margin_cap``) and ``timing`` (``n_states``, ``seed``) sections.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/gainsched/timing.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``, one row per state dimension (NaN fit with fewer than two timed solves).
     """
     from .design import Theorem3
 
@@ -674,6 +832,22 @@ def vertex_lmi_step(params, inputs, outputs):
 
     Every verdict is the shared engine's (point check, dual certificate or necessary condition);
     the solver status and margin are information.
+
+    Parameters
+    ----------
+    params : dict
+        The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi`` and ``sensitivity``
+        (``sigma2_grid``, to which the system's own sigma^2 is added) sections.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` (``results/gainsched/vertex_lmis.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: problem, slack, gamma3_top, sigma2, verdict, evidence, status,
+        margin, certified_slack.
     """
     from .design import FixedGainsVertexLMI, Theorem3, zero_diagonal_blocks
     from .feasibility import necessary_condition, with_sigma2

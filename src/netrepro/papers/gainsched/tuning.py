@@ -25,6 +25,7 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and noise variance.
     p_seq : ndarray (K,)
         p(0..K-1) of the cost horizon.
     n_runs : int
@@ -38,6 +39,7 @@ def tune_gains(sys: System, p_seq, n_runs: int, seed: int, nonlinearity: str, sc
     maxiter : int
         Nelder-Mead iterations.
     start : Gains, optional
+        Starting gains (default zero gains).
 
     Returns
     -------
@@ -89,10 +91,12 @@ def sum_mse(e) -> float:
     Parameters
     ----------
     e : ndarray (runs, K+1, n)
+        Estimation errors e(k) per run (from :func:`.model.simulate`).
 
     Returns
     -------
     float
+        sum over k of the mean over runs of ||e(k)||^2.
     """
     e = np.asarray(e, dtype=float)
     if e.ndim == 3 and e.shape[2] == 2:
@@ -111,14 +115,19 @@ def tune_gains_exact(sys: System, p_seq, F, X0, scheduled: bool, maxiter: int, s
     Parameters
     ----------
     sys : System
+        The plant (1), (2), (6), its sector (3) and noise variance.
     p_seq : ndarray (K,)
+        p(0..K-1) of the cost horizon.
     F : ndarray (nz, nz)
         Linear gain of f.
     X0 : ndarray (2n, 2n)
         Initial second moment of [x; x_f].
     scheduled : bool
+        Tune Gf, Hf as well (else they are zero).
     maxiter : int
+        Nelder-Mead iterations.
     start : Gains, optional
+        Starting gains (default zero gains).
 
     Returns
     -------
