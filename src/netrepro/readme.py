@@ -58,7 +58,7 @@ def results_table(root: str | Path = ".", papers=None) -> str:
     Returns
     -------
     str
-        The Markdown table (header, one row per paper, a total row when any paper is built), no final newline.
+        The Markdown table (header, one row per paper, a total row), without a final newline.
     """
     root = Path(root)
     registry = load_registry()

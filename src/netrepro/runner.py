@@ -275,8 +275,9 @@ def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, str
     inputs_only : bool, default False
         Check only the given files that have a sidecar (a rule's inputs); unfinished is then an error.
     remove_corrupt : bool, default False
-        Delete corrupt files and their sidecars (and leftover temporary files, orphaned sidecars
-        and unfinished outputs), so the next ``snakemake`` run rebuilds them.
+        Delete corrupt files, files without a sidecar and unfinished outputs, with their sidecars
+        (and leftover temporary files and orphaned sidecars), so the next ``snakemake`` run
+        rebuilds them.
     quiet : bool, default False
         Print only problems and the summary.
     stream : file-like, optional

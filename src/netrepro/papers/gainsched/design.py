@@ -68,7 +68,8 @@ class Theorem3Solution:
     objective : float
         t, or gamma of the performance design.
     solver_feasible : bool
-        The solver's opinion (information): status ``optimal``, and for feasibility problems a margin above ``margin_tol``.
+        The solver's opinion (information): status ``optimal``, and for feasibility problems a
+        margin above ``margin_tol``.
     values : dict
         Variable name -> ndarray (empty when the solver returned no point).
     solve_time_s : float
