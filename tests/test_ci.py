@@ -50,3 +50,19 @@ def test_the_workflow_passes_actionlint_and_make_lint_runs_it():
     assert proc.returncode == 0, proc.stdout + proc.stderr
     lint = re.search(r"^lint:.*?(?=^\S)", (ROOT / "Makefile").read_text(), re.M | re.S).group(0)
     assert "actionlint .github/workflows/regenerate.yml" in lint
+
+
+def test_make_report_takes_an_overlay_a_profile_and_shard_counts():
+    root = Path(__file__).resolve().parents[1]
+
+    def dry(*args):
+        out = subprocess.run(["make", "-n", "report", *args], cwd=root, capture_output=True, text=True, check=True)
+        return [line for line in out.stdout.splitlines() if "snakemake report" in line]
+
+    default = dry()
+    assert default and all("--configfile" not in line and "--config " not in line and "-j2" in line for line in default)
+    scaled = dry("CONFIG=paper-scale", "PROFILE=slurm", "SHARDS={onebit_estimator: 8}")
+    assert scaled and all("--configfile config/config.yaml config/paper-scale.yaml" in line for line in scaled)
+    assert all("--profile workflow/profiles/slurm" in line and " -j" not in line for line in scaled)  # the profile's job limit
+    assert all("--config 'shards={onebit_estimator: 8}'" in line for line in scaled)
+    assert (root / "config" / "paper-scale.yaml").is_file()
