@@ -60,6 +60,7 @@ def test_bonferroni_z_against_scipy_and_the_union_bound():
     for m in (1, 4, 48):
         z = bonferroni_z(0.05, m)
         assert 2 * stats.norm.sf(z) == pytest.approx(0.05 / m, rel=1e-12)
+        assert z == float(stats.norm.ppf(1.0 - 0.05 / (2 * m)))  # scipy.special.ndtri: scipy.stats's numbers exactly
     assert bonferroni_z(0.05, 1) == pytest.approx(1.959963984540054, rel=1e-12)
     with pytest.raises(InputError, match="alpha"):
         bonferroni_z(1.5, 3)
