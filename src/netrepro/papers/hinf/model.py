@@ -132,6 +132,7 @@ def gaussian_draws(rng: np.random.Generator, factor, size: int):
     Parameters
     ----------
     rng : numpy.random.Generator
+        The generator the draws come from (it advances as ``multivariate_normal`` would advance it).
     factor : ndarray, shape ``(d, d)``
         :func:`gaussian_factor` of the covariance.
     size : int
