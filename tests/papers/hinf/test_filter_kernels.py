@@ -8,7 +8,7 @@ import pytest
 
 from netrepro.papers.hinf import filters as F
 from netrepro.papers.hinf.motion import sigma_gradient
-from netrepro.papers.hinf.noise import NoiseModel, geometry, noise_information
+from netrepro.papers.hinf.noise import NoiseModel, geometry, noise_information, sample_noise
 
 MODEL = NoiseModel(a0=0.3528, a1=15.625, a2=0.0008, alpha=5.0)
 A_ROT = np.array([[1.0, 0.1], [-0.05, 0.98]])
@@ -78,3 +78,14 @@ def test_noise_information_kernel_matches_numpy(lead):
     a = noise_information(15.0, th, MODEL, derivatives=True, kernel="numpy")
     b = noise_information(15.0, th, MODEL, derivatives=True, kernel="compiled")
     assert _same(a, b)
+
+
+@pytest.mark.parametrize("lead", [(100, 10), (50, 16, 4), (3,), ()])
+def test_sample_noise_rotation_kernel_matches_numpy(lead):
+    # the same draws (same generator state) rotated by the kernel and by numpy's matmul: tolerance 0
+    rng = np.random.default_rng(8)
+    r, th = rng.uniform(0.0, 60.0, lead), rng.uniform(-np.pi, np.pi, lead)
+    for theta in (th, np.asfortranarray(th) if th.ndim > 1 else th):
+        a = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="numpy")
+        b = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="compiled")
+        assert a.shape == lead + (2,) and a.tobytes() == b.tobytes()

@@ -13,7 +13,7 @@ from netrepro.errors import InputError
 from netrepro.papers.hinf.algebra import central_difference
 from netrepro.papers.hinf.consensus import component_membership, component_sums, topology_changed
 from netrepro.papers.hinf.filters import gain_norms, steady_state_prior
-from netrepro.papers.hinf.model import advantage, bonferroni_z, settle_step, tag_z
+from netrepro.papers.hinf.model import advantage, bonferroni_z, gaussian_draws, gaussian_factor, settle_step, tag_z
 
 
 def test_central_difference_is_exact_on_quadratics():
@@ -60,6 +60,7 @@ def test_bonferroni_z_against_scipy_and_the_union_bound():
     for m in (1, 4, 48):
         z = bonferroni_z(0.05, m)
         assert 2 * stats.norm.sf(z) == pytest.approx(0.05 / m, rel=1e-12)
+        assert z == float(stats.norm.ppf(1.0 - 0.05 / (2 * m)))  # scipy.special.ndtri: scipy.stats's numbers exactly
     assert bonferroni_z(0.05, 1) == pytest.approx(1.959963984540054, rel=1e-12)
     with pytest.raises(InputError, match="alpha"):
         bonferroni_z(1.5, 3)
@@ -106,3 +107,18 @@ def test_range_derivative_reading_of_eq17_against_finite_differences():
         assert np.linalg.norm(dinfo_dr_reading(r, 0.7, model, "square_roots") - fd) > 0.1 * np.linalg.norm(fd)
     with pytest.raises(ValueError, match="unknown reading"):
         dinfo_dr_reading(5.0, 0.7, model, "sqrt")
+
+
+@pytest.mark.parametrize("cov", [0.01 * np.eye(2), 0.001 * np.eye(2), np.zeros((2, 2)), [[0.02, 0.005], [0.005, 0.01]],
+                                 np.diag([1.0, 2.0, 0.5])])
+def test_gaussian_draws_are_multivariate_normal(cov):
+    # the simulation's target noise: numpy's multivariate_normal with its factor computed once, the same
+    # draws from the same generator state (tolerance 0), and the generator left in the same state
+    cov = np.asarray(cov, dtype=float)
+    F = gaussian_factor(cov)
+    for size in (1, 7, 200):
+        g1, g2 = np.random.default_rng(size), np.random.default_rng(size)
+        for _ in range(3):
+            want = g1.multivariate_normal(np.zeros(len(cov)), cov, size=size)
+            assert gaussian_draws(g2, F, size).tobytes() == want.tobytes()
+        assert g1.random() == g2.random()

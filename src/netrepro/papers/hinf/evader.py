@@ -374,8 +374,9 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
     tol : float
         Relative Frank-Wolfe gap guaranteed (default :data:`EXACT_TOLERANCE`).
     kernel : {"auto", "compiled", "numpy"}
-        ``"compiled"``: the faces of each size by :func:`.evader_kernels.faces_kernel`, the same arithmetic
-        instance by instance (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see
+        ``"compiled"``: the faces of each size by :func:`.evader_kernels.faces_kernel`, the determinant form and
+        the certificate's value and gradient by :func:`.evader_kernels.polarised_det_kernel` and
+        :func:`.evader_kernels.bounds_kernel`, the same arithmetic instance by instance (bit-identical); ``"numpy"``: the reference form; ``"auto"``: see
         :func:`.algebra.use_compiled`, and at least :data:`EXACT_COMPILED_MIN_BATCH` instances.
 
     Returns
@@ -391,7 +392,6 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
     l = s[..., 0] + s[..., 2]                          # tr S_j
     lead = Minv.shape[:-3]
     Mf, sf, lf = Minv.reshape(-1, n, 2, 2), s.reshape(-1, n, 3), l.reshape(-1, n)
-    Hf = _polarised_det(sf)                            # (M, N, N)
     best_f = np.full(len(sf), np.inf)
     best_lam = np.zeros((len(sf), n))
     rows = np.arange(len(sf))  # instances still to be solved
@@ -399,29 +399,36 @@ def min_fused_trace_exact(Minv, tol: float = EXACT_TOLERANCE, kernel: str = "aut
     # runs on large batches only (an evader deciding for many runs at every step)
     compiled = use_compiled(kernel, Minv.size // 4) and (kernel == "compiled" or len(sf) >= EXACT_COMPILED_MIN_BATCH)
     if compiled:
-        from .evader_kernels import faces_kernel  # numba: used where it is already loaded (or asked for)
+        from .evader_kernels import faces_kernel, polarised_det_kernel  # numba: used where it is already loaded
+        Mf, sf = np.ascontiguousarray(Mf), np.ascontiguousarray(sf)
+        Hf = np.empty((len(sf), n, n))
+        polarised_det_kernel(sf, Hf)                   # (M, N, N), bit-identical to _polarised_det
+    else:
+        Hf = _polarised_det(sf)                        # (M, N, N)
+    bounds = None  # fused_trace_bounds at the current best_lam, once computed (reused while best_lam is unchanged)
     for k in (1, 2, 3):
         if k > n or len(rows) == 0:
             break
         if k == 3:  # triangles only where no vertex or edge is already certified (the Frank-Wolfe gap decides)
-            value, lower = fused_trace_bounds(Mf, best_lam)
+            value, lower = bounds = _fused_trace_bounds_flat(Mf, best_lam, compiled)
             rows = np.nonzero(value - lower > 0.01 * tol * np.abs(value))[0]
             if len(rows) == 0:
                 break
+            bounds = None
         combos = np.asarray(list(combinations(range(n), k)))
         if compiled:
             faces_kernel(np.ascontiguousarray(Hf), np.ascontiguousarray(lf), combos, rows, best_f, best_lam)
         else:
             _best_on_faces_numpy(Hf, lf, combos, rows, best_f, best_lam)
-    value, lower = fused_trace_bounds(Mf, best_lam)
+    value, lower = bounds if bounds is not None else _fused_trace_bounds_flat(Mf, best_lam, compiled)
     rough = value - lower > 0.01 * tol * np.abs(value)  # nearly degenerate faces: polish by Newton, keep if better
     if rough.any():
         bad = np.nonzero(rough)[0]
         pol = _newton_polish(sf[bad], lf[bad], best_lam[bad])
-        v2, lo2 = fused_trace_bounds(Mf[bad], pol)
+        v2, lo2 = _fused_trace_bounds_flat(Mf[bad], pol, compiled)
         keep = v2 - lo2 < (value - lower)[bad]
         best_lam[bad[keep]] = pol[keep]
-        value, lower = fused_trace_bounds(Mf, best_lam)
+        value, lower = _fused_trace_bounds_flat(Mf, best_lam, compiled)
     failing = value - lower > tol * np.abs(value)
     if failing.any():  # rare (none in the default runs): the certificate would fail; try harder before raising
         _rescue_degenerate(Mf, sf, lf, best_lam, np.nonzero(failing)[0])
@@ -459,6 +466,21 @@ def _rescue_degenerate(Mf, sf, lf, best_lam, bad, steps: int = 10) -> None:
         better = v2 - lo2 < gap
         best_lam[bad[better]] = pol[better]
         gap = np.where(better, v2 - lo2, gap)
+
+
+def _fused_trace_bounds_flat(Mf, lam, compiled: bool):
+    """:func:`fused_trace_bounds` of ``Mf (M, N, 2, 2)``, ``lam (M, N)``; ``compiled``: value and gradient by
+    :func:`.evader_kernels.bounds_kernel` (bit-identical), the gap in numpy as there."""
+    if not compiled:
+        return fused_trace_bounds(Mf, lam)
+    from .evader_kernels import bounds_kernel
+
+    Mf = np.ascontiguousarray(Mf, dtype=float)
+    lam = np.ascontiguousarray(lam, dtype=float)
+    value, grad = np.empty(len(lam)), np.empty(lam.shape)
+    bounds_kernel(Mf, lam, value, grad)
+    gap = np.einsum("...n,...n->...", grad, lam) - grad.min(-1)
+    return value, value - gap
 
 
 def fused_trace_bounds(Minv, lam):
@@ -538,7 +560,12 @@ def evader_decisions(x_t, agents, model: NoiseModel, step: float, n_headings: in
     r, th = geometry(cand, agents[:, None, :, :])
     Minv = noise_information(r, th, model)
     upper, lam = _inner(solver)(Minv, n_iter)
-    _, lower = fused_trace_bounds(Minv, lam)
+    if use_compiled("auto", Minv.size // 4):  # the certificate by the compiled kernel (bit-identical)
+        n = Minv.shape[-3]
+        _, lower = _fused_trace_bounds_flat(Minv.reshape(-1, n, 2, 2), lam.reshape(-1, n), True)
+        lower = lower.reshape(upper.shape)
+    else:
+        _, lower = fused_trace_bounds(Minv, lam)
     lower = np.minimum(lower, upper)
     choice = np.argmax(upper, axis=1)
     idx = np.arange(len(x_t))

@@ -1,10 +1,12 @@
 """Compiled (numba) kernels of the evader's inner solvers, eq (24) of the `hinf` paper.
 
 ``pairwise_kernel``: the pairwise Frank-Wolfe solver; ``faces_kernel``: the enumeration of the faces of the
-simplex of the exact solver. Imported lazily by :func:`.evader.min_fused_trace_pairwise` and
+simplex of the exact solver; ``polarised_det_kernel`` and ``bounds_kernel``: the exact solver's determinant form
+and the value and gradient of its Frank-Wolfe certificate. Imported lazily by :func:`.evader.min_fused_trace_pairwise` and
 :func:`.evader.min_fused_trace_exact`, so that the steps that do not use them do not import numba. Each kernel
 replays, per instance and in the same floating-point order, the numpy expressions of its reference
-(:func:`.evader._min_fused_trace_pairwise_numpy`, :func:`.evader._best_on_faces_numpy`), so that its results
+(:func:`.evader._min_fused_trace_pairwise_numpy`, :func:`.evader._best_on_faces_numpy`,
+:func:`.evader._polarised_det`, :func:`.evader.fused_trace_bounds`), so that its results
 are bit-identical. Both are written on scalars (no helper functions, no scratch arrays): numba compiles them
 faster, a cost a process pays once when it loads a kernel cold.
 """
@@ -16,7 +18,7 @@ from numba import njit
 
 from .filter_kernels import fma
 
-__all__ = ["pairwise_kernel", "faces_kernel"]
+__all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel"]
 
 
 # --------------------------------------------------------------------------- compiled kernel (numba)
@@ -275,3 +277,85 @@ def faces_kernel(H, l, combos, rows, best_f, best_lam):
                 best_lam[r, combos[bc, 1]] = b1
             if k > 2:
                 best_lam[r, combos[bc, 2]] = b2
+
+
+@njit(cache=True, error_model="numpy")
+def polarised_det_kernel(s, H):
+    """:func:`.evader._polarised_det` of ``s (M, N, 3)`` into ``H (M, N, N)``, the same operations in the same order.
+
+    ``H_ij = (a_i d_j + d_i a_j) / 2 - b_i b_j`` for ``s = (a, b, d)`` (the symmetric 2x2 matrices ``S_j`` of
+    eq (24)), so that ``det(sum_j lam_j S_j) = lam^T H lam``. Written into ``H`` (allocated by the caller).
+
+    Parameters
+    ----------
+    s : ndarray ``(M, N, 3)``
+        ``(a, b, d)`` of ``S_j = [[a, b], [b, d]]``.
+    H : ndarray ``(M, N, N)``
+        Output.
+
+    Returns
+    -------
+    None
+    """
+    m, n = s.shape[0], s.shape[1]
+    for r in range(m):
+        for i in range(n):
+            ai = s[r, i, 0]
+            bi = s[r, i, 1]
+            di = s[r, i, 2]
+            for j in range(n):
+                H[r, i, j] = 0.5 * (ai * s[r, j, 2] + di * s[r, j, 0]) - bi * s[r, j, 1]
+
+
+@njit(cache=True, error_model="numpy")
+def bounds_kernel(Minv, lam, value, grad):
+    """Value and gradient of :func:`.evader.fused_trace_bounds` per instance, bit-identical to its numpy form.
+
+    ``A = sum_j lam_j M_j^{-1}`` (``einsum``: sequential sum over the agents), ``A^{-1}`` by
+    :func:`.algebra.inv2` (``adj(A) / det A``), ``value = tr A^{-1}`` and
+    ``grad_j = -tr(A^{-1} A^{-1} M_j^{-1})`` (``A^{-1} @ A^{-1}`` rounded as numpy's stacked ``matmul``:
+    ``fma(a_i1, b_1j, a_i0 b_0j)``; the trace of the product as ``einsum("...ij,...nji->...n")`` adds it), the
+    same operations as :func:`pairwise_kernel`. The gap (a dot product and a minimum) stays in numpy.
+
+    Parameters
+    ----------
+    Minv : ndarray ``(M, N, 2, 2)``
+        The informations ``M_j^{-1}`` of eq (24).
+    lam : ndarray ``(M, N)``
+        Weights on the simplex.
+    value : ndarray ``(M,)``
+        Output: ``f(lam) = tr A^{-1}``.
+    grad : ndarray ``(M, N)``
+        Output: the gradient of ``f``.
+
+    Returns
+    -------
+    None
+    """
+    m, n = lam.shape
+    for r in range(m):
+        A00 = 0.0
+        A01 = 0.0
+        A10 = 0.0
+        A11 = 0.0
+        for q in range(n):
+            A00 += lam[r, q] * Minv[r, q, 0, 0]
+        for q in range(n):
+            A01 += lam[r, q] * Minv[r, q, 0, 1]
+        for q in range(n):
+            A10 += lam[r, q] * Minv[r, q, 1, 0]
+        for q in range(n):
+            A11 += lam[r, q] * Minv[r, q, 1, 1]
+        c = A00 * A11 - A01 * A10
+        i00 = A11 / c
+        i11 = A00 / c
+        i01 = -A01 / c
+        i10 = -A10 / c
+        value[r] = i00 + i11
+        C00 = fma(i01, i10, i00 * i00)
+        C01 = fma(i01, i11, i00 * i01)
+        C10 = fma(i11, i10, i10 * i00)
+        C11 = fma(i11, i11, i10 * i01)
+        for q in range(n):
+            grad[r, q] = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1])
+                           + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))

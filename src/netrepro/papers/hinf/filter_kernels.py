@@ -21,7 +21,8 @@ from llvmlite import ir as llvm_ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-__all__ = ["fma", "hinf_update_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel"]
+__all__ = ["fma", "hinf_update_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
+           "rotate_kernel"]
 
 
 @intrinsic
@@ -246,3 +247,21 @@ def noise_information_kernel(c, s, rinv_r, rinv_b, d_r, d_b, derivatives, Minv, 
             dMinv_dtheta[b, 0, 1] = p01 + p10
             dMinv_dtheta[b, 1, 0] = p10 + p01
             dMinv_dtheta[b, 1, 1] = p11 + p11
+
+
+@njit(cache=True, error_model="numpy")
+def rotate_kernel(c, s, v0, v1, out):
+    """``T(theta) v`` with ``T = [[c, -s], [s, c]]`` of eq (3) on ``B`` flattened sensors, as numpy's ``matmul`` rounds it.
+
+    The last step of :func:`.noise.sample_noise` (``rotation(theta) @ local[..., None]``, a ``dgemv`` per
+    sensor): ``out_i = fma(T_i0, v_0, T_i1 v_1) + 0.0``.
+
+    Parameters
+    ----------
+    c, s, v0, v1 : ndarray ``(B,)``
+        ``cos theta``, ``sin theta`` and the vector's components.
+    out : ndarray ``(B, 2)``
+        Receives ``T v``.
+    """
+    for b in range(c.shape[0]):
+        out[b, 0], out[b, 1] = _mv(c[b], -s[b], s[b], c[b], v0[b], v1[b])

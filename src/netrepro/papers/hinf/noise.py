@@ -235,7 +235,7 @@ def dinfo_dr_reading(r, theta, model: NoiseModel, reading: str = "variances"):
     return -2 * model.a2 * (r - model.a1) * T @ inv_r2 @ np.diag([1.0, model.alpha]) @ T.T
 
 
-def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel):
+def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel, kernel: str = "auto"):
     """Draw measurement noise ``m_i = T_i diag(sqrt f_r, sqrt f_b) eps_i``, ``eps_i ~ N(0, I_2)`` (eq (3)).
 
     Parameters
@@ -244,6 +244,10 @@ def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel):
     r, theta : array_like
         Range and bearing (same shape).
     model : NoiseModel
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: the rotation by :func:`.filter_kernels.rotate_kernel`, the same arithmetic sensor by
+        sensor (bit-identical; ``r`` and ``theta`` of one shape); ``"numpy"``: the reference form;
+        ``"auto"``: see :func:`.algebra.use_compiled`.
 
     Returns
     -------
@@ -251,8 +255,16 @@ def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel):
     """
     fr, fb = noise_variances(r, model)
     eps = rng.standard_normal(np.shape(fr) + (2,))
-    local = np.stack([np.sqrt(fr) * eps[..., 0], np.sqrt(fb) * eps[..., 1]], -1)
-    return (rotation(theta) @ local[..., None])[..., 0]
+    v0, v1 = np.sqrt(fr) * eps[..., 0], np.sqrt(fb) * eps[..., 1]
+    theta = np.asarray(theta, dtype=float)
+    if theta.shape != fr.shape or not use_compiled(kernel, fr.size):
+        local = np.stack([v0, v1], -1)
+        return (rotation(theta) @ local[..., None])[..., 0]
+    from .filter_kernels import rotate_kernel  # numba: imported by the steps that simulate
+
+    out = np.empty(fr.shape + (2,))
+    rotate_kernel(np.cos(theta).ravel(), np.sin(theta).ravel(), v0.ravel(), v1.ravel(), out.reshape(-1, 2))
+    return out
 
 
 def fit_noise_model(r, var_range, var_bearing) -> dict:
