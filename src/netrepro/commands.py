@@ -1,4 +1,4 @@
-"""``python -m netrepro new-paper | check-paper | diff``: the commands for people, beside the runner's.
+"""``python -m netrepro new-paper | check-paper | diff | scaling``: the commands for people, beside the runner's.
 
 Kept apart from :mod:`netrepro.runner`, which every pipeline job runs: a rule's code inputs are the
 modules its job can reach, so the scaffold, the contract and the diff tool stay out of them (an
@@ -12,7 +12,7 @@ import sys
 
 __all__ = ["COMMANDS", "main"]
 
-COMMANDS = ("new-paper", "check-paper", "diff")
+COMMANDS = ("new-paper", "check-paper", "diff", "scaling")
 
 
 def _new_paper(args) -> int:
@@ -34,7 +34,8 @@ def _new_paper(args) -> int:
 def main(argv=None) -> int:
     """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code.
 
-    ``diff`` is handed to :func:`netrepro.diff.main` (its own parser); ``new-paper`` writes a
+    ``diff`` is handed to :func:`netrepro.diff.main` and ``scaling`` to :func:`netrepro.scaling.main`
+    (their own parsers); ``new-paper`` writes a
     paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`.
 
     Parameters
@@ -53,6 +54,10 @@ def main(argv=None) -> int:
         from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
 
         return diff_main(argv[1:])
+    if argv[:1] == ["scaling"]:
+        from .scaling import main as scaling_main  # its own parser: python -m netrepro scaling [--collect BUILD]
+
+        return scaling_main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m netrepro")
     sub = parser.add_subparsers(dest="command", required=True)
     new = sub.add_parser("new-paper", help="create the working skeleton of a new paper (docs/adding-a-paper.md)")

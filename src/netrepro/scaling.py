@@ -1,0 +1,458 @@
+"""How the workflow scales on a cluster: per-rule work, projected wall times, ``docs/scaling.md``.
+
+Three steps, each from data a run wrote:
+
+1. :func:`rule_work` reads a build directory's provenance sidecars (``<output>.meta.json``, field
+   ``wall_time_s``; the rule from the sidecar's ``rule`` or from the ``"rule"`` of the command's
+   ``--io`` JSON) and sums the work per rule. One job writing several outputs leaves one sidecar
+   per output with the same command: it is counted once.
+2. :func:`parse_dry_run` reads the jobs and their dependencies from a dry run
+   (``snakemake -n --forceall ...``), :func:`job_table` gives each job its measured time, and
+   :func:`project` bounds and list-schedules the DAG (:func:`schedule`: longest remaining path
+   first) on N nodes of C job slots.
+3. :func:`write_doc` (``python -m netrepro scaling``) writes ``docs/scaling.md`` from the committed
+   CSVs under ``docs/scaling/``: the measured Slurm runs (``tests/slurm/measure.py``), the
+   per-rule work and the projection. Nothing in it is typed by hand but the prose.
+
+The lower bound of the wall time on ``s`` slots is ``max(critical path, total work / s)``: no
+schedule beats the longest dependency chain, nor perfect division of the summed work. A list
+schedule is within a factor ``2 - 1/s`` of the optimum (Graham 1966, Bell Syst. Tech. J. 45,
+Theorem 1), so ``lower bound <= list schedule <= (2 - 1/s) * optimum``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import heapq
+import json
+import re
+import shlex
+import sys
+from pathlib import Path
+
+__all__ = [
+    "rule_work", "write_csv", "read_csv", "parse_dry_run", "job_table", "critical_path", "schedule",
+    "project", "write_doc", "render_doc", "main",
+]
+
+SIDECAR = ".meta.json"
+SIDECAR_DIRS = ("results", "figures", "report")
+DATA = Path("docs/scaling")
+DOC = Path("docs/scaling.md")
+NODES = (1, 8, 64)
+CORES = 2
+
+
+# ---- 1. per-rule work ----------------------------------------------------------------------------------
+def _rule_of(meta: dict) -> str | None:
+    """The rule a sidecar belongs to: its ``rule`` field, else the ``"rule"`` of the command's ``--io``."""
+    if meta.get("rule"):
+        return str(meta["rule"])
+    try:
+        words = shlex.split(meta.get("command", ""))
+    except ValueError:
+        return None
+    for flag, value in zip(words, words[1:]):
+        if flag == "--io":
+            try:
+                return json.loads(value).get("rule")
+            except (ValueError, AttributeError):
+                return None
+    return None
+
+
+def _sidecars(build: Path, dirs=SIDECAR_DIRS):
+    for sub in dirs:
+        root = build / sub
+        if root.is_dir():
+            yield from sorted(root.rglob("*" + SIDECAR))
+
+
+def job_times(build: Path, dirs=SIDECAR_DIRS) -> dict:
+    """``{output path (relative to build): (rule, job key, wall_time_s)}`` from a build's sidecars.
+
+    The job key is the sidecar's command (one job, one command, whatever its number of outputs)."""
+    found = {}
+    for path in _sidecars(Path(build), dirs):
+        try:
+            meta = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if not isinstance(meta, dict) or meta.get("wall_time_s") is None:
+            continue
+        rule = _rule_of(meta)
+        if rule is None:
+            continue
+        output = str(path.relative_to(build))[: -len(SIDECAR)]
+        key = meta.get("command") or meta.get("output") or output
+        found[output] = (rule, key, float(meta["wall_time_s"]))
+    return found
+
+
+def rule_work(build: Path, dirs=SIDECAR_DIRS) -> list[dict]:
+    """Work per rule of a build: ``rule, jobs, total_s, max_job_s`` rows, most work first.
+
+    Parameters
+    ----------
+    build
+        A build directory (the root of a checkout that ran the workflow).
+    dirs
+        Its subdirectories searched for sidecars ``<output>.meta.json``.
+
+    Returns
+    -------
+    list of dict
+        One row per rule: the number of distinct jobs (distinct commands), their summed
+        ``wall_time_s`` and the longest one, in seconds (3 decimals, as the sidecars).
+    """
+    jobs = {}
+    for rule, key, seconds in job_times(build, dirs).values():
+        jobs[(rule, key)] = seconds
+    per_rule = {}
+    for (rule, _), seconds in jobs.items():
+        row = per_rule.setdefault(rule, {"rule": rule, "jobs": 0, "total_s": 0.0, "max_job_s": 0.0})
+        row["jobs"] += 1
+        row["total_s"] += seconds
+        row["max_job_s"] = max(row["max_job_s"], seconds)
+    rows = sorted(per_rule.values(), key=lambda r: (-r["total_s"], r["rule"]))
+    for row in rows:
+        row["total_s"] = round(row["total_s"], 3)
+        row["max_job_s"] = round(row["max_job_s"], 3)
+    return rows
+
+
+def write_csv(rows: list[dict], path: Path, fields=None) -> Path:
+    """Write ``rows`` as a CSV (columns ``fields`` or the first row's keys)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fields = fields or (list(rows[0]) if rows else [])
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=fields, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+def read_csv(path: Path) -> list[dict]:
+    """The rows of a CSV as dicts of strings ([] when the file does not exist)."""
+    path = Path(path)
+    if not path.is_file():
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+# ---- 2. the DAG and its schedule ---------------------------------------------------------------------------
+def parse_dry_run(text: str) -> list[dict]:
+    """Jobs of a dry run: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists)."""
+    jobs, job = [], None
+    for line in text.splitlines():
+        head = re.match(r"^(?:local)?rule (\w+):\s*$", line)
+        if head:
+            job = {"rule": head.group(1), "input": [], "output": [], "wildcards": {}}
+            jobs.append(job)
+            continue
+        field = re.match(r"^\s+(input|output|jobid|wildcards): (.*)$", line)
+        if job is None or not field:
+            continue
+        key, value = field.groups()
+        if key == "jobid":
+            job["jobid"] = int(value)
+        elif key == "wildcards":
+            job["wildcards"] = dict(part.split("=", 1) for part in value.split(", ") if "=" in part)
+        else:
+            job[key] = [v.strip() for v in value.split(", ") if v.strip()]
+    return [j for j in jobs if "jobid" in j]
+
+
+def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
+    """One row per dry-run job: ``jobid, rule, wildcards, seconds, measured, parents``.
+
+    ``times`` maps an output path to ``(rule, key, seconds)`` (:func:`job_times`); a job takes the
+    time of its first output that has one, else ``default`` (``measured`` is then 0). ``parents``
+    are the jobids whose outputs it reads, space separated.
+    """
+    producer = {out: j["jobid"] for j in jobs for out in j["output"]}
+    rows = []
+    for j in sorted(jobs, key=lambda j: j["jobid"]):
+        seconds = next((times[out][2] for out in j["output"] if out in times), None)
+        parents = sorted({producer[i] for i in j["input"] if i in producer and producer[i] != j["jobid"]})
+        rows.append({"jobid": j["jobid"], "rule": j["rule"],
+                     "wildcards": " ".join(f"{k}={v}" for k, v in j["wildcards"].items()),
+                     "seconds": round(default if seconds is None else seconds, 3),
+                     "measured": int(seconds is not None), "parents": " ".join(map(str, parents))})
+    return rows
+
+
+def _graph(rows: list[dict], overhead: float = 0.0):
+    durations = {int(r["jobid"]): float(r["seconds"]) + overhead for r in rows}
+    parents = {int(r["jobid"]): [int(p) for p in str(r.get("parents") or "").split()] for r in rows}
+    return durations, parents
+
+
+def _children(durations: dict, parents: dict) -> dict:
+    children = {j: [] for j in durations}
+    for j, ps in parents.items():
+        for p in ps:
+            children[p].append(j)
+    return children
+
+
+def _remaining(durations: dict, children: dict) -> dict:
+    """Longest path from the start of each job to the end of the workflow (iterative, any depth)."""
+    rank, order, seen = {}, [], set()
+    for root in durations:
+        stack = [(root, False)]
+        while stack:
+            j, done = stack.pop()
+            if done:
+                order.append(j)
+                continue
+            if j in seen:
+                continue
+            seen.add(j)
+            stack.append((j, True))
+            stack.extend((c, False) for c in children[j] if c not in seen)
+    for j in order:  # children before parents
+        rank[j] = durations[j] + max((rank[c] for c in children[j]), default=0.0)
+    return rank
+
+
+def critical_path(durations: dict, parents: dict) -> float:
+    """Length of the longest dependency chain (the wall time on unboundedly many slots)."""
+    rank = _remaining(durations, _children(durations, parents))
+    return max(rank.values(), default=0.0)
+
+
+def schedule(durations: dict, parents: dict, slots: int) -> float:
+    """Makespan of a list schedule: a job starts when its parents are done and a slot is free;
+    among ready jobs the one with the longest remaining path goes first (ties: lower job id)."""
+    if slots < 1:
+        raise ValueError(f"slots must be at least 1, got {slots}")
+    children = _children(durations, parents)
+    rank = _remaining(durations, children)
+    waiting = {j: len(parents.get(j, ())) for j in durations}
+    ready = [(-rank[j], j) for j, n in waiting.items() if n == 0]
+    heapq.heapify(ready)
+    running, now, free = [], 0.0, slots
+    while ready or running:
+        while ready and free:
+            _, j = heapq.heappop(ready)
+            heapq.heappush(running, (now + durations[j], j))
+            free -= 1
+        now, done = heapq.heappop(running)
+        free += 1
+        for c in children[done]:
+            waiting[c] -= 1
+            if waiting[c] == 0:
+                heapq.heappush(ready, (-rank[c], c))
+    return now
+
+
+def project(rows: list[dict], nodes=NODES, cores: int = CORES, overhead: float = 0.0) -> list[dict]:
+    """Projected wall time on each node count: ``nodes, slots, total_work_s, critical_path_s,
+    lower_bound_s, list_schedule_s`` (``overhead`` seconds added to every job first)."""
+    durations, parents = _graph(rows, overhead)
+    total = sum(durations.values())
+    critical = critical_path(durations, parents)
+    out = []
+    for n in nodes:
+        slots = n * cores
+        out.append({"nodes": n, "slots": slots, "total_work_s": round(total, 1),
+                    "critical_path_s": round(critical, 1), "lower_bound_s": round(max(critical, total / slots), 1),
+                    "list_schedule_s": round(schedule(durations, parents, slots), 1)})
+    return out
+
+
+# ---- 3. docs/scaling.md ------------------------------------------------------------------------------------
+def _table(rows: list[dict], columns: list[str]) -> str:
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(str(r.get(c, "")) for c in columns) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def _f(x, digits=1) -> str:
+    return f"{float(x):.{digits}f}"
+
+
+def _median(values):
+    v = sorted(values)
+    return (v[len(v) // 2] + v[(len(v) - 1) // 2]) / 2 if v else float("nan")
+
+
+def render_doc(data: Path = DATA) -> str:
+    """The text of ``docs/scaling.md`` from the CSVs in ``data``."""
+    data = Path(data)
+    runs = read_csv(data / "slurm_small.csv")
+    rates = read_csv(data / "sbatch_rate.csv")
+    rules = read_csv(data / "paper_scale_rules.csv")
+    jobs = read_csv(data / "paper_scale_jobs.csv")
+    source = read_csv(data / "paper_scale_source.csv")
+    src = {r["key"]: r["value"] for r in source}
+
+    parts = ["<!-- generated by `python -m netrepro scaling` from docs/scaling/*.csv: do not edit by hand -->",
+             "# Scaling on a cluster", ""]
+    parts.append(
+        "Measured on this repository's own test cluster (one Slurm node on the development machine, "
+        "`tests/slurm/cluster.py`), then projected to larger clusters from the per-job times of a "
+        "paper-scale build. Regenerate the measurements with `python -m tests.slurm.measure` (as root, "
+        "with the Slurm packages), the paper-scale tables with `python -m netrepro scaling --collect BUILD "
+        "--dry-run DRY.log`, and this page with `python -m netrepro scaling`.")
+    parts += ["", "## Measured: the small configuration on the local Slurm, with and without job arrays", ""]
+    if runs:
+        parts.append(
+            "Each row is one cold run of the sharded tables of `config/test.yaml` (intermittent, the onebit "
+            "estimator, hinf's loop variants and Kalman-best; every shard count as in the row) through "
+            "`workflow/profiles/slurm`, in a fresh copy of the repository. `arrays`: the profile as it is "
+            "(each `*_shard` rule one job array); `individual`: `--slurm-array-jobs ''` (one sbatch per job). "
+            "`submissions` counts sbatch calls in the plugin's log, `jobs` the Slurm jobs (array tasks one by "
+            "one); `wall_s` is the whole `snakemake` command; `job_sum_s`/`job_max_s` are Slurm's run times "
+            "(squeue, whole seconds) of the run's jobs. The load is the machine's 1-minute load average "
+            "before and after (other work shared the machine).")
+        parts += ["", _table(runs, ["mode", "repeat", "status", "submissions", "array_submissions",
+                                    "single_submissions", "jobs", "wall_s", "job_sum_s", "job_max_s",
+                                    "load_before", "load_after", "cpus", "shards"]), ""]
+        summary = []
+        for mode in sorted({r["mode"] for r in runs}):
+            ok = [r for r in runs if r["mode"] == mode and r["status"] == "ok"]
+            if ok:
+                summary.append({"mode": mode, "runs": len(ok),
+                                "submissions (median)": _f(_median([float(r["submissions"]) for r in ok]), 0),
+                                "jobs (median)": _f(_median([float(r["jobs"]) for r in ok]), 0),
+                                "wall_s (median)": _f(_median([float(r["wall_s"]) for r in ok])),
+                                "wall_s (min-max)": f"{min(float(r['wall_s']) for r in ok):.1f}-"
+                                                    f"{max(float(r['wall_s']) for r in ok):.1f}"})
+        if summary:
+            parts += ["Summary of the successful runs:", "",
+                      _table(summary, list(summary[0])), ""]
+    else:
+        parts += ["No measured run yet (`python -m tests.slurm.measure`).", ""]
+    if rates:
+        parts.append("Plain `sbatch --hold` calls timed against the same controller (the submission rate it "
+                     "sustains, one caller):")
+        parts += ["", _table(rates, ["calls", "seconds", "per_s", "load_before", "started_utc"]), ""]
+
+    parts += ["## Paper-scale work per rule", ""]
+    if rules:
+        parts.append(
+            f"From the provenance sidecars (`wall_time_s`: the step itself, without the start of Snakemake "
+            f"and Python in the job) of the build in `{src.get('build', '?')}` "
+            f"({src.get('what', 'configuration not recorded')}). One row per rule, most work first.")
+        total = sum(float(r["total_s"]) for r in rules)
+        parts += ["", _table(rules, ["rule", "jobs", "total_s", "max_job_s"]), "",
+                  f"Total: {total:.1f} s of step time in {sum(int(r['jobs']) for r in rules)} jobs.", ""]
+    else:
+        parts += ["No per-rule table yet.", ""]
+
+    parts += ["## Projected wall time on N nodes of 2 cores", ""]
+    if jobs:
+        overhead = float(src.get("overhead_s", 0.0) or 0.0)
+        unmeasured = sorted({r["rule"] for r in jobs if r["measured"] == "0"})
+        parts.append(
+            f"The DAG is the dry run's ({len(jobs)} jobs, the shard counts of the build above). Each job "
+            f"takes its sidecar time; jobs without one ({', '.join(unmeasured) or 'none'}) take "
+            f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job: "
+            f"{src.get('overhead_note', 'the per-job start-up')}. The lower bound is "
+            "max(critical path, total work / slots); the list schedule runs the ready job with the "
+            "longest remaining path first on 2 slots per node (no schedule is shorter than the bound, and "
+            "a list schedule is at most 2 - 1/slots times the best one).")
+        rows = []
+        for label, extra in (("step time", 0.0), ("+overhead", overhead)):
+            for p in project(jobs, NODES, CORES, extra):
+                rows.append({"job time": label, **p})
+        parts += ["", _table(rows, ["job time", "nodes", "slots", "total_work_s", "critical_path_s",
+                                     "lower_bound_s", "list_schedule_s"]), ""]
+        durations, _ = _graph(jobs)
+        longest = max(jobs, key=lambda r: float(r["seconds"]))
+        merges = [r for r in jobs if r["rule"] + "_shard" in {x["rule"] for x in jobs}]
+        parts.append("## Where the projection stops holding")
+        parts += ["",
+                  f"* **The longest single job** ({longest['rule']} {longest['wildcards']}, "
+                  f"{float(longest['seconds']):.1f} s) bounds the wall time from below whatever the node "
+                  "count; only more shards of its step (a larger `shards:` count) shorten it, and only for "
+                  "shard rules.",
+                  f"* **The merge steps run serially**: {len(merges)} merge jobs "
+                  f"({', '.join(sorted({r['rule'] for r in merges})) or 'none'}) each wait for all of their "
+                  f"step's shards and run as one job on the login node (local rules), "
+                  f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; they, the figures, the "
+                  "notebooks and the report make up the critical path.",
+                  "* **The scheduler's submission rate**: the profile lets Snakemake hand at most 10 jobs per "
+                  "second to the plugin (`max-jobs-per-timespan: 10/1s`), which submits with two threads. "
+                  + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second, so the profile's "
+                     "limit, not the controller, sets the pace: "
+                     if rates else "")
+                  + f"{len(jobs)} jobs need at least {len(jobs) / 10:.0f} s of submissions without arrays; "
+                  "with arrays a step's shards are one sbatch call. On a shared cluster the queue wait of "
+                  "each job comes on top and is not modelled.",
+                  "* **Snakemake's own start-up**: the main process parses the workflow and builds the DAG "
+                  "before the first submission, and every Slurm job starts Snakemake and Python again "
+                  "(the `+overhead` rows). With the small configuration's step times of seconds this "
+                  "start-up dominates; it matters less at paper scale, where single steps take minutes.",
+                  "* **Status polling**: the plugin asks squeue at intervals (first after "
+                  "`slurm-init-seconds-before-status-checks`, 20 s in the profile, then up to 180 s), so "
+                  "each level of the DAG can add up to one polling interval after its jobs finish.",
+                  ""]
+    else:
+        parts += ["No job table yet.", ""]
+    return "\n".join(parts).rstrip() + "\n"
+
+
+def write_doc(out: Path = DOC, data: Path = DATA) -> Path:
+    """Write ``docs/scaling.md`` (or ``out``) from the CSVs in ``data``."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(render_doc(data))
+    return out
+
+
+def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0, what: str = "",
+            overhead: float | None = None, overhead_note: str = "") -> list[Path]:
+    """Write ``paper_scale_rules.csv``, ``paper_scale_jobs.csv`` and ``paper_scale_source.csv`` in
+    ``data`` from a build's sidecars and the dry run of the same configuration."""
+    build, data = Path(build), Path(data)
+    times = job_times(build)
+    rules = rule_work(build)
+    jobs = job_table(parse_dry_run(Path(dry_run).read_text()), times, default)
+    if overhead is None:
+        overhead = measured_overhead(read_csv(data / "slurm_small.csv"))
+        overhead_note = overhead_note or ("the median over the measured Slurm runs of (Slurm run time - step "
+                                          "time) per job: Snakemake, srun and Python starting in the job")
+    source = [{"key": "build", "value": str(build)}, {"key": "what", "value": what},
+              {"key": "default_s", "value": default}, {"key": "overhead_s", "value": round(overhead, 1)},
+              {"key": "overhead_note", "value": overhead_note}]
+    return [write_csv(rules, data / "paper_scale_rules.csv", ["rule", "jobs", "total_s", "max_job_s"]),
+            write_csv(jobs, data / "paper_scale_jobs.csv",
+                      ["jobid", "rule", "wildcards", "seconds", "measured", "parents"]),
+            write_csv(source, data / "paper_scale_source.csv", ["key", "value"])]
+
+
+def measured_overhead(runs: list[dict]) -> float:
+    """Per-job start-up from measured runs: median of ``(job_sum_s - step_sum_s) / jobs`` (0 if none)."""
+    values = [(float(r["job_sum_s"]) - float(r["step_sum_s"])) / int(r["jobs"]) for r in runs
+              if r.get("status") == "ok" and r.get("step_sum_s") not in (None, "") and int(r.get("jobs") or 0)]
+    return max(_median(values), 0.0) if values else 0.0
+
+
+def main(argv=None) -> int:
+    """``python -m netrepro scaling``: regenerate docs/scaling.md (and, with --collect, its tables)."""
+    parser = argparse.ArgumentParser(prog="python -m netrepro scaling", description=main.__doc__)
+    parser.add_argument("--data", type=Path, default=DATA, help="directory of the CSVs (docs/scaling)")
+    parser.add_argument("--out", type=Path, default=DOC, help="the page written (docs/scaling.md)")
+    parser.add_argument("--collect", type=Path, metavar="BUILD",
+                        help="first write the per-rule and per-job tables from this build's sidecars")
+    parser.add_argument("--dry-run", type=Path, help="with --collect: `snakemake -n --forceall ...` output")
+    parser.add_argument("--what", default="", help="with --collect: the build's configuration, in words")
+    parser.add_argument("--default", type=float, default=10.0, help="seconds of a job without a sidecar")
+    args = parser.parse_args(argv)
+    if args.collect:
+        if not args.dry_run:
+            parser.error("--collect needs --dry-run")
+        for path in collect(args.collect, args.dry_run, args.data, args.default, args.what):
+            print(f"wrote {path}")
+    print(f"wrote {write_doc(args.out, args.data)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
