@@ -12,7 +12,10 @@ repeat, the sbatch calls counted in the plugin's own log lines (plain and array 
 jobs Slurm ran (array tasks counted one by one), the wall time of the whole ``snakemake`` command
 (DAG, submissions, polling, the local merge rules), the summed and longest run time Slurm gives
 the run's jobs (``squeue`` ``%M``, whole seconds), the summed step time of the same jobs (their
-provenance sidecars' ``wall_time_s``; the difference is the start-up in each job), the machine's 1-minute load average before and
+provenance sidecars' ``wall_time_s``; the difference is the start-up in each job), the array
+batches the plugin held back (its debug line "Array job collection incomplete": never submitted
+when the run then hangs, upstream issue #473), the profile's ``max-jobs-per-timespan`` (or the
+one given after ``--``), the plugin's version, the machine's 1-minute load average before and
 after, the number of CPUs and the commit. It also times ``--sbatch-probe`` plain ``sbatch``
 calls against the same controller, written to ``sbatch_rate.csv`` beside it: the submission rate
 this controller sustains. Every wait is bounded (``--timeout`` per run: SIGINT, then SIGKILL).
@@ -50,8 +53,8 @@ TARGETS = [
 ]
 MODES = {"arrays": [], "individual": ["--slurm-array-jobs", ""]}
 FIELDS = ["mode", "repeat", "submissions", "array_submissions", "single_submissions", "jobs", "array_tasks",
-          "wall_s", "job_sum_s", "job_max_s", "step_sum_s", "load_before", "load_after", "cpus", "targets", "shards",
-          "status", "commit", "started_utc"]
+          "wall_s", "job_sum_s", "job_max_s", "step_sum_s", "held_back", "rate_limit", "plugin", "load_before",
+          "load_after", "cpus", "targets", "shards", "status", "commit", "started_utc"]
 RATE_FIELDS = ["calls", "seconds", "per_s", "load_before", "cpus", "started_utc"]
 
 SINGLE_RE = re.compile(r"has been submitted with SLURM jobid (\d+)")
@@ -109,6 +112,15 @@ def _commit() -> str:
         return ""
 
 
+def _plugin_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("snakemake-executor-plugin-slurm")
+    except PackageNotFoundError:
+        return ""
+
+
 def _append(path: Path, fields, row):
     new = not path.exists()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -154,8 +166,13 @@ def measure_once(cluster, mode: str, repeat: int, timeout: float, shards: dict |
     env["MPLBACKEND"] = "Agg"
     env["NETREPRO_SLURM_PARTITION"] = PARTITION
     env.pop("NETREPRO_SLURM_ACCOUNT", None)
+    # --verbose: the plugin's debug lines say when it holds an array batch back (upstream issue #473)
     cmd = [sys.executable, "-m", "snakemake", *TARGETS, "--configfile", "config/measure.yaml", "--profile",
-           "workflow/profiles/slurm", "--slurm-init-seconds-before-status-checks", "3", *MODES[mode], *extra]
+           "workflow/profiles/slurm", "--verbose", "--slurm-init-seconds-before-status-checks", "3",
+           *MODES[mode], *extra]
+    profile = yaml.safe_load((work / "workflow/profiles/slurm/config.yaml").read_text())
+    rate = next((b for a, b in zip(extra, list(extra)[1:]) if a == "--max-jobs-per-timespan"),
+                profile.get("max-jobs-per-timespan"))
     known_before = {row[0] for row in cluster.jobs(fields="%i")}
     load_before = os.getloadavg()[0]
     started = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -172,7 +189,9 @@ def measure_once(cluster, mode: str, repeat: int, timeout: float, shards: dict |
            "single_submissions": len(subs["single"]), "jobs": subs["jobs"],
            "array_tasks": subs["jobs"] - len(subs["single"]), "wall_s": round(wall, 1),
            "job_sum_s": sum(times), "job_max_s": max(times, default=0),
-           "step_sum_s": round(sum(steps.values()), 1), "load_before": round(load_before, 2),
+           "step_sum_s": round(sum(steps.values()), 1),
+           "held_back": len(re.findall(r"Array job collection incomplete", log)), "rate_limit": rate,
+           "plugin": _plugin_version(), "load_before": round(load_before, 2),
            "load_after": round(load_after, 2), "cpus": os.cpu_count(), "targets": len(TARGETS),
            "shards": " ".join(f"{k}={v}" for k, v in cfg.get("shards", {}).items()), "status": status,
            "commit": _commit(), "started_utc": started}
