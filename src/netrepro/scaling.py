@@ -32,8 +32,8 @@ import sys
 from pathlib import Path
 
 __all__ = [
-    "rule_work", "write_csv", "read_csv", "parse_dry_run", "job_table", "critical_path", "schedule",
-    "project", "write_doc", "render_doc", "main",
+    "job_times", "rule_work", "write_csv", "read_csv", "parse_dry_run", "job_table", "critical_path", "schedule",
+    "project", "measured_overhead", "collect", "render_doc", "write_doc", "main",
 ]
 
 SIDECAR = ".meta.json"
@@ -42,6 +42,7 @@ DATA = Path("docs/scaling")
 DOC = Path("docs/scaling.md")
 NODES = (1, 8, 64)
 CORES = 2
+TOP_RULES = 20  # rules listed one by one in docs/scaling.md; the CSV has them all
 
 
 # ---- 1. per-rule work ----------------------------------------------------------------------------------
@@ -70,9 +71,22 @@ def _sidecars(build: Path, dirs=SIDECAR_DIRS):
 
 
 def job_times(build: Path, dirs=SIDECAR_DIRS) -> dict:
-    """``{output path (relative to build): (rule, job key, wall_time_s)}`` from a build's sidecars.
+    """The step time of every output of a build, from its provenance sidecars.
 
-    The job key is the sidecar's command (one job, one command, whatever its number of outputs)."""
+    Parameters
+    ----------
+    build : path
+        A build directory (the root of a checkout that ran the workflow).
+    dirs : sequence of str
+        Its subdirectories searched for sidecars ``<output>.meta.json``.
+
+    Returns
+    -------
+    dict
+        ``{output path relative to build: (rule, job key, wall_time_s)}``; the job key is the
+        sidecar's command (one job, one command, whatever its number of outputs). Sidecars without
+        a time or a rule are left out.
+    """
     found = {}
     for path in _sidecars(Path(build), dirs):
         try:
@@ -95,9 +109,9 @@ def rule_work(build: Path, dirs=SIDECAR_DIRS) -> list[dict]:
 
     Parameters
     ----------
-    build
+    build : path
         A build directory (the root of a checkout that ran the workflow).
-    dirs
+    dirs : sequence of str
         Its subdirectories searched for sidecars ``<output>.meta.json``.
 
     Returns
@@ -123,7 +137,22 @@ def rule_work(build: Path, dirs=SIDECAR_DIRS) -> list[dict]:
 
 
 def write_csv(rows: list[dict], path: Path, fields=None) -> Path:
-    """Write ``rows`` as a CSV (columns ``fields`` or the first row's keys)."""
+    """Write ``rows`` as a CSV.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The rows.
+    path : path
+        The file written (its directory is created).
+    fields : list of str, optional
+        The columns, in order; the first row's keys when None.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fields = fields or (list(rows[0]) if rows else [])
@@ -135,7 +164,18 @@ def write_csv(rows: list[dict], path: Path, fields=None) -> Path:
 
 
 def read_csv(path: Path) -> list[dict]:
-    """The rows of a CSV as dicts of strings ([] when the file does not exist)."""
+    """The rows of a CSV.
+
+    Parameters
+    ----------
+    path : path
+        The file.
+
+    Returns
+    -------
+    list of dict
+        One dict of strings per row; ``[]`` when the file does not exist.
+    """
     path = Path(path)
     if not path.is_file():
         return []
@@ -145,7 +185,18 @@ def read_csv(path: Path) -> list[dict]:
 
 # ---- 2. the DAG and its schedule ---------------------------------------------------------------------------
 def parse_dry_run(text: str) -> list[dict]:
-    """Jobs of a dry run: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists)."""
+    """The jobs of a dry run (``snakemake -n``, with ``--forceall`` for every job).
+
+    Parameters
+    ----------
+    text : str
+        The dry run's output.
+
+    Returns
+    -------
+    list of dict
+        One per job: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists).
+    """
     jobs, job = [], None
     for line in text.splitlines():
         head = re.match(r"^(?:local)?rule (\w+):\s*$", line)
@@ -167,11 +218,23 @@ def parse_dry_run(text: str) -> list[dict]:
 
 
 def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
-    """One row per dry-run job: ``jobid, rule, wildcards, seconds, measured, parents``.
+    """One row per dry-run job, with its time and the jobs it waits for.
 
-    ``times`` maps an output path to ``(rule, key, seconds)`` (:func:`job_times`); a job takes the
-    time of its first output that has one, else ``default`` (``measured`` is then 0). ``parents``
-    are the jobids whose outputs it reads, space separated.
+    Parameters
+    ----------
+    jobs : list of dict
+        The jobs of :func:`parse_dry_run`.
+    times : dict
+        ``{output path: (rule, key, seconds)}`` (:func:`job_times`); a job takes the time of its
+        first output that has one.
+    default : float
+        Seconds of a job none of whose outputs has a time.
+
+    Returns
+    -------
+    list of dict
+        ``jobid, rule, wildcards, seconds, measured`` (1 when timed, 0 when ``default``) and
+        ``parents`` (the jobids whose outputs it reads, space separated), by jobid.
     """
     producer = {out: j["jobid"] for j in jobs for out in j["output"]}
     rows = []
@@ -220,14 +283,49 @@ def _remaining(durations: dict, children: dict) -> dict:
 
 
 def critical_path(durations: dict, parents: dict) -> float:
-    """Length of the longest dependency chain (the wall time on unboundedly many slots)."""
+    """The length of the longest dependency chain: the wall time on unboundedly many slots.
+
+    Parameters
+    ----------
+    durations : dict
+        ``{job: seconds}``.
+    parents : dict
+        ``{job: [jobs it waits for]}``.
+
+    Returns
+    -------
+    float
+        The largest sum of durations along a chain of dependencies (0 for no job).
+    """
     rank = _remaining(durations, _children(durations, parents))
     return max(rank.values(), default=0.0)
 
 
 def schedule(durations: dict, parents: dict, slots: int) -> float:
-    """Makespan of a list schedule: a job starts when its parents are done and a slot is free;
-    among ready jobs the one with the longest remaining path goes first (ties: lower job id)."""
+    """The makespan of a list schedule on ``slots`` job slots.
+
+    A job starts when its parents are done and a slot is free; among ready jobs the one with the
+    longest remaining path goes first (ties: the lower job id).
+
+    Parameters
+    ----------
+    durations : dict
+        ``{job: seconds}``.
+    parents : dict
+        ``{job: [jobs it waits for]}``.
+    slots : int
+        Jobs that run at once (at least 1).
+
+    Returns
+    -------
+    float
+        The time the last job ends.
+
+    Raises
+    ------
+    ValueError
+        If ``slots`` is below 1.
+    """
     if slots < 1:
         raise ValueError(f"slots must be at least 1, got {slots}")
     children = _children(durations, parents)
@@ -251,8 +349,26 @@ def schedule(durations: dict, parents: dict, slots: int) -> float:
 
 
 def project(rows: list[dict], nodes=NODES, cores: int = CORES, overhead: float = 0.0) -> list[dict]:
-    """Projected wall time on each node count: ``nodes, slots, total_work_s, critical_path_s,
-    lower_bound_s, list_schedule_s`` (``overhead`` seconds added to every job first)."""
+    """The projected wall time of a job table on each node count.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Jobs with ``jobid``, ``seconds`` and ``parents`` (:func:`job_table`, or its CSV).
+    nodes : sequence of int
+        Node counts.
+    cores : int
+        Job slots per node.
+    overhead : float
+        Seconds added to every job first (its start-up).
+
+    Returns
+    -------
+    list of dict
+        Per node count: ``nodes, slots, total_work_s, critical_path_s``, ``lower_bound_s``
+        (max of the critical path and the work per slot) and ``list_schedule_s``
+        (:func:`schedule`), seconds rounded to 0.1.
+    """
     durations, parents = _graph(rows, overhead)
     total = sum(durations.values())
     critical = critical_path(durations, parents)
@@ -282,7 +398,20 @@ def _median(values):
 
 
 def render_doc(data: Path = DATA) -> str:
-    """The text of ``docs/scaling.md`` from the CSVs in ``data``."""
+    """The text of ``docs/scaling.md``.
+
+    Parameters
+    ----------
+    data : path
+        The directory of the CSVs (``slurm_small.csv``, ``sbatch_rate.csv``, ``array_deadlock.csv``,
+        ``paper_scale_rules.csv``, ``paper_scale_jobs.csv``, ``paper_scale_source.csv``); a missing
+        one leaves its section saying so.
+
+    Returns
+    -------
+    str
+        The page, Markdown.
+    """
     data = Path(data)
     runs = read_csv(data / "slurm_small.csv")
     rates = read_csv(data / "sbatch_rate.csv")
@@ -328,6 +457,19 @@ def render_doc(data: Path = DATA) -> str:
                       _table(summary, list(summary[0])), ""]
     else:
         parts += ["No measured run yet (`python -m tests.slurm.measure`).", ""]
+    deadlock = read_csv(data / "array_deadlock.csv")
+    if deadlock:
+        parts += ["### Job arrays and the scheduler's rate limit (plugin issue #473)", "",
+                  "The plugin submits a rule's jobs as an array only once it holds every ready job of "
+                  "that rule; a smaller batch is set aside (its debug line \"Array job collection "
+                  "incomplete\") and, Snakemake having already counted it as running, never offered again. "
+                  "Snakemake hands jobs over in batches of at most `max-jobs-per-timespan` per second, so "
+                  "a limit below the number of ready shards cuts them and the run waits forever (upstream "
+                  "issue #473, reported for 2.7.1). These runs (more shards per step than the test, "
+                  "`held_back`: batches set aside; `timeout`: the run was stopped at its time limit) are "
+                  "why the profile hands over up to 100 jobs per second:", "",
+                  _table(deadlock, ["plugin", "rate_limit", "shards", "status", "held_back", "submissions",
+                                    "jobs", "wall_s", "load_before", "started_utc"]), ""]
     if rates:
         parts.append("Plain `sbatch --hold` calls timed against the same controller (the submission rate it "
                      "sustains, one caller):")
@@ -340,8 +482,15 @@ def render_doc(data: Path = DATA) -> str:
             f"and Python in the job) of the build in `{src.get('build', '?')}` "
             f"({src.get('what', 'configuration not recorded')}). One row per rule, most work first.")
         total = sum(float(r["total_s"]) for r in rules)
-        parts += ["", _table(rules, ["rule", "jobs", "total_s", "max_job_s"]), "",
-                  f"Total: {total:.1f} s of step time in {sum(int(r['jobs']) for r in rules)} jobs.", ""]
+        shown = rules[:TOP_RULES]
+        rest = rules[TOP_RULES:]
+        if rest:
+            shown = shown + [{"rule": f"({len(rest)} more rules)", "jobs": sum(int(r["jobs"]) for r in rest),
+                              "total_s": f"{sum(float(r['total_s']) for r in rest):.3f}",
+                              "max_job_s": f"{max(float(r['max_job_s']) for r in rest):.3f}"}]
+        parts += ["", _table(shown, ["rule", "jobs", "total_s", "max_job_s"]), "",
+                  f"Total: {total:.1f} s of step time in {sum(int(r['jobs']) for r in rules)} jobs "
+                  f"(every rule: `docs/scaling/paper_scale_rules.csv`).", ""]
     else:
         parts += ["No per-rule table yet.", ""]
 
@@ -363,13 +512,13 @@ def render_doc(data: Path = DATA) -> str:
                 rows.append({"job time": label, **p})
         parts += ["", _table(rows, ["job time", "nodes", "slots", "total_work_s", "critical_path_s",
                                      "lower_bound_s", "list_schedule_s"]), ""]
-        durations, _ = _graph(jobs)
-        longest = max(jobs, key=lambda r: float(r["seconds"]))
+        rate = next((r["rate_limit"] for r in reversed(runs) if r.get("rate_limit")), "100/1s")
+        longest = max((r for r in jobs if r["measured"] == "1") or jobs, key=lambda r: float(r["seconds"]))
         merges = [r for r in jobs if r["rule"] + "_shard" in {x["rule"] for x in jobs}]
         parts.append("## Where the projection stops holding")
         parts += ["",
-                  f"* **The longest single job** ({longest['rule']} {longest['wildcards']}, "
-                  f"{float(longest['seconds']):.1f} s) bounds the wall time from below whatever the node "
+                  f"* **The longest single job** ({longest['rule']} {longest['wildcards']}".rstrip()
+                  + f", {float(longest['seconds']):.1f} s) bounds the wall time from below whatever the node "
                   "count; only more shards of its step (a larger `shards:` count) shorten it, and only for "
                   "shard rules.",
                   f"* **The merge steps run serially**: {len(merges)} merge jobs "
@@ -377,18 +526,20 @@ def render_doc(data: Path = DATA) -> str:
                   f"step's shards and run as one job on the login node (local rules), "
                   f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; they, the figures, the "
                   "notebooks and the report make up the critical path.",
-                  "* **The scheduler's submission rate**: the profile lets Snakemake hand at most 10 jobs per "
-                  "second to the plugin (`max-jobs-per-timespan: 10/1s`), which submits with two threads. "
-                  + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second, so the profile's "
-                     "limit, not the controller, sets the pace: "
+                  f"* **The scheduler's submission rate**: the profile lets Snakemake hand at most {rate} "
+                  "jobs to the plugin (`max-jobs-per-timespan`), which calls sbatch from two threads. "
+                  + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second on an idle "
+                     f"controller, so the {len(jobs)} jobs would take "
+                     f"{len(jobs) / float(rates[-1]['per_s']):.1f} s of submission one by one; "
                      if rates else "")
-                  + f"{len(jobs)} jobs need at least {len(jobs) / 10:.0f} s of submissions without arrays; "
-                  "with arrays a step's shards are one sbatch call. On a shared cluster the queue wait of "
-                  "each job comes on top and is not modelled.",
+                  + "a real cluster's controller is shared and slower, and administrators cap submissions "
+                  "per user, which arrays (one sbatch call per step) keep low. The queue wait of each job "
+                  "on a shared cluster comes on top and is not modelled.",
                   "* **Snakemake's own start-up**: the main process parses the workflow and builds the DAG "
                   "before the first submission, and every Slurm job starts Snakemake and Python again "
-                  "(the `+overhead` rows). With the small configuration's step times of seconds this "
-                  "start-up dominates; it matters less at paper scale, where single steps take minutes.",
+                  "(the `+overhead` rows; measured on a machine loaded by other work, so an upper estimate). "
+                  "Where steps take seconds this start-up dominates; it matters less where single steps "
+                  "take minutes.",
                   "* **Status polling**: the plugin asks squeue at intervals (first after "
                   "`slurm-init-seconds-before-status-checks`, 20 s in the profile, then up to 180 s), so "
                   "each level of the DAG can add up to one polling interval after its jobs finish.",
@@ -399,7 +550,20 @@ def render_doc(data: Path = DATA) -> str:
 
 
 def write_doc(out: Path = DOC, data: Path = DATA) -> Path:
-    """Write ``docs/scaling.md`` (or ``out``) from the CSVs in ``data``."""
+    """Write ``docs/scaling.md`` from the CSVs (:func:`render_doc`).
+
+    Parameters
+    ----------
+    out : path
+        The page written.
+    data : path
+        The directory of the CSVs.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(render_doc(data))
@@ -408,8 +572,32 @@ def write_doc(out: Path = DOC, data: Path = DATA) -> Path:
 
 def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0, what: str = "",
             overhead: float | None = None, overhead_note: str = "") -> list[Path]:
-    """Write ``paper_scale_rules.csv``, ``paper_scale_jobs.csv`` and ``paper_scale_source.csv`` in
-    ``data`` from a build's sidecars and the dry run of the same configuration."""
+    """Write the per-rule and per-job tables of a build, and where they came from.
+
+    Parameters
+    ----------
+    build : path
+        The build directory (read only).
+    dry_run : path
+        The output of ``snakemake -n --forceall`` for the build's configuration and shard counts.
+    data : path
+        The directory written: ``paper_scale_rules.csv`` (:func:`rule_work`),
+        ``paper_scale_jobs.csv`` (:func:`job_table`) and ``paper_scale_source.csv``.
+    default : float
+        Seconds of a job without a sidecar.
+    what : str
+        The build's configuration, in words, for the page.
+    overhead : float, optional
+        Start-up seconds per job; from the measured runs in ``data`` when None
+        (:func:`measured_overhead`).
+    overhead_note : str
+        How ``overhead`` was obtained, for the page.
+
+    Returns
+    -------
+    list of Path
+        The three files written.
+    """
     build, data = Path(build), Path(data)
     times = job_times(build)
     rules = rule_work(build)
@@ -428,15 +616,38 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
 
 
 def measured_overhead(runs: list[dict]) -> float:
-    """Per-job start-up from measured runs: median of ``(job_sum_s - step_sum_s) / jobs`` (0 if none)."""
+    """The start-up of a Slurm job, from measured runs.
+
+    Parameters
+    ----------
+    runs : list of dict
+        Rows of ``slurm_small.csv`` (``status, job_sum_s, step_sum_s, jobs``).
+
+    Returns
+    -------
+    float
+        The median over the successful runs of ``(job_sum_s - step_sum_s) / jobs``: Slurm's run
+        time of a job less the step's own time (0 when no run qualifies, never negative).
+    """
     values = [(float(r["job_sum_s"]) - float(r["step_sum_s"])) / int(r["jobs"]) for r in runs
               if r.get("status") == "ok" and r.get("step_sum_s") not in (None, "") and int(r.get("jobs") or 0)]
     return max(_median(values), 0.0) if values else 0.0
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro scaling``: regenerate docs/scaling.md (and, with --collect, its tables)."""
-    parser = argparse.ArgumentParser(prog="python -m netrepro scaling", description=main.__doc__)
+    """``python -m netrepro scaling``: regenerate docs/scaling.md (and, with --collect, its tables).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``scaling``; ``sys.argv[1:]`` when None.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    parser = argparse.ArgumentParser(prog="python -m netrepro scaling", description=main.__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, default=DATA, help="directory of the CSVs (docs/scaling)")
     parser.add_argument("--out", type=Path, default=DOC, help="the page written (docs/scaling.md)")
     parser.add_argument("--collect", type=Path, metavar="BUILD",
