@@ -112,8 +112,8 @@ def test_rule_work_and_job_table_from_sidecars(tmp_path):
         {"rule": "merge", "jobs": 1, "total_s": 1.25, "max_job_s": 1.25},
     ]
     jobs = scaling.parse_dry_run(DRY)
-    assert [(j["jobid"], j["rule"], j["wildcards"]) for j in jobs] == [
-        (2, "shard", {"shard": "0"}), (3, "shard", {"shard": "1"}), (1, "merge", {})]
+    assert [(j["jobid"], j["rule"], j["wildcards"], j["local"]) for j in jobs] == [
+        (2, "shard", {"shard": "0"}, False), (3, "shard", {"shard": "1"}, False), (1, "merge", {}, True)]
     table = scaling.job_table(jobs, scaling.job_times(tmp_path), default=10.0)
     assert [(r["jobid"], r["seconds"], r["measured"], r["parents"]) for r in table] == [
         (1, 1.25, 1, "2 3"), (2, 2.5, 1, ""), (3, 3.5, 1, "")]
@@ -121,6 +121,8 @@ def test_rule_work_and_job_table_from_sidecars(tmp_path):
     assert {r["seconds"] for r in table} == {10.0} and {r["measured"] for r in table} == {0}
     # merge after the longer shard: 3.5 + 1.25 on 2 slots; 2.5 + 3.5 + 1.25 on one
     assert [p["list_schedule_s"] for p in scaling.project(table_with(tmp_path, jobs), (1, 2), 1)] == [7.2, 4.8]
+    # 1 s of start-up for each Slurm job, none for the local merge: 3.5 + 1 + 1.25 on 2 slots
+    assert [p["list_schedule_s"] for p in scaling.project(table_with(tmp_path, jobs), (2,), 1, 1.0)] == [5.8]
 
 
 def table_with(root, jobs):

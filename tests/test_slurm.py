@@ -195,7 +195,11 @@ def test_sharded_tables_through_slurm_as_job_arrays(cluster, tmp_path_factory):
     # sbatch calls: one per array plus one per plain job (a shard the scheduler handed over alone
     # goes as a plain job)
     assert subs["jobs"] == planned, f"{subs['jobs']} Slurm jobs for {planned} planned:\n{log[-4000:]}"
-    assert subs["calls"] == len(subs["arrays"]) + len(subs["single"]) < planned
+    # Slurm's side of the count: one job id per sbatch call (an array's tasks share their parent's id);
+    # the cluster is this test's own, so every job it knows is this run's
+    sbatch_ids = {job_id.split("_")[0] for job_id in known}
+    assert len(sbatch_ids) == subs["calls"] == len(subs["arrays"]) + len(subs["single"]) < planned, (
+        sorted(sbatch_ids), subs)
     assert {known.get(job_id, (None, None, None))[:2] for job_id in subs["single"]} == {(PARTITION, "COMPLETED")}
     assert not cluster.jobs("PENDING,RUNNING,COMPLETING,CONFIGURING,SUSPENDED")
     # without slurmdbd, sacct cannot answer; the profile makes the plugin ask squeue

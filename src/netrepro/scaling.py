@@ -195,13 +195,14 @@ def parse_dry_run(text: str) -> list[dict]:
     Returns
     -------
     list of dict
-        One per job: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists).
+        One per job: ``rule``, ``local`` (a local rule: it runs in the main Snakemake process, not
+        on the cluster), ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists).
     """
     jobs, job = [], None
     for line in text.splitlines():
-        head = re.match(r"^(?:local)?rule (\w+):\s*$", line)
+        head = re.match(r"^(local)?rule (\w+):\s*$", line)
         if head:
-            job = {"rule": head.group(1), "input": [], "output": [], "wildcards": {}}
+            job = {"rule": head.group(2), "local": bool(head.group(1)), "input": [], "output": [], "wildcards": {}}
             jobs.append(job)
             continue
         field = re.match(r"^\s+(input|output|jobid|wildcards): (.*)$", line)
@@ -233,8 +234,8 @@ def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
     Returns
     -------
     list of dict
-        ``jobid, rule, wildcards, seconds, measured`` (1 when timed, 0 when ``default``) and
-        ``parents`` (the jobids whose outputs it reads, space separated), by jobid.
+        ``jobid, rule, wildcards, seconds, measured`` (1 when timed, 0 when ``default``), ``local``
+        (1 for a local rule) and ``parents`` (the jobids whose outputs it reads, space separated), by jobid.
     """
     producer = {out: j["jobid"] for j in jobs for out in j["output"]}
     rows = []
@@ -244,12 +245,15 @@ def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
         rows.append({"jobid": j["jobid"], "rule": j["rule"],
                      "wildcards": " ".join(f"{k}={v}" for k, v in j["wildcards"].items()),
                      "seconds": round(default if seconds is None else seconds, 3),
-                     "measured": int(seconds is not None), "parents": " ".join(map(str, parents))})
+                     "measured": int(seconds is not None), "local": int(bool(j.get("local"))),
+                     "parents": " ".join(map(str, parents))})
     return rows
 
 
 def _graph(rows: list[dict], overhead: float = 0.0):
-    durations = {int(r["jobid"]): float(r["seconds"]) + overhead for r in rows}
+    # a local rule runs in the main process: no Slurm job, no start-up
+    durations = {int(r["jobid"]): float(r["seconds"]) + (0.0 if str(r.get("local", 0)) == "1" else overhead)
+                 for r in rows}
     parents = {int(r["jobid"]): [int(p) for p in str(r.get("parents") or "").split()] for r in rows}
     return durations, parents
 
@@ -360,7 +364,7 @@ def project(rows: list[dict], nodes=NODES, cores: int = CORES, overhead: float =
     cores : int
         Job slots per node.
     overhead : float
-        Seconds added to every job first (its start-up).
+        Seconds added first to every job but those of local rules (the start-up of a Slurm job).
 
     Returns
     -------
@@ -501,7 +505,7 @@ def render_doc(data: Path = DATA) -> str:
         parts.append(
             f"The DAG is the dry run's ({len(jobs)} jobs, the shard counts of the build above). Each job "
             f"takes its sidecar time; jobs without one ({', '.join(unmeasured) or 'none'}) take "
-            f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job: "
+            f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job that runs on Slurm (not the local rules): "
             f"{src.get('overhead_note', 'the per-job start-up')}. The lower bound is "
             "max(critical path, total work / slots); the list schedule runs the ready job with the "
             "longest remaining path first on 2 slots per node (no schedule is shorter than the bound, and "
@@ -526,9 +530,10 @@ def render_doc(data: Path = DATA) -> str:
                   f"step's shards and run as one job on the login node (local rules), "
                   f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; they, the figures, the "
                   "notebooks and the report make up the critical path.",
-                  f"* **The scheduler's submission rate**: the profile lets Snakemake hand at most {rate} "
-                  "jobs to the plugin (`max-jobs-per-timespan`), which calls sbatch from two threads. "
-                  + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second on an idle "
+                  f"* **The scheduler's submission rate**: the profile lets Snakemake hand at most "
+                  f"{rate.replace('/', ' jobs per ')} to the plugin (`max-jobs-per-timespan: {rate}`), which "
+                  "calls sbatch from two threads. "
+                  + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second on this "
                      f"controller, so the {len(jobs)} jobs would take "
                      f"{len(jobs) / float(rates[-1]['per_s']):.1f} s of submission one by one; "
                      if rates else "")
@@ -611,7 +616,7 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
               {"key": "overhead_note", "value": overhead_note}]
     return [write_csv(rules, data / "paper_scale_rules.csv", ["rule", "jobs", "total_s", "max_job_s"]),
             write_csv(jobs, data / "paper_scale_jobs.csv",
-                      ["jobid", "rule", "wildcards", "seconds", "measured", "parents"]),
+                      ["jobid", "rule", "wildcards", "seconds", "measured", "local", "parents"]),
             write_csv(source, data / "paper_scale_source.csv", ["key", "value"])]
 
 
