@@ -505,7 +505,8 @@ def render_doc(data: Path = DATA) -> str:
         parts.append(
             f"The DAG is the dry run's ({len(jobs)} jobs, the shard counts of the build above). Each job "
             f"takes its sidecar time; jobs without one ({', '.join(unmeasured) or 'none'}) take "
-            f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job that runs on Slurm (not the local rules): "
+            f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job that runs "
+            "on Slurm (not to the local rules): "
             f"{src.get('overhead_note', 'the per-job start-up')}. The lower bound is "
             "max(critical path, total work / slots); the list schedule runs the ready job with the "
             "longest remaining path first on 2 slots per node (no schedule is shorter than the bound, and "
