@@ -396,6 +396,15 @@ def _f(x, digits=1) -> str:
     return f"{float(x):.{digits}f}"
 
 
+def _counts(shards: str) -> str:
+    """``"a=2 b=3"`` -> ``"2/3"``: the shard counts of a measured run, in their order."""
+    return "/".join(part.split("=", 1)[1] for part in str(shards).split() if "=" in part)
+
+
+def _total(shards: str) -> int:
+    return sum(int(c) for c in _counts(shards).split("/") if c.isdigit())
+
+
 def _median(values):
     v = sorted(values)
     return (v[len(v) // 2] + v[(len(v) - 1) // 2]) / 2 if v else float("nan")
@@ -441,16 +450,20 @@ def render_doc(data: Path = DATA) -> str:
             "(each `*_shard` rule one job array); `individual`: `--slurm-array-jobs ''` (one sbatch per job). "
             "`submissions` counts sbatch calls in the plugin's log, `jobs` the Slurm jobs (array tasks one by "
             "one); `wall_s` is the whole `snakemake` command; `job_sum_s`/`job_max_s` are Slurm's run times "
-            "(squeue, whole seconds) of the run's jobs. The load is the machine's 1-minute load average "
-            "before and after (other work shared the machine).")
-        parts += ["", _table(runs, ["mode", "repeat", "status", "submissions", "array_submissions",
-                                    "single_submissions", "jobs", "wall_s", "job_sum_s", "job_max_s",
-                                    "load_before", "load_after", "cpus", "shards"]), ""]
+            "(squeue, whole seconds) of the run's jobs and `step_sum_s` the steps' own time in them "
+            "(sidecars). `shards` are the shard counts of intermittent_monte_carlo / "
+            "intermittent_two_sensor_region / onebit_estimator / hinf_loop_variants / hinf_kalman_best. "
+            "The load is the machine's 1-minute load average before and after (other work shared the "
+            "machine's 2 cores; the test node offers 4 job slots).")
+        parts += ["", _table([{**r, "shards": _counts(r["shards"])} for r in runs],
+                             ["mode", "repeat", "status", "shards", "submissions", "array_submissions",
+                              "single_submissions", "jobs", "wall_s", "job_sum_s", "job_max_s", "step_sum_s",
+                              "load_before", "load_after", "cpus"]), ""]
         summary = []
-        for mode in sorted({r["mode"] for r in runs}):
-            ok = [r for r in runs if r["mode"] == mode and r["status"] == "ok"]
+        for shards, mode in sorted({(r["shards"], r["mode"]) for r in runs}, key=lambda k: (_total(k[0]), k[1])):
+            ok = [r for r in runs if r["mode"] == mode and r["shards"] == shards and r["status"] == "ok"]
             if ok:
-                summary.append({"mode": mode, "runs": len(ok),
+                summary.append({"shards": _counts(shards), "mode": mode, "runs": len(ok),
                                 "submissions (median)": _f(_median([float(r["submissions"]) for r in ok]), 0),
                                 "jobs (median)": _f(_median([float(r["jobs"]) for r in ok]), 0),
                                 "wall_s (median)": _f(_median([float(r["wall_s"]) for r in ok])),
@@ -459,6 +472,12 @@ def render_doc(data: Path = DATA) -> str:
         if summary:
             parts += ["Summary of the successful runs:", "",
                       _table(summary, list(summary[0])), ""]
+            parts.append(
+                "With arrays a step costs one sbatch call whatever its shard count, so the saving grows with "
+                "the shards per step; the wall time on this one node is set by its job slots, the machine's "
+                "load and the per-job start-up (`job_sum_s` against the steps' own `step_sum_s`, from their "
+                "sidecars), not by the submissions.")
+            parts.append("")
     else:
         parts += ["No measured run yet (`python -m tests.slurm.measure`).", ""]
     deadlock = read_csv(data / "array_deadlock.csv")
@@ -472,8 +491,9 @@ def render_doc(data: Path = DATA) -> str:
                   "issue #473, reported for 2.7.1). These runs (more shards per step than the test, "
                   "`held_back`: batches set aside; `timeout`: the run was stopped at its time limit) are "
                   "why the profile hands over up to 100 jobs per second:", "",
-                  _table(deadlock, ["plugin", "rate_limit", "shards", "status", "held_back", "submissions",
-                                    "jobs", "wall_s", "load_before", "started_utc"]), ""]
+                  _table([{**r, "shards": _counts(r["shards"])} for r in deadlock],
+                         ["plugin", "rate_limit", "shards", "status", "held_back", "submissions", "jobs",
+                          "wall_s", "load_before", "started_utc"]), ""]
     if rates:
         parts.append("Plain `sbatch --hold` calls timed against the same controller (the submission rate it "
                      "sustains, one caller):")
