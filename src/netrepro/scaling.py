@@ -32,8 +32,8 @@ import sys
 from pathlib import Path
 
 __all__ = [
-    "job_times", "rule_work", "write_csv", "read_csv", "parse_dry_run", "job_table", "critical_path", "schedule",
-    "project", "measured_overhead", "collect", "render_doc", "write_doc", "main",
+    "job_times", "rule_work", "local_rules", "write_csv", "read_csv", "parse_dry_run", "job_table",
+    "critical_path", "schedule", "project", "measured_overhead", "collect", "render_doc", "write_doc", "main",
 ]
 
 SIDECAR = ".meta.json"
@@ -218,7 +218,45 @@ def parse_dry_run(text: str) -> list[dict]:
     return [j for j in jobs if "jobid" in j]
 
 
-def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
+def local_rules(workflow: Path = Path("."), configfiles=()) -> set[str]:
+    """The rules Snakemake runs in its main process (``localrule: True`` or ``localrules:``).
+
+    A dry run does not tell them apart, so the workflow is loaded with Snakemake's API.
+
+    Parameters
+    ----------
+    workflow : path
+        A checkout of the workflow (its ``Snakefile`` at the root); nothing is run or written.
+    configfiles : sequence of path
+        The configuration files, as for ``--configfile``.
+
+    Returns
+    -------
+    set of str
+        The names of the local rules.
+    """
+    import os
+
+    from snakemake.api import SnakemakeApi
+    from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
+
+    workflow = Path(workflow).resolve()
+    here = Path.cwd()
+    os.chdir(workflow)  # the workflow reads its config and rule files relative to its root
+    try:
+        with SnakemakeApi(OutputSettings()) as api:
+            api_wf = api.workflow(resource_settings=ResourceSettings(),
+                                  config_settings=ConfigSettings(configfiles=[Path(c) for c in configfiles]),
+                                  snakefile=Path("Snakefile"), workdir=workflow)
+            wf = api_wf._workflow
+            # Workflow.is_local without its "everything is local" switch (no cluster executor here)
+            return {rule.name for rule in wf.rules if rule.group is None
+                    and (rule.name in wf._localrules or rule.norun or rule.is_template_engine)}
+    finally:
+        os.chdir(here)
+
+
+def job_table(jobs: list[dict], times: dict, default: float, local=frozenset()) -> list[dict]:
     """One row per dry-run job, with its time and the jobs it waits for.
 
     Parameters
@@ -230,6 +268,9 @@ def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
         first output that has one.
     default : float
         Seconds of a job none of whose outputs has a time.
+    local : set of str
+        Names of local rules (:func:`local_rules`); a job is local when its rule is one of them or
+        the dry run marked it ``localrule``.
 
     Returns
     -------
@@ -245,7 +286,7 @@ def job_table(jobs: list[dict], times: dict, default: float) -> list[dict]:
         rows.append({"jobid": j["jobid"], "rule": j["rule"],
                      "wildcards": " ".join(f"{k}={v}" for k, v in j["wildcards"].items()),
                      "seconds": round(default if seconds is None else seconds, 3),
-                     "measured": int(seconds is not None), "local": int(bool(j.get("local"))),
+                     "measured": int(seconds is not None), "local": int(bool(j.get("local")) or j["rule"] in local),
                      "parents": " ".join(map(str, parents))})
     return rows
 
@@ -438,9 +479,11 @@ def render_doc(data: Path = DATA) -> str:
     parts.append(
         "Measured on this repository's own test cluster (one Slurm node on the development machine, "
         "`tests/slurm/cluster.py`), then projected to larger clusters from the per-job times of a "
-        "paper-scale build. Regenerate the measurements with `python -m tests.slurm.measure` (as root, "
-        "with the Slurm packages), the paper-scale tables with `python -m netrepro scaling --collect BUILD "
-        "--dry-run DRY.log`, and this page with `python -m netrepro scaling`.")
+        "complete build (which one: below). Regenerate the measurements with "
+        "`python -m tests.slurm.measure` (as root, with the Slurm packages), the per-rule and per-job "
+        "tables with `python -m netrepro scaling --collect BUILD --dry-run DRY.log` (DRY.log: "
+        "`snakemake -n --forceall report` with the build's configuration and shard counts), and this page "
+        "with `python -m netrepro scaling`.")
     parts += ["", "## Measured: the small configuration on the local Slurm, with and without job arrays", ""]
     if runs:
         parts.append(
@@ -472,12 +515,24 @@ def render_doc(data: Path = DATA) -> str:
         if summary:
             parts += ["Summary of the successful runs:", "",
                       _table(summary, list(summary[0])), ""]
-            parts.append(
-                "With arrays a step costs one sbatch call whatever its shard count, so the saving grows with "
-                "the shards per step; the wall time on this one node is set by its job slots, the machine's "
-                "load and the per-job start-up (`job_sum_s` against the steps' own `step_sum_s`, from their "
-                "sidecars), not by the submissions.")
-            parts.append("")
+            text = ("With arrays a step costs one sbatch call whatever its shard count, so the saving grows "
+                    "with the shards per step. ")
+            largest = max((r["shards"] for r in runs if r["status"] == "ok"), key=_total)
+            by_mode = {row["mode"]: row for row in summary if row["shards"] == _counts(largest)}
+            if {"arrays", "individual"} <= set(by_mode):
+                a, i = by_mode["arrays"], by_mode["individual"]
+                text += (f"At the largest shard counts measured ({_counts(largest)}) the calls went from "
+                         f"{i['submissions (median)']} to {a['submissions (median)']} and the wall time "
+                         f"from {i['wall_s (median)']} s to {a['wall_s (median)']} s (medians). ")
+                faster = float(a["wall_s (median)"]) < float(i["wall_s (median)"])
+            else:
+                faster = None
+            text += ("The wall time on this one node is set by its job slots, the machine's load and the "
+                     "per-job start-up (`job_sum_s` against the steps' own `step_sum_s`), not by the "
+                     "submissions: arrays save sbatch calls, the scheduler's and the administrators' concern"
+                     + {True: ", and were also faster here.", False: ", and did not make runs faster here.",
+                        None: "."}[faster])
+            parts += [text, ""]
     else:
         parts += ["No measured run yet (`python -m tests.slurm.measure`).", ""]
     deadlock = read_csv(data / "array_deadlock.csv")
@@ -499,7 +554,7 @@ def render_doc(data: Path = DATA) -> str:
                      "sustains, one caller):")
         parts += ["", _table(rates, ["calls", "seconds", "per_s", "load_before", "started_utc"]), ""]
 
-    parts += ["## Paper-scale work per rule", ""]
+    parts += ["## Work per rule", ""]
     if rules:
         parts.append(
             f"From the provenance sidecars (`wall_time_s`: the step itself, without the start of Snakemake "
@@ -530,7 +585,9 @@ def render_doc(data: Path = DATA) -> str:
             f"{src.get('overhead_note', 'the per-job start-up')}. The lower bound is "
             "max(critical path, total work / slots); the list schedule runs the ready job with the "
             "longest remaining path first on 2 slots per node (no schedule is shorter than the bound, and "
-            "a list schedule is at most 2 - 1/slots times the best one).")
+            "a list schedule is at most 2 - 1/slots times the best one). Local rules' jobs (merges, "
+            "figures, notebooks, the report) run on the login node; the model puts them on the nodes' "
+            "slots too, which errs long by their step time.")
         rows = []
         for label, extra in (("step time", 0.0), ("+overhead", overhead)):
             for p in project(jobs, NODES, CORES, extra):
@@ -551,8 +608,8 @@ def render_doc(data: Path = DATA) -> str:
                   f"step's shards and run as one job on the login node (local rules), "
                   f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; they, the figures, the "
                   "notebooks and the report make up the critical path.",
-                  f"* **The scheduler's submission rate**: the profile lets Snakemake hand at most "
-                  f"{rate.replace('/', ' jobs per ')} to the plugin (`max-jobs-per-timespan: {rate}`), which "
+                  "* **The scheduler's submission rate**: the profile lets Snakemake hand jobs to the "
+                  f"plugin at most as fast as `max-jobs-per-timespan: {rate}`, and the plugin "
                   "calls sbatch from two threads. "
                   + (f"Plain sbatch calls here ran at {_f(rates[-1]['per_s'])} per second on this "
                      f"controller, so the {len(jobs)} jobs would take "
@@ -597,7 +654,7 @@ def write_doc(out: Path = DOC, data: Path = DATA) -> Path:
 
 
 def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0, what: str = "",
-            overhead: float | None = None, overhead_note: str = "") -> list[Path]:
+            overhead: float | None = None, overhead_note: str = "", local=frozenset()) -> list[Path]:
     """Write the per-rule and per-job tables of a build, and where they came from.
 
     Parameters
@@ -618,6 +675,8 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
         (:func:`measured_overhead`).
     overhead_note : str
         How ``overhead`` was obtained, for the page.
+    local : set of str
+        Names of local rules (:func:`local_rules`): no Slurm start-up for their jobs.
 
     Returns
     -------
@@ -627,7 +686,7 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
     build, data = Path(build), Path(data)
     times = job_times(build)
     rules = rule_work(build)
-    jobs = job_table(parse_dry_run(Path(dry_run).read_text()), times, default)
+    jobs = job_table(parse_dry_run(Path(dry_run).read_text()), times, default, local)
     if overhead is None:
         overhead = measured_overhead(read_csv(data / "slurm_small.csv"))
         overhead_note = overhead_note or ("the median over the measured Slurm runs of (Slurm run time - step "
@@ -681,11 +740,16 @@ def main(argv=None) -> int:
     parser.add_argument("--dry-run", type=Path, help="with --collect: `snakemake -n --forceall ...` output")
     parser.add_argument("--what", default="", help="with --collect: the build's configuration, in words")
     parser.add_argument("--default", type=float, default=10.0, help="seconds of a job without a sidecar")
+    parser.add_argument("--workflow", type=Path, default=Path("."),
+                        help="with --collect: a checkout of the build's workflow, to find its local rules")
+    parser.add_argument("--configfile", nargs="*", default=["config/config.yaml"],
+                        help="with --collect: the build's configuration files (for the local rules)")
     args = parser.parse_args(argv)
     if args.collect:
         if not args.dry_run:
             parser.error("--collect needs --dry-run")
-        for path in collect(args.collect, args.dry_run, args.data, args.default, args.what):
+        local = local_rules(args.workflow, args.configfile)
+        for path in collect(args.collect, args.dry_run, args.data, args.default, args.what, local=local):
             print(f"wrote {path}")
     print(f"wrote {write_doc(args.out, args.data)}")
     return 0
