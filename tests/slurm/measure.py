@@ -204,6 +204,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--modes", nargs="+", default=list(MODES), choices=list(MODES))
     parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--first-repeat", type=int, default=1, help="number of the first repeat (to add runs)")
     parser.add_argument("--timeout", type=float, default=1500, help="seconds per run before SIGINT")
     parser.add_argument("--out", type=Path, default=ROOT / "docs/scaling/slurm_small.csv")
     parser.add_argument("--sbatch-probe", type=int, default=20, help="plain sbatch calls timed (0: none)")
@@ -224,7 +225,7 @@ def main(argv=None) -> int:
             rate = sbatch_rate(cluster, PARTITION, args.sbatch_probe)
             _append(args.out.with_name("sbatch_rate.csv"), RATE_FIELDS, rate)
             print(f"sbatch: {rate}", flush=True)
-        for repeat in range(1, args.repeats + 1):
+        for repeat in range(args.first_repeat, args.first_repeat + args.repeats):
             for mode in args.modes:
                 row, log = measure_once(cluster, mode, repeat, args.timeout, shards, args.extra)
                 _append(args.out, FIELDS, row)
