@@ -147,3 +147,12 @@ def test_committed_page_is_generated_from_the_committed_tables(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert out.read_text() == (ROOT / "docs/scaling.md").read_text(), (
         "docs/scaling.md is not what its CSVs give: run `python -m netrepro scaling` and commit it")
+
+
+def test_local_rules_are_snakemakes_own():
+    # the merges and the generated figure rules say `localrule: True`; the shards run on the cluster
+    local = scaling.local_rules(ROOT, ["config/test.yaml"])
+    assert {"onebit_estimator", "hinf_loop_variants", "intermittent_monte_carlo", "onebit_notebook"} <= local
+    assert "report" not in local and "hinf_simulate" not in local
+    assert not {name for name in local if name.endswith("_shard")}
+    assert "intermittent_fig1" in local  # a rule the figures.smk loop generates
