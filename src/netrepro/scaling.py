@@ -531,7 +531,12 @@ def render_doc(data: Path = DATA) -> str:
                      "per-job start-up (`job_sum_s` against the steps' own `step_sum_s`), not by the "
                      "submissions: arrays save sbatch calls, the scheduler's and the administrators' concern"
                      + {True: ", and were also faster here.", False: ", and did not make runs faster here.",
-                        None: "."}[faster])
+                        None: "."}[faster]
+                     + " Per job, an array task starts more Snakemake processes than a plain job: from the "
+                     "second task on, snakemake-executor-plugin-slurm-jobstep (0.6.1, read in its code) runs "
+                     "the task's own submission command, itself a Snakemake that then starts the step's, "
+                     "inside the Snakemake of the array's first job; one workflow parse more per task, "
+                     "which shows in `job_sum_s` against `step_sum_s`.")
             parts += [text, ""]
     else:
         parts += ["No measured run yet (`python -m tests.slurm.measure`).", ""]
