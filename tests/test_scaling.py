@@ -156,3 +156,16 @@ def test_local_rules_are_snakemakes_own():
     assert "report" not in local and "hinf_simulate" not in local
     assert not {name for name in local if name.endswith("_shard")}
     assert "intermittent_fig1" in local  # a rule the figures.smk loop generates
+
+
+def test_partial_build_table_and_its_section(tmp_path):
+    build = tmp_path / "build"
+    _sidecar(build, "results/shards/s_0.csv", 7.5, "shard", _command("shard", 0))
+    _sidecar(build, "results/x.csv", 2.0, "x", _command("x", 1))
+    path = scaling.collect_partial(build, tmp_path / "data", "3 of 9 jobs done")
+    rows = scaling.read_csv(path)
+    assert rows[0]["rule"] == "(as of)" and rows[0]["note"].endswith(": 3 of 9 jobs done")
+    assert [(r["rule"], r["jobs"], r["total_s"]) for r in rows[1:]] == [("shard", "1", "7.5"), ("x", "1", "2.0")]
+    page = scaling.render_doc(tmp_path / "data")
+    assert "## The paper-scale build, as far as it had run" in page
+    assert "the longest job so far: shard, 8 s" in page  # 7.5 s, printed to the second

@@ -33,7 +33,8 @@ from pathlib import Path
 
 __all__ = [
     "job_times", "rule_work", "local_rules", "write_csv", "read_csv", "parse_dry_run", "job_table",
-    "critical_path", "schedule", "project", "measured_overhead", "collect", "render_doc", "write_doc", "main",
+    "critical_path", "schedule", "project", "measured_overhead", "collect", "collect_partial", "render_doc",
+    "write_doc", "main",
 ]
 
 SIDECAR = ".meta.json"
@@ -578,6 +579,18 @@ def render_doc(data: Path = DATA) -> str:
     else:
         parts += ["No per-rule table yet.", ""]
 
+    partial = read_csv(data / "paper_scale_partial_rules.csv")
+    if partial:
+        head, rows = partial[0], partial[1:]
+        parts += ["## The paper-scale build, as far as it had run", "",
+                  f"Sidecars of an unfinished paper-scale build ({head['note']}): the rules that had "
+                  "finished, most work first. Not used in the projection below, which needs every job.", "",
+                  _table(rows[:TOP_RULES], ["rule", "jobs", "total_s", "max_job_s"]), ""]
+        if rows:
+            top = max(rows, key=lambda r: float(r["max_job_s"]))
+            parts += [f"{len(rows)} rules, {sum(int(r['jobs']) for r in rows)} jobs, "
+                      f"{sum(float(r['total_s']) for r in rows):.0f} s of step time; the longest job so far: "
+                      f"{top['rule']}, {float(top['max_job_s']):.0f} s.", ""]
     parts += ["## Projected wall time on N nodes of 2 cores", ""]
     if jobs:
         overhead = float(src.get("overhead_s", 0.0) or 0.0)
@@ -705,6 +718,32 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
             write_csv(source, data / "paper_scale_source.csv", ["key", "value"])]
 
 
+def collect_partial(build: Path, data: Path = DATA, what: str = "") -> Path:
+    """Write the per-rule table of a build that has not finished (``paper_scale_partial_rules.csv``).
+
+    Parameters
+    ----------
+    build : path
+        The build directory (read only).
+    data : path
+        The directory written.
+    what : str
+        The build's configuration and state, in words, for the page.
+
+    Returns
+    -------
+    Path
+        The file written; its first data row ``(as of)`` holds ``what`` and the time of collection.
+    """
+    from datetime import datetime, timezone
+
+    stamp = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    rows = [{"rule": "(as of)", "jobs": "", "total_s": "", "max_job_s": "", "note": f"{stamp}: {what}"}]
+    rows += [{**r, "note": ""} for r in rule_work(build)]
+    return write_csv(rows, Path(data) / "paper_scale_partial_rules.csv",
+                     ["rule", "jobs", "total_s", "max_job_s", "note"])
+
+
 def measured_overhead(runs: list[dict]) -> float:
     """The start-up of a Slurm job, from measured runs.
 
@@ -749,7 +788,11 @@ def main(argv=None) -> int:
                         help="with --collect: a checkout of the build's workflow, to find its local rules")
     parser.add_argument("--configfile", nargs="*", default=["config/config.yaml"],
                         help="with --collect: the build's configuration files (for the local rules)")
+    parser.add_argument("--partial", type=Path, metavar="BUILD",
+                        help="write the per-rule table of an unfinished build (paper_scale_partial_rules.csv)")
     args = parser.parse_args(argv)
+    if args.partial:
+        print(f"wrote {collect_partial(args.partial, args.data, args.what)}")
     if args.collect:
         if not args.dry_run:
             parser.error("--collect needs --dry-run")
