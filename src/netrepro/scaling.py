@@ -257,7 +257,7 @@ def local_rules(workflow: Path = Path("."), configfiles=()) -> set[str]:
         os.chdir(here)
 
 
-def job_table(jobs: list[dict], times: dict, default: float, local=frozenset()) -> list[dict]:
+def job_table(jobs: list[dict], times: dict, default: float, local=frozenset(), fallback=None) -> list[dict]:
     """One row per dry-run job, with its time and the jobs it waits for.
 
     Parameters
@@ -272,22 +272,43 @@ def job_table(jobs: list[dict], times: dict, default: float, local=frozenset()) 
     local : set of str
         Names of local rules (:func:`local_rules`); a job is local when its rule is one of them or
         the dry run marked it ``localrule``.
+    fallback : dict, optional
+        Times of another build, like ``times``, for the jobs ``times`` lacks (before ``default``).
+        Before it, a job ``times`` lacks takes the median time of the other jobs of its rule that
+        ``times`` has (source ``rule``).
 
     Returns
     -------
     list of dict
-        ``jobid, rule, wildcards, seconds, measured`` (1 when timed, 0 when ``default``), ``local``
+        ``jobid, rule, wildcards, seconds, measured`` (1 when timed by ``times``, 0 otherwise),
+        ``source`` (``build``, ``rule``, ``fallback`` or ``default``), ``local``
         (1 for a local rule) and ``parents`` (the jobids whose outputs it reads, space separated), by jobid.
     """
     producer = {out: j["jobid"] for j in jobs for out in j["output"]}
+    timed = {}
+    for j in jobs:
+        seconds = next((times[out][2] for out in j["output"] if out in times), None)
+        if seconds is not None:
+            timed.setdefault(j["rule"], []).append(seconds)
     rows = []
     for j in sorted(jobs, key=lambda j: j["jobid"]):
         seconds = next((times[out][2] for out in j["output"] if out in times), None)
+        source = "build"
+        if seconds is None and j["rule"] in timed:
+            # another job of the same rule in the same build, e.g. a shard still running: the shards
+            # of a step split the same work evenly
+            seconds, source = _median(timed[j["rule"]]), "rule"
+        if seconds is None and fallback:
+            seconds = next((fallback[out][2] for out in j["output"] if out in fallback), None)
+            source = "fallback"
+        if seconds is None:
+            source = "default"
         parents = sorted({producer[i] for i in j["input"] if i in producer and producer[i] != j["jobid"]})
         rows.append({"jobid": j["jobid"], "rule": j["rule"],
                      "wildcards": " ".join(f"{k}={v}" for k, v in j["wildcards"].items()),
                      "seconds": round(default if seconds is None else seconds, 3),
-                     "measured": int(seconds is not None), "local": int(bool(j.get("local")) or j["rule"] in local),
+                     "measured": int(source == "build"), "source": source,
+                     "local": int(bool(j.get("local")) or j["rule"] in local),
                      "parents": " ".join(map(str, parents))})
     return rows
 
@@ -438,6 +459,17 @@ def _f(x, digits=1) -> str:
     return f"{float(x):.{digits}f}"
 
 
+def _reshard_note(jobs: list[dict], longest: dict) -> str:
+    """What more shards would make of the longest job, when it is a shard (its step's work split evenly)."""
+    if not longest["rule"].endswith("_shard"):
+        return ""
+    same = [float(r["seconds"]) for r in jobs if r["rule"] == longest["rule"]]
+    work = sum(same)
+    splits = ", ".join(f"{k} shards {work / k:.0f} s" for k in (16, 64) if k > len(same))
+    return (f" Its step's {len(same)} shards hold {work:.0f} s of work; split evenly that is "
+            f"{splits} per shard (shard counts are set per run: `--config 'shards={{...}}'`)." if splits else "")
+
+
 def _counts(shards: str) -> str:
     """``"a=2 b=3"`` -> ``"2/3"``: the shard counts of a measured run, in their order."""
     return "/".join(part.split("=", 1)[1] for part in str(shards).split() if "=" in part)
@@ -564,8 +596,9 @@ def render_doc(data: Path = DATA) -> str:
     if rules:
         parts.append(
             f"From the provenance sidecars (`wall_time_s`: the step itself, without the start of Snakemake "
-            f"and Python in the job) of the build in `{src.get('build', '?')}` "
-            f"({src.get('what', 'configuration not recorded')}). One row per rule, most work first.")
+            f"and Python in the job) of the build in `{src.get('rules_build') or src.get('build', '?')}` "
+            f"({src.get('rules_what') or src.get('what', 'configuration not recorded')}). One row per rule, "
+            "most work first.")
         total = sum(float(r["total_s"]) for r in rules)
         shown = rules[:TOP_RULES]
         rest = rules[TOP_RULES:]
@@ -584,7 +617,7 @@ def render_doc(data: Path = DATA) -> str:
         head, rows = partial[0], partial[1:]
         parts += ["## The paper-scale build, as far as it had run", "",
                   f"Sidecars of an unfinished paper-scale build ({head['note']}): the rules that had "
-                  "finished, most work first. Not used in the projection below, which needs every job.", "",
+                  "finished, most work first. The projection below takes these times for the jobs they cover.", "",
                   _table(rows[:TOP_RULES], ["rule", "jobs", "total_s", "max_job_s"]), ""]
         if rows:
             top = max(rows, key=lambda r: float(r["max_job_s"]))
@@ -594,10 +627,22 @@ def render_doc(data: Path = DATA) -> str:
     parts += ["## Projected wall time on N nodes of 2 cores", ""]
     if jobs:
         overhead = float(src.get("overhead_s", 0.0) or 0.0)
-        unmeasured = sorted({r["rule"] for r in jobs if r["measured"] == "0"})
+        unmeasured = sorted({r["rule"] for r in jobs if r.get("source", "build" if r["measured"] == "1" else
+                                                               "default") == "default"})
+        from_fallback = [r for r in jobs if r.get("source") == "fallback"]
+        text = (f"The DAG is the dry run's ({len(jobs)} jobs) for the configuration and shard counts of "
+                f"`{src.get('build', '?')}`. Each job takes its sidecar time there")
+        from_rule = [r for r in jobs if r.get("source") == "rule"]
+        if from_rule:
+            text += (f"; {len(from_rule)} jobs without one take the median time of their rule's other jobs "
+                     f"there ({', '.join(sorted({r['rule'] for r in from_rule}))}: shards of one step split "
+                     "the same work evenly)")
+        if from_fallback:
+            text += (f"; the {len(from_fallback)} other jobs without one (the build had not finished) take the time "
+                     f"of the same output in `{src.get('fallback')}` (the default configuration: a low "
+                     f"estimate for them)")
         parts.append(
-            f"The DAG is the dry run's ({len(jobs)} jobs, the shard counts of the build above). Each job "
-            f"takes its sidecar time; jobs without one ({', '.join(unmeasured) or 'none'}) take "
+            text + f"; jobs without any ({', '.join(unmeasured) or 'none'}) take "
             f"{src.get('default_s', '?')} s. `+overhead` rows add {overhead:.1f} s to every job that runs "
             "on Slurm (not to the local rules): "
             f"{src.get('overhead_note', 'the per-job start-up')}. The lower bound is "
@@ -620,12 +665,13 @@ def render_doc(data: Path = DATA) -> str:
                   f"* **The longest single job** ({longest['rule']} {longest['wildcards']}".rstrip()
                   + f", {float(longest['seconds']):.1f} s) bounds the wall time from below whatever the node "
                   "count; only more shards of its step (a larger `shards:` count) shorten it, and only for "
-                  "shard rules.",
+                  "shard rules." + _reshard_note(jobs, longest),
                   f"* **The merge steps run serially**: {len(merges)} merge jobs "
                   f"({', '.join(sorted({r['rule'] for r in merges})) or 'none'}) each wait for all of their "
                   f"step's shards and run as one job on the login node (local rules), "
-                  f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; they, the figures, the "
-                  "notebooks and the report make up the critical path.",
+                  f"{sum(float(r['seconds']) for r in merges):.1f} s in total here; each starts only after its "
+                  "step's last shard, and the figures, notebooks and the report queue behind them: "
+                  "the end of the critical path, which no node count shortens.",
                   "* **The scheduler's submission rate**: the profile lets Snakemake hand jobs to the "
                   f"plugin at most as fast as `max-jobs-per-timespan: {rate}`, and the plugin "
                   "calls sbatch from two threads. "
@@ -672,7 +718,8 @@ def write_doc(out: Path = DOC, data: Path = DATA) -> Path:
 
 
 def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0, what: str = "",
-            overhead: float | None = None, overhead_note: str = "", local=frozenset()) -> list[Path]:
+            overhead: float | None = None, overhead_note: str = "", local=frozenset(),
+            fallback: Path | None = None, rules_from: Path | None = None, rules_what: str = "") -> list[Path]:
     """Write the per-rule and per-job tables of a build, and where they came from.
 
     Parameters
@@ -695,6 +742,14 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
         How ``overhead`` was obtained, for the page.
     local : set of str
         Names of local rules (:func:`local_rules`): no Slurm start-up for their jobs.
+    fallback : path, optional
+        Another build whose sidecars time the jobs ``build`` has none for (e.g. the default
+        configuration's, for an unfinished paper-scale build: a low estimate for those jobs).
+    rules_from : path, optional
+        The build whose sidecars give the per-rule table instead of ``build`` (a complete one,
+        when ``build`` has not finished).
+    rules_what : str
+        That build's configuration, in words.
 
     Returns
     -------
@@ -703,18 +758,21 @@ def collect(build: Path, dry_run: Path, data: Path = DATA, default: float = 10.0
     """
     build, data = Path(build), Path(data)
     times = job_times(build)
-    rules = rule_work(build)
-    jobs = job_table(parse_dry_run(Path(dry_run).read_text()), times, default, local)
+    rules = rule_work(Path(rules_from) if rules_from else build)
+    jobs = job_table(parse_dry_run(Path(dry_run).read_text()), times, default, local,
+                     job_times(Path(fallback)) if fallback else None)
     if overhead is None:
         overhead = measured_overhead(read_csv(data / "slurm_small.csv"))
         overhead_note = overhead_note or ("the median over the measured Slurm runs of (Slurm run time - step "
                                           "time) per job: Snakemake, srun and Python starting in the job")
     source = [{"key": "build", "value": str(build)}, {"key": "what", "value": what},
+              {"key": "fallback", "value": str(fallback or "")},
+              {"key": "rules_build", "value": str(rules_from or "")}, {"key": "rules_what", "value": rules_what},
               {"key": "default_s", "value": default}, {"key": "overhead_s", "value": round(overhead, 1)},
               {"key": "overhead_note", "value": overhead_note}]
     return [write_csv(rules, data / "paper_scale_rules.csv", ["rule", "jobs", "total_s", "max_job_s"]),
             write_csv(jobs, data / "paper_scale_jobs.csv",
-                      ["jobid", "rule", "wildcards", "seconds", "measured", "local", "parents"]),
+                      ["jobid", "rule", "wildcards", "seconds", "measured", "source", "local", "parents"]),
             write_csv(source, data / "paper_scale_source.csv", ["key", "value"])]
 
 
@@ -788,6 +846,11 @@ def main(argv=None) -> int:
                         help="with --collect: a checkout of the build's workflow, to find its local rules")
     parser.add_argument("--configfile", nargs="*", default=["config/config.yaml"],
                         help="with --collect: the build's configuration files (for the local rules)")
+    parser.add_argument("--fallback", type=Path, metavar="BUILD",
+                        help="with --collect: time the jobs BUILD has no sidecar for from this build")
+    parser.add_argument("--rules-from", type=Path, metavar="BUILD",
+                        help="with --collect: the per-rule table from this (complete) build instead")
+    parser.add_argument("--rules-what", default="", help="with --rules-from: that build's configuration")
     parser.add_argument("--partial", type=Path, metavar="BUILD",
                         help="write the per-rule table of an unfinished build (paper_scale_partial_rules.csv)")
     args = parser.parse_args(argv)
@@ -797,7 +860,8 @@ def main(argv=None) -> int:
         if not args.dry_run:
             parser.error("--collect needs --dry-run")
         local = local_rules(args.workflow, args.configfile)
-        for path in collect(args.collect, args.dry_run, args.data, args.default, args.what, local=local):
+        for path in collect(args.collect, args.dry_run, args.data, args.default, args.what, local=local,
+                            fallback=args.fallback, rules_from=args.rules_from, rules_what=args.rules_what):
             print(f"wrote {path}")
     print(f"wrote {write_doc(args.out, args.data)}")
     return 0
