@@ -169,3 +169,14 @@ def test_partial_build_table_and_its_section(tmp_path):
     page = scaling.render_doc(tmp_path / "data")
     assert "## The paper-scale build, as far as it had run" in page
     assert "the longest job so far: shard, 8 s" in page  # 7.5 s, printed to the second
+
+
+def test_job_table_sources_in_order():
+    # build times shard 0 only; the other shard takes its rule's median; the merge the fallback's time
+    jobs = scaling.parse_dry_run(DRY)
+    times = {"results/shards/s_0.csv": ("shard", "k0", 4.0)}
+    fallback = {"results/merged.csv": ("merge", "k9", 0.5), "results/shards/s_1.csv": ("shard", "k1", 99.0)}
+    table = scaling.job_table(jobs, times, default=10.0, local={"merge"}, fallback=fallback)
+    assert [(r["jobid"], r["seconds"], r["source"], r["measured"], r["local"]) for r in table] == [
+        (1, 0.5, "fallback", 0, 1), (2, 4.0, "build", 1, 0), (3, 4.0, "rule", 0, 0)]
+    assert [(r["seconds"], r["source"]) for r in scaling.job_table(jobs, {}, 10.0)] == [(10.0, "default")] * 3
