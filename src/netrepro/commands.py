@@ -1,4 +1,4 @@
-"""``python -m netrepro new-paper | check-paper | diff | scale-record``: the commands for people, beside the runner's.
+"""``python -m netrepro new-paper | check-paper | diff | scale-record | scaling``: the commands for people, beside the runner's.
 
 Kept apart from :mod:`netrepro.runner`, which every pipeline job runs: a rule's code inputs are the
 modules its job can reach, so the scaffold, the contract and the diff tool stay out of them (an
@@ -12,7 +12,7 @@ import sys
 
 __all__ = ["COMMANDS", "main"]
 
-COMMANDS = ("new-paper", "check-paper", "diff", "scale-record")
+COMMANDS = ("new-paper", "check-paper", "diff", "scale-record", "scaling")
 
 
 def _new_paper(args) -> int:
@@ -34,8 +34,8 @@ def _new_paper(args) -> int:
 def main(argv=None) -> int:
     """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code.
 
-    ``diff`` and ``scale-record`` are handed to :func:`netrepro.diff.main` and
-    :func:`netrepro.scale.main` (their own parsers); ``new-paper`` writes a
+    ``diff``, ``scale-record`` and ``scaling`` are handed to :func:`netrepro.diff.main`,
+    :func:`netrepro.scale.main` and :func:`netrepro.scaling.main` (their own parsers); ``new-paper`` writes a
     paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`.
 
     Parameters
@@ -58,6 +58,10 @@ def main(argv=None) -> int:
         from .scale import main as scale_main  # its own parser: python -m netrepro scale-record RUN
 
         return scale_main(argv[1:])
+    if argv[:1] == ["scaling"]:
+        from .scaling import main as scaling_main  # its own parser: python -m netrepro scaling [--collect BUILD]
+
+        return scaling_main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m netrepro")
     sub = parser.add_subparsers(dest="command", required=True)
     new = sub.add_parser("new-paper", help="create the working skeleton of a new paper (docs/adding-a-paper.md)")

@@ -9,8 +9,9 @@ each job's rule, wildcards, inputs and outputs), takes each job's time from one 
 * ``--results DIR``: the provenance sidecars (``<output>.meta.json``, ``wall_time_s``) of a
   run, plus ``--overhead`` seconds per job for the start-up a sidecar does not see,
 
-and list-schedules the DAG (longest remaining path first) on N nodes with ``--cores`` job
-slots each. Prints the job count, the summed job time, the critical path and the makespan
+and list-schedules the DAG (longest remaining path first; :func:`netrepro.scaling.schedule`) on
+N nodes with ``--cores`` job slots each. ``python -m netrepro scaling`` does the same from committed
+tables for ``docs/scaling.md``. Prints the job count, the summed job time, the critical path and the makespan
 per N. Jobs without a measured time get ``--default`` seconds (plus the overhead).
 
     python tests/slurm/project.py --dry-run dry.log --results results --overhead 20 --nodes 1 2 4 8 16
@@ -19,35 +20,14 @@ per N. Jobs without a measured time get ``--default`` seconds (plus the overhead
 from __future__ import annotations
 
 import argparse
-import heapq
 import json
 import re
 import sys
 from pathlib import Path
 
+from netrepro.scaling import parse_dry_run, schedule  # the one implementation (tested in tests/test_scaling.py)
+
 __all__ = ["parse_dry_run", "schedule", "main"]
-
-
-def parse_dry_run(text: str) -> list[dict]:
-    """Jobs of a dry run: ``rule``, ``jobid``, ``wildcards`` (dict), ``input`` and ``output`` (lists)."""
-    jobs, job = [], None
-    for line in text.splitlines():
-        head = re.match(r"^(?:local)?rule (\w+):\s*$", line)
-        if head:
-            job = {"rule": head.group(1), "input": [], "output": [], "wildcards": {}}
-            jobs.append(job)
-            continue
-        field = re.match(r"^\s+(input|output|jobid|wildcards): (.*)$", line)
-        if job is None or not field:
-            continue
-        key, value = field.groups()
-        if key == "jobid":
-            job["jobid"] = int(value)
-        elif key == "wildcards":
-            job["wildcards"] = dict(part.split("=", 1) for part in value.split(", ") if "=" in part)
-        else:
-            job[key] = [v.strip() for v in value.split(", ") if v.strip()]
-    return [j for j in jobs if "jobid" in j]
 
 
 def _slurm_key(rule, wildcards):
@@ -55,38 +35,6 @@ def _slurm_key(rule, wildcards):
     if wildcards:
         key += "_wildcards_" + "_".join(str(v) for v in wildcards.values())
     return key
-
-
-def schedule(durations: dict, parents: dict, slots: int) -> float:
-    """Makespan of a list schedule: a job starts when its parents are done and a slot is free."""
-    children = {j: [] for j in durations}
-    for j, ps in parents.items():
-        for p in ps:
-            children[p].append(j)
-    rank = {}
-
-    def remaining(j):  # longest path from the start of j to the end of the workflow
-        if j not in rank:
-            rank[j] = durations[j] + max((remaining(c) for c in children[j]), default=0.0)
-        return rank[j]
-
-    sys.setrecursionlimit(max(10000, 4 * len(durations)))
-    waiting = {j: len(parents.get(j, ())) for j in durations}
-    ready = [(-remaining(j), j) for j, n in waiting.items() if n == 0]
-    heapq.heapify(ready)
-    running, now, free = [], 0.0, slots
-    while ready or running:
-        while ready and free:
-            _, j = heapq.heappop(ready)
-            heapq.heappush(running, (now + durations[j], j))
-            free -= 1
-        now, done = heapq.heappop(running)
-        free += 1
-        for c in children[done]:
-            waiting[c] -= 1
-            if waiting[c] == 0:
-                heapq.heappush(ready, (-remaining(c), c))
-    return now
 
 
 def main(argv=None) -> int:
