@@ -115,3 +115,21 @@ def test_region_closed_form_has_the_kink_exactly():
     below = table[table["lambda1"] < kink]
     assert (below["lambda2c_lower"] > 0).all()
     assert (table[table["lambda1"] > kink]["lambda2c_lower"] == 0).all()
+
+
+def test_monte_carlo_table_is_identical_for_any_shard_count_even_above_the_block_count(tmp_path):
+    from netrepro.engines.montecarlo import n_blocks
+
+    exact = steps.exact_mean_step(SCALAR, {}, {})["table"]
+    write_table(exact, tmp_path / "exact.csv")
+    blocks = n_blocks(SCALAR["n_paths"], SCALAR["block_size"])
+    tables = []
+    for n_shards in (1, 2, blocks + 2):  # more shards than blocks: some shards hold no block
+        paths = []
+        for s in range(n_shards):
+            paths.append(str(tmp_path / f"s{n_shards}_{s}.npz"))
+            steps.monte_carlo_shard_step({**SCALAR, "n_shards": n_shards, "shard": s}, {}, {"sums": paths[-1]})
+        tables.append(steps.monte_carlo_merge_step(SCALAR, {"shards": paths, "exact": str(tmp_path / "exact.csv")},
+                                                   {})["table"])
+    for other in tables[1:]:
+        pd.testing.assert_frame_equal(tables[0], other, check_exact=True)
