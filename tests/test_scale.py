@@ -141,3 +141,8 @@ def test_scale_step_and_panel(tmp_path, two_runs, monkeypatch):
     assert 'data-claim="flips"' in html and 'data-claim="same"' not in html and 'data-claim="moves"' not in html
     assert "30.0 min" in html
     assert scale_html({}) == ""
+
+
+def test_findings_comparison_keeps_both_evidence_texts(two_runs):
+    findings = scale.compare_by_scale(*two_runs, kind="findings").set_index("finding_id")
+    assert findings.loc["F1", "evidence_default"] == "e" and findings.loc["F1", "evidence_paper_scale"] == "e2"

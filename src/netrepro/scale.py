@@ -31,7 +31,8 @@ SCALE_COLUMNS = ["paper", "claim_id", "verdict_default", "verdict_paper_scale", 
                  "value_paper_scale", "changed", "what_changed", "robust_default", "robust_paper_scale",
                  "condition_paper_scale", "note_paper_scale"]
 FINDING_COLUMNS = ["paper", "finding_id", "verdict_default", "verdict_paper_scale", "robust_default",
-                   "robust_paper_scale", "changed", "what_changed", "condition_paper_scale"]
+                   "robust_paper_scale", "changed", "what_changed", "condition_paper_scale", "evidence_default",
+                   "evidence_paper_scale"]
 STALE_COLUMNS = ["paper", "path", "recorded_sha256", "current_sha256"]
 # result folders that hold one table per paper (file stem = slug); the others are results/<slug>/
 _PER_PAPER = ("claims", "findings", "errata", "reconstructions", "evidence")
@@ -90,6 +91,8 @@ def compare_by_scale(default_run, scale_run, kind: str = "claims", rel: float = 
             if kind == "claims":
                 row.update(value_default=_cell(ra, value_col), value_paper_scale=_cell(rb, value_col),
                            note_paper_scale=_cell(rb, "note"))
+            else:
+                row.update(evidence_default=_cell(ra, value_col), evidence_paper_scale=_cell(rb, value_col))
             rows.append(row)
     return pd.DataFrame(rows, columns=SCALE_COLUMNS if kind == "claims" else FINDING_COLUMNS)
 

@@ -295,6 +295,19 @@ def scale_html(scale: dict) -> str:
                   findings=[] if findings is None else changed(findings).to_dict(orient="records"),
                   values_only=int(((claims["changed"].str.lower() != "true")
                                    & claims["what_changed"].str.contains("value")).sum()),
+                  value_rows=_value_only_rows(claims, findings),
                   stale=[] if stale is None else stale.to_dict(orient="records"),
                   stale_papers=[] if stale is None else sorted(set(stale["paper"])),
                   table=scale["table"])
+
+
+def _value_only_rows(claims: pd.DataFrame, findings: pd.DataFrame | None) -> list[dict]:
+    """Claims and findings whose verdict and robust flag stay but whose value or evidence moves with scale."""
+    rows = []
+    for kind, frame, ident in (("claim", claims, "claim_id"), ("finding", findings, "finding_id")):
+        if frame is None:
+            continue
+        moved = frame[(frame["changed"].str.lower() != "true") & frame["what_changed"].str.contains("value")]
+        for _, r in moved.iterrows():
+            rows.append({"kind": kind, "paper": r["paper"], "id": r[ident], "verdict": r["verdict_paper_scale"]})
+    return rows
