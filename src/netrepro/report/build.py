@@ -79,7 +79,7 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
                   scorecard=Markup(scorecard_html(score, papers)), scale=Markup(scale_html(params.get("scale") or {})),
                   sections=[Markup(paper_section(slug, spec, claims[slug], ctx)) for slug, spec in papers.items()],
                   references=Markup(references_html(papers)))
-    sidecars = _run_sidecars(papers)
+    sidecars = _run_sidecars(papers, extra=[p for k, p in (params.get("scale") or {}).items() if k != "reference"])
     workflow_files = _workflow_sources(root)
     configs = list(dict.fromkeys(["config/config.yaml", *configfiles]))
     if outputs.get("crate") and files_dir is not None:
@@ -117,12 +117,13 @@ def _layouts(papers: dict) -> dict:
     return out
 
 
-def _run_sidecars(papers: dict) -> dict[str, dict]:
+def _run_sidecars(papers: dict, extra=()) -> dict[str, dict]:
     """Every result table and figure of the run with its sidecar: the registered outputs of each
-    paper and everything upstream of them (path -> sidecar, in the order found)."""
+    paper, the ``extra`` tables (the comparison by scale), and everything upstream of them
+    (path -> sidecar, in the order found)."""
     seen: set[str] = set()
     found: dict[str, dict] = {}
-    for spec in papers.values():
+    for spec in [*papers.values(), {"tables": list(extra)}]:
         paths = [*spec.get("figures", []), *spec.get("tables", []),
                  *(spec.get(k) for k in ("claims", "errata", "reconstructions", "findings"))]
         for path in paths:
