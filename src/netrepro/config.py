@@ -164,7 +164,25 @@ def _read_schema(path: Path) -> dict:
 
 
 def load_schemas(schema_dir: Path = SCHEMA_DIR):
-    """The top-level schema and a registry resolving ``$ref: <file>.schema.yaml``."""
+    """The top-level schema and a registry resolving ``$ref: <file>.schema.yaml``.
+
+    Parameters
+    ----------
+    schema_dir : pathlib.Path
+        The folder of the schemas (``workflow/schemas`` of this checkout by default).
+
+    Returns
+    -------
+    top : dict
+        ``config.schema.yaml``, with its ``$schema`` set.
+    registry : referencing.Registry
+        Every ``*.schema.yaml`` of the folder under its file name, for ``$ref``.
+
+    Raises
+    ------
+    FileNotFoundError
+        When the folder has no ``config.schema.yaml``.
+    """
     from referencing import Registry, Resource
 
     resources = []
@@ -322,6 +340,18 @@ def shard_count(config: dict, step: str) -> int:
 def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
     """Validate ``config`` (schema, generic checks, then each paper's ``check_config``); return it unchanged.
 
+    Parameters
+    ----------
+    config : dict
+        The merged workflow configuration (every ``--configfile`` and ``--config`` applied).
+    schema_dir : pathlib.Path
+        The folder of the schemas.
+
+    Returns
+    -------
+    dict
+        ``config`` itself.
+
     Raises
     ------
     ConfigError
@@ -378,7 +408,29 @@ def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
 
 # ----------------------------------------------------------------------------- helpers for check_config
 def require_matrix(key: str, value, shape=None, square=False) -> np.ndarray:
-    """A finite 2-D array from ``value``, or a :class:`ConfigError` naming ``key``."""
+    """A finite 2-D array from ``value``, or a :class:`ConfigError` naming ``key``.
+
+    Parameters
+    ----------
+    key : str
+        The configuration key, for the message (e.g. ``"gainsched.system.A"``).
+    value : object
+        The configured value (nested lists, or a scalar, read as a 1 x 1 matrix).
+    shape : tuple of int, optional
+        The shape required, if any.
+    square : bool
+        Whether the matrix must be square.
+
+    Returns
+    -------
+    numpy.ndarray
+        The matrix as floats.
+
+    Raises
+    ------
+    ConfigError
+        When the value is not numeric, not finite, not 2-D, or of the wrong shape.
+    """
     try:
         arr = np.atleast_2d(np.asarray(value, dtype=float))
     except (TypeError, ValueError) as exc:
@@ -393,7 +445,28 @@ def require_matrix(key: str, value, shape=None, square=False) -> np.ndarray:
 
 
 def require_pd(key: str, value, semi: bool = False) -> np.ndarray:
-    """A symmetric positive (semi)definite matrix, or a :class:`ConfigError` naming ``key``."""
+    """A symmetric positive (semi)definite matrix, or a :class:`ConfigError` naming ``key``.
+
+    Parameters
+    ----------
+    key : str
+        The configuration key, for the message.
+    value : object
+        The configured matrix.
+    semi : bool
+        Accept a smallest eigenvalue of 0 (semidefinite) instead of requiring it positive.
+
+    Returns
+    -------
+    numpy.ndarray
+        The matrix as floats.
+
+    Raises
+    ------
+    ConfigError
+        When it is not a finite square matrix, not symmetric (to numpy's ``allclose``), or not
+        positive (semi)definite; the message gives the smallest eigenvalue.
+    """
     arr = require_matrix(key, value, square=True)
     if not np.allclose(arr, arr.T):
         raise ConfigError(f"config key '{key}' = {value!r} must be symmetric")
