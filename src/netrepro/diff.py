@@ -15,7 +15,7 @@ import math
 import sys
 from pathlib import Path
 
-__all__ = ["DIFF_COLUMNS", "tables_of", "diff_runs", "main"]
+__all__ = ["DIFF_COLUMNS", "tables_of", "paired_entries", "same_value", "diff_runs", "main"]
 
 DIFF_COLUMNS = ["paper", "kind", "id", "verdict_a", "verdict_b", "value_a", "value_b", "robust_a", "robust_b",
                 "changed"]
@@ -55,7 +55,21 @@ def tables_of(run: str | Path, kind: str) -> dict:
     raise FileNotFoundError(f"{run}: no {kind} tables (looked in results/{kind}/ and {kind}/)")
 
 
-def _same_value(a: str, b: str, rel: float) -> bool:
+def same_value(a: str, b: str, rel: float) -> bool:
+    """Whether two table cells hold the same value: equal text, or numbers within ``rel`` (NaN equals NaN).
+
+    Parameters
+    ----------
+    a, b : str
+        The cells, as read (strings).
+    rel : float
+        Relative tolerance of two numbers.
+
+    Returns
+    -------
+    bool
+        True when equal as text, or both numbers within ``rel`` of the larger magnitude.
+    """
     if a == b:
         return True
     try:
@@ -65,6 +79,33 @@ def _same_value(a: str, b: str, rel: float) -> bool:
     if math.isnan(x) and math.isnan(y):
         return True
     return abs(x - y) <= rel * max(abs(x), abs(y))
+
+
+def paired_entries(run_a, run_b, kind: str):
+    """Every entry of two runs' ``claims`` or ``findings`` tables, side by side.
+
+    Parameters
+    ----------
+    run_a, run_b : str or pathlib.Path
+        The two runs (see the module docstring).
+    kind : {"claims", "findings"}
+        Which tables.
+
+    Yields
+    ------
+    tuple
+        ``(paper, id, row_a, row_b)`` per entry, in run A's order and then the entries only run B
+        has; a row is a pandas Series of strings, or None where that run lacks the entry.
+    """
+    import pandas as pd
+
+    a, b = tables_of(run_a, kind), tables_of(run_b, kind)
+    for paper in sorted(set(a) | set(b)):
+        ta = a.get(paper, pd.DataFrame(columns=[_ID[kind]])).set_index(_ID[kind])
+        tb = b.get(paper, pd.DataFrame(columns=[_ID[kind]])).set_index(_ID[kind])
+        for entry in [*ta.index, *[i for i in tb.index if i not in ta.index]]:
+            yield (paper, entry, ta.loc[entry] if entry in ta.index else None,
+                   tb.loc[entry] if entry in tb.index else None)
 
 
 def diff_runs(run_a: str | Path, run_b: str | Path, rel: float = 1e-9):
@@ -85,37 +126,30 @@ def diff_runs(run_a: str | Path, run_b: str | Path, rel: float = 1e-9):
     """
     import pandas as pd
 
+    def cell(row, col):
+        return "" if row is None or col not in row.index else str(row[col])
+
     rows = []
     for kind in ("claims", "findings"):
-        a, b = tables_of(run_a, kind), tables_of(run_b, kind)
-        for paper in sorted(set(a) | set(b)):
-            ta = a.get(paper, pd.DataFrame(columns=[_ID[kind]])).set_index(_ID[kind])
-            tb = b.get(paper, pd.DataFrame(columns=[_ID[kind]])).set_index(_ID[kind])
-            for entry in [*ta.index, *[i for i in tb.index if i not in ta.index]]:
-                ra = ta.loc[entry] if entry in ta.index else None
-                rb = tb.loc[entry] if entry in tb.index else None
-
-                def cell(row, col):
-                    return "" if row is None or col not in row.index else str(row[col])
-
-                changed = []
-                if ra is None:
-                    changed.append("added")
-                elif rb is None:
-                    changed.append("removed")
-                else:
-                    if cell(ra, "verdict") != cell(rb, "verdict"):
-                        changed.append("verdict")
-                    if cell(ra, "robust") != cell(rb, "robust"):
-                        changed.append("robust")
-                    if not _same_value(cell(ra, _VALUE[kind]), cell(rb, _VALUE[kind]), rel):
-                        changed.append("value")
-                if changed:
-                    rows.append({"paper": paper, "kind": _KIND[kind], "id": entry,
-                                 "verdict_a": cell(ra, "verdict"), "verdict_b": cell(rb, "verdict"),
-                                 "value_a": cell(ra, _VALUE[kind]), "value_b": cell(rb, _VALUE[kind]),
-                                 "robust_a": cell(ra, "robust"), "robust_b": cell(rb, "robust"),
-                                 "changed": "+".join(changed)})
+        for paper, entry, ra, rb in paired_entries(run_a, run_b, kind):
+            changed = []
+            if ra is None:
+                changed.append("added")
+            elif rb is None:
+                changed.append("removed")
+            else:
+                if cell(ra, "verdict") != cell(rb, "verdict"):
+                    changed.append("verdict")
+                if cell(ra, "robust") != cell(rb, "robust"):
+                    changed.append("robust")
+                if not same_value(cell(ra, _VALUE[kind]), cell(rb, _VALUE[kind]), rel):
+                    changed.append("value")
+            if changed:
+                rows.append({"paper": paper, "kind": _KIND[kind], "id": entry,
+                             "verdict_a": cell(ra, "verdict"), "verdict_b": cell(rb, "verdict"),
+                             "value_a": cell(ra, _VALUE[kind]), "value_b": cell(rb, _VALUE[kind]),
+                             "robust_a": cell(ra, "robust"), "robust_b": cell(rb, "robust"),
+                             "changed": "+".join(changed)})
     return pd.DataFrame(rows, columns=DIFF_COLUMNS)
 
 

@@ -21,7 +21,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from .diff import _same_value, tables_of
+from .diff import paired_entries, same_value, tables_of
 
 __all__ = ["SCALE_COLUMNS", "FINDING_COLUMNS", "STALE_COLUMNS", "compare_by_scale", "code_fingerprint",
            "stale_sources", "record", "scale_step", "main"]
@@ -68,32 +68,26 @@ def compare_by_scale(default_run, scale_run, kind: str = "claims", rel: float = 
 
     ident = {"claims": "claim_id", "findings": "finding_id"}[kind]
     value_col = {"claims": "reproduced_value", "findings": "evidence"}[kind]
-    a, b = tables_of(default_run, kind), tables_of(scale_run, kind)
     rows = []
-    for paper in sorted(set(a) | set(b)):
-        ta = a.get(paper, pd.DataFrame(columns=[ident])).set_index(ident)
-        tb = b.get(paper, pd.DataFrame(columns=[ident])).set_index(ident)
-        for entry in [*ta.index, *[i for i in tb.index if i not in ta.index]]:
-            ra = ta.loc[entry] if entry in ta.index else None
-            rb = tb.loc[entry] if entry in tb.index else None
-            what = []
-            if ra is None or rb is None:
-                what.append("added" if ra is None else "removed")
-            else:
-                what += [c for c in ("verdict", "robust") if _cell(ra, c) != _cell(rb, c)]
-                if not _same_value(_cell(ra, value_col), _cell(rb, value_col), rel):
-                    what.append("value")
-            row = {"paper": paper, ident: entry, "verdict_default": _cell(ra, "verdict"),
-                   "verdict_paper_scale": _cell(rb, "verdict"), "robust_default": _cell(ra, "robust"),
-                   "robust_paper_scale": _cell(rb, "robust"),
-                   "changed": bool(set(what) - {"value"}), "what_changed": "+".join(what),
-                   "condition_paper_scale": _cell(rb, "condition")}
-            if kind == "claims":
-                row.update(value_default=_cell(ra, value_col), value_paper_scale=_cell(rb, value_col),
-                           note_paper_scale=_cell(rb, "note"))
-            else:
-                row.update(evidence_default=_cell(ra, value_col), evidence_paper_scale=_cell(rb, value_col))
-            rows.append(row)
+    for paper, entry, ra, rb in paired_entries(default_run, scale_run, kind):
+        what = []
+        if ra is None or rb is None:
+            what.append("added" if ra is None else "removed")
+        else:
+            what += [c for c in ("verdict", "robust") if _cell(ra, c) != _cell(rb, c)]
+            if not same_value(_cell(ra, value_col), _cell(rb, value_col), rel):
+                what.append("value")
+        row = {"paper": paper, ident: entry, "verdict_default": _cell(ra, "verdict"),
+               "verdict_paper_scale": _cell(rb, "verdict"), "robust_default": _cell(ra, "robust"),
+               "robust_paper_scale": _cell(rb, "robust"),
+               "changed": bool(set(what) - {"value"}), "what_changed": "+".join(what),
+               "condition_paper_scale": _cell(rb, "condition")}
+        if kind == "claims":
+            row.update(value_default=_cell(ra, value_col), value_paper_scale=_cell(rb, value_col),
+                       note_paper_scale=_cell(rb, "note"))
+        else:
+            row.update(evidence_default=_cell(ra, value_col), evidence_paper_scale=_cell(rb, value_col))
+        rows.append(row)
     return pd.DataFrame(rows, columns=SCALE_COLUMNS if kind == "claims" else FINDING_COLUMNS)
 
 
