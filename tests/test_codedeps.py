@@ -41,22 +41,43 @@ def files_of(modules) -> set[str]:
 
 
 @pytest.fixture(scope="module")
-def planned_jobs():
-    """``{rule: (func, code inputs)}`` for every step job of the full workflow, from a dry run."""
+def dry_run_steps():
+    """``[(rule header, shell args)]`` of every step job of the full workflow, from a dry run."""
     proc = subprocess.run(
         [sys.executable, "-m", "snakemake", "-n", "-p", "--forceall", "report"],
         cwd=ROOT, capture_output=True, text=True, timeout=300,
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
-    jobs = {}
+    steps, header = [], None
     for line in (proc.stdout + proc.stderr).splitlines():
-        if "-m netrepro run" not in line:
-            continue
-        args = shlex.split(line[line.index("-m netrepro run"):])
-        func = args[args.index("--func") + 1]
+        named = re.match(r"^(?:local)?rule (\w+):$", line.strip())
+        if named:
+            header = named.group(1)
+        elif "-m netrepro run" in line:
+            steps.append((header, shlex.split(line[line.index("-m netrepro run"):])))
+    return steps
+
+
+@pytest.fixture(scope="module")
+def planned_jobs(dry_run_steps):
+    """``{rule: (func, code inputs)}`` for every step job of the full workflow."""
+    jobs = {}
+    for _, args in dry_run_steps:
         io = json.loads(args[args.index("--io") + 1])
-        jobs[io["rule"]] = (func, set(io["inputs"]["code"]))
+        jobs[args[args.index("--rule") + 1]] = (args[args.index("--func") + 1], set(io["inputs"]["code"]))
     return jobs
+
+
+@pytest.mark.slow  # a dry run of the whole workflow
+def test_every_step_passes_its_own_rule_name(dry_run_steps):
+    # Each rule writes its name twice (``rule NAME:`` and ``params: rule="NAME"``: Snakemake
+    # formats ``{rule}`` only in shell commands, and the lint flags it there). The name the
+    # runner records in every sidecar must be the rule's own, for hand-written and generated rules.
+    assert len({header for header, _ in dry_run_steps}) > 50
+    wrong = [(header, args[args.index("--rule") + 1] if "--rule" in args else None)
+             for header, args in dry_run_steps
+             if "--rule" not in args or args[args.index("--rule") + 1] != header]
+    assert not wrong, f"(rule, name its command passes): {wrong}"
 
 
 def test_closure_matches_bytecode_reading_for_every_module():

@@ -79,14 +79,14 @@ def _command_line(args, cwd, code=None):
 def test_command_line_exit_keeps_outputs_logs_and_exit_code(tmp_path):
     # The command line ends without the interpreter's teardown: the table, its sidecar and the
     # log file must still be complete, and a failing step must still exit with 1.
-    io = json.dumps({"outputs": {"table": "t.csv"}, "rule": "demo"})
-    ok = _command_line(["run", "--func", "tests.test_runner:table_step", "--params", '{"x": 1.5}',
+    io = json.dumps({"outputs": {"table": "t.csv"}})
+    ok = _command_line(["run", "--rule", "demo", "--func", "tests.test_runner:table_step", "--params", '{"x": 1.5}',
                         "--io", io, "--log", "run.log"], tmp_path)
     assert ok.returncode == 0, ok.stderr
     assert pd.read_csv(tmp_path / "t.csv")["x"].tolist() == [1.5, 2.0]
     verify_output(tmp_path / "t.csv")
     assert "rule demo: tests.test_runner:table_step done" in (tmp_path / "run.log").read_text()
-    bad = _command_line(["run", "--func", "tests.test_runner:table_step", "--params", "{}",
+    bad = _command_line(["run", "--rule", "demo", "--func", "tests.test_runner:table_step", "--params", "{}",
                          "--io", io, "--log", "bad.log"], tmp_path)
     assert bad.returncode == 1
     assert "rule demo failed" in (tmp_path / "bad.log").read_text()

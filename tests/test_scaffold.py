@@ -230,6 +230,7 @@ rule kalman_iid_fixed_point_curve:
         CONDA_ENV
     params:
         cfg=as_json(pick(KALMAN_IID_CFG, "system", "curve")),
+        rule="kalman_iid_fixed_point_curve",
         io=io_json,
     shell:
         step("netrepro.papers.kalman_iid.steps:fixed_point_curve_step")
@@ -249,6 +250,7 @@ rule kalman_iid_evidence:
         CONDA_ENV
     params:
         cfg=as_json(pick(KALMAN_IID_CFG, "system")),
+        rule="kalman_iid_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.kalman_iid.evidence:evidence_step")

@@ -273,7 +273,7 @@ def main(argv=None) -> int:
                                      epilog="Also: new-paper, check-paper, diff (netrepro.commands; each with --help).")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run one pipeline step")
-    run.add_argument("--rule", default=None, help="rule name (default: the \"rule\" entry of --io)")
+    run.add_argument("--rule", default="?", help="name of the Snakemake rule (its params.rule), for the sidecars")
     run.add_argument("--func", required=True, help="package.module:function")
     run.add_argument("--params", default="{}", help="JSON object of parameters")
     run.add_argument("--io", default="{}", help='JSON {"inputs": {...}, "outputs": {...}}')
@@ -297,7 +297,6 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.INFO, handlers=handlers, format="%(asctime)s %(name)s %(levelname)s %(message)s")
     logging.captureWarnings(True)
     io = json.loads(args.io)
-    args.rule = args.rule or io.get("rule") or "?"
     try:
         run_step(args.rule, args.func, json.loads(args.params), io.get("inputs", {}), io.get("outputs", {}))
     except Exception:

@@ -68,39 +68,8 @@ def as_json(obj):
 
 
 def io_json(wildcards, input, output):
-    """The job's rule name and named inputs and outputs, as shell-quoted JSON for the runner."""
-    return as_json(
-        {
-            "rule": producing_rule(output[0]),
-            "inputs": dict(input.items()),
-            "outputs": dict(output.items()),
-        }
-    )
-
-
-def producing_rule(path):
-    """Name of the rule that declares the output ``path`` (a wildcard output by its pattern).
-
-    The rules' declared outputs are read once from ``workflow.rules``. Not Snakemake's ``{rule}``
-    in the shell command: ``snakemake --lint`` reports it as a variable from outside the rule
-    (one lint per rule, and the lint test fails); nor a ``rule=`` param, which would be one more
-    line in each of the papers' rules.
-    """
-    if not _PRODUCERS:
-        for each in workflow.rules:
-            for out in each.output:
-                if out.contains_wildcard():
-                    _PATTERNS.append((out.regex(), each.name))
-                else:
-                    _PRODUCERS[str(out)] = each.name
-    path = str(path)
-    if path in _PRODUCERS:
-        return _PRODUCERS[path]
-    return next((name for pattern, name in _PATTERNS if pattern.fullmatch(path)), "?")
-
-
-_PRODUCERS = {}
-_PATTERNS = []
+    """The job's named inputs and outputs, as shell-quoted JSON for the runner."""
+    return as_json({"inputs": dict(input.items()), "outputs": dict(output.items())})
 
 
 def code(func):
@@ -113,13 +82,15 @@ def step(func="{params.func}"):
 
     Rules generated in a loop pass ``params.func`` (their shell command is formatted when the
     job runs, after the loop has moved on); hand-written rules pass the function here. The rule's
-    name reaches the runner in ``params.io`` (:func:`io_json`) and is recorded in every output's
-    sidecar, which is where the report reads it.
+    name is its ``params.rule`` (Snakemake formats ``{rule}`` only in shell commands, and
+    ``snakemake --lint`` reports that as a variable from outside the rule); the runner records it
+    in every output's sidecar, which is where the report reads it. ``tests/test_codedeps.py``
+    checks that each rule's ``params.rule`` is its own name.
     """
     # BLAS threads = the job's threads: with -j2 on 2 cores, more only adds contention
     return (
         "OPENBLAS_NUM_THREADS={threads} OMP_NUM_THREADS={threads} "
-        f"{PYTHON} -m netrepro run --func {func} "
+        f"{PYTHON} -m netrepro run --rule {{params.rule}} --func {func} "
         "--params {params.cfg} --io {params.io} > {log} 2>&1"
     )
 

@@ -29,6 +29,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             params:
                 func=_spec.func,
                 cfg=as_json(_spec.params),
+                rule=_spec.rule,
                 io=io_json,
             shell:
                 step()

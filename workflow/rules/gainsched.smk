@@ -28,6 +28,7 @@ rule gainsched_design:
         cfg=as_json(
             pick(GCFG, "system", "paper_gains", "lmi", "performance", "tuning", "simulation")
         ),
+        rule="gainsched_design",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:design_step")
@@ -51,6 +52,7 @@ rule gainsched_stability:
         runtime=5,
     params:
         cfg=as_json(pick(GCFG, "system", "lmi", "stability", "simulation")),
+        rule="gainsched_stability",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:stability_step")
@@ -74,6 +76,7 @@ rule gainsched_simulation:
         runtime=2,
     params:
         cfg=as_json(pick(GCFG, "system", "simulation", "performance")),
+        rule="gainsched_simulation",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:simulation_step")
@@ -98,6 +101,7 @@ rule gainsched_exact_moments:
         runtime=1,
     params:
         cfg=as_json(pick(GCFG, "system", "simulation")),
+        rule="gainsched_exact_moments",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:exact_moments_step")
@@ -119,6 +123,7 @@ rule gainsched_sensitivity:
         runtime=5,
     params:
         cfg=as_json(pick(GCFG, "system", "paper_gains", "lmi", "sensitivity")),
+        rule="gainsched_sensitivity",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:sensitivity_step")
@@ -140,6 +145,7 @@ rule gainsched_scheduling:
         runtime=5,
     params:
         cfg=as_json(pick(GCFG, "system", "lmi", "performance", "simulation", "scheduling")),
+        rule="gainsched_scheduling",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:scheduling_step")
@@ -160,6 +166,7 @@ rule gainsched_timing:
         runtime=10,
     params:
         cfg=as_json(pick(GCFG, "system", "lmi", "timing")),
+        rule="gainsched_timing",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:timing_step")
@@ -180,6 +187,7 @@ rule gainsched_vertex_lmis:
         runtime=5,
     params:
         cfg=as_json(pick(GCFG, "system", "paper_gains", "lmi", "sensitivity")),
+        rule="gainsched_vertex_lmis",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.steps:vertex_lmi_step")
@@ -224,6 +232,7 @@ rule gainsched_evidence:
                 "evidence",
             )
         ),
+        rule="gainsched_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.gainsched.evidence:evidence_step")

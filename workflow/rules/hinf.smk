@@ -27,6 +27,7 @@ rule hinf_noise_model:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_noise_model",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:noise_model_step")
@@ -43,6 +44,7 @@ rule hinf_consensus_check:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_consensus_check",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:consensus_check_step")
@@ -60,6 +62,7 @@ rule hinf_attenuation:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_attenuation",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:attenuation_step")
@@ -82,6 +85,7 @@ rule hinf_simulate:
         CONDA_ENV
     params:
         cfg=lambda wildcards: as_json({"scenario": wildcards.scenario, "cfg": HCFG}),
+        rule="hinf_simulate",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:simulate_step")
@@ -108,6 +112,7 @@ rule hinf_tables:
         CONDA_ENV
     params:
         cfg=as_json({}),
+        rule="hinf_tables",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:tables_step")
@@ -124,6 +129,7 @@ rule hinf_sensitivity:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_sensitivity",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:sensitivity_step")
@@ -140,6 +146,7 @@ rule hinf_sensitivity_evasive:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_sensitivity_evasive",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:sensitivity_evasive_step")
@@ -160,6 +167,7 @@ rule hinf_paired_evasive:
         runtime=20,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_paired_evasive",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:paired_evasive_step")
@@ -182,6 +190,7 @@ rule hinf_fig2_horizon:
         runtime=20,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_fig2_horizon",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:fig2_horizon_step")
@@ -203,6 +212,7 @@ rule hinf_evader_check:
         runtime=10,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_evader_check",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:evader_check_step")
@@ -223,6 +233,7 @@ rule hinf_fig5_control:
         runtime=10,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_fig5_control",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:fig5_control_step")
@@ -243,6 +254,7 @@ rule hinf_evasive_network:
         runtime=10,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_evasive_network",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:evasive_network_step")
@@ -271,6 +283,7 @@ rule hinf_loop_variants_shard:
                 "n_shards": len(shards("hinf_loop_variants")),
             }
         ),
+        rule="hinf_loop_variants_shard",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:loop_variants_shard_step")
@@ -293,6 +306,7 @@ rule hinf_loop_variants:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_loop_variants",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:loop_variants_merge_step")
@@ -321,6 +335,7 @@ rule hinf_kalman_best_shard:
                 "n_shards": len(shards("hinf_kalman_best")),
             }
         ),
+        rule="hinf_kalman_best_shard",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:kalman_best_shard_step")
@@ -342,6 +357,7 @@ rule hinf_kalman_best:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_kalman_best",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:kalman_best_merge_step")
@@ -361,6 +377,7 @@ rule hinf_network:
         CONDA_ENV
     params:
         cfg=as_json(HCFG),
+        rule="hinf_network",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.steps:network_step")
@@ -406,6 +423,7 @@ rule hinf_evidence:
         runtime=5,
     params:
         cfg=as_json(HCFG),
+        rule="hinf_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.hinf.evidence:evidence_step")

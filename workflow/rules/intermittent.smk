@@ -30,6 +30,7 @@ rule intermittent_exact_mean:
                 "exact_horizon",
             )
         ),
+        rule="intermittent_exact_mean",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:exact_mean_step")
@@ -47,6 +48,7 @@ rule intermittent_stationary_mean:
         CONDA_ENV
     params:
         cfg=as_json(pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets")),
+        rule="intermittent_stationary_mean",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:stationary_mean_step")
@@ -75,6 +77,7 @@ rule intermittent_monte_carlo_shard:
                 "n_shards": len(shards("intermittent_monte_carlo")),
             }
         ),
+        rule="intermittent_monte_carlo_shard",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:monte_carlo_shard_step")
@@ -101,6 +104,7 @@ rule intermittent_monte_carlo:
         runtime=5,
     params:
         cfg=as_json(pick(ICFG.get("scalar", {}), *MC_KEYS)),
+        rule="intermittent_monte_carlo",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:monte_carlo_merge_step")
@@ -122,6 +126,7 @@ rule intermittent_scalar_bounds:
         cfg=as_json(
             pick(ICFG.get("scalar", {}), "a", "R1", "R2", "Ep0", "lambda_offsets", "horizon")
         ),
+        rule="intermittent_scalar_bounds",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:scalar_bounds_step")
@@ -150,6 +155,7 @@ rule intermittent_two_sensor_region_shard:
                 "n_shards": len(shards("intermittent_two_sensor_region")),
             }
         ),
+        rule="intermittent_two_sensor_region_shard",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:two_sensor_region_shard_step")
@@ -171,6 +177,7 @@ rule intermittent_two_sensor_region:
         CONDA_ENV
     params:
         cfg=as_json(pick(ICFG.get("two_sensor", {}), "a", "lambda1_grid", "bisection_tol")),
+        rule="intermittent_two_sensor_region",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:two_sensor_region_merge_step")
@@ -200,6 +207,7 @@ rule intermittent_two_sensor_simulation:
                 "seed",
             )
         ),
+        rule="intermittent_two_sensor_simulation",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:two_sensor_simulation_step")
@@ -222,6 +230,7 @@ rule intermittent_stationary_curve:
                 **ICFG.get("stationary_curve", {}),
             }
         ),
+        rule="intermittent_stationary_curve",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:stationary_curve_step")
@@ -244,6 +253,7 @@ rule intermittent_heavy_tail:
                 **ICFG.get("heavy_tail", {}),
             }
         ),
+        rule="intermittent_heavy_tail",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:heavy_tail_step")
@@ -261,6 +271,7 @@ rule intermittent_region_closed_form:
         CONDA_ENV
     params:
         cfg=as_json(pick(ICFG.get("two_sensor", {}), "a", "n_dense")),
+        rule="intermittent_region_closed_form",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.steps:region_closed_form_step")
@@ -301,6 +312,7 @@ rule intermittent_evidence:
                 "evidence": ICFG.get("evidence", {}),
             }
         ),
+        rule="intermittent_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.intermittent.evidence:evidence_step")

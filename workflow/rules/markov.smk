@@ -18,6 +18,7 @@ rule markov_critical_curves:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "curves")),
+        rule="markov_critical_curves",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:critical_curves_step")
@@ -34,6 +35,7 @@ rule markov_lmi_checks:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "checks")),
+        rule="markov_lmi_checks",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:lmi_checks_step")
@@ -50,6 +52,7 @@ rule markov_tight_variants:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "checks")),
+        rule="markov_tight_variants",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:tight_variants_step")
@@ -66,6 +69,7 @@ rule markov_iid_line:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "iid")),
+        rule="markov_iid_line",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:iid_line_step")
@@ -84,6 +88,7 @@ rule markov_exact_moments:
         mem_mb=1000,
     params:
         cfg=as_json(pick(MCFG, "examples", "exact")),
+        rule="markov_exact_moments",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:exact_moments_step")
@@ -102,6 +107,7 @@ rule markov_stability_map:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "map", "estimator")),
+        rule="markov_stability_map",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:stability_map_step")
@@ -120,6 +126,7 @@ rule markov_sample_paths:
         CONDA_ENV
     params:
         cfg=as_json(pick(MCFG, "examples", "paths", "estimator")),
+        rule="markov_sample_paths",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:sample_paths_step")
@@ -140,6 +147,7 @@ rule markov_expectations:
         mem_mb=1000,
     params:
         cfg=as_json(pick(MCFG, "examples", "paths", "expectations", "estimator")),
+        rule="markov_expectations",
         io=io_json,
     shell:
         step("netrepro.papers.markov.steps:expectations_step")
@@ -184,6 +192,7 @@ rule markov_evidence:
                 "errata_seed",
             )
         ),
+        rule="markov_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.markov.evidence:evidence_step")

@@ -59,6 +59,7 @@ rule onebit_efq:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["efq"])),
+        rule="onebit_efq",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:efq_step")
@@ -79,6 +80,7 @@ rule onebit_ratios:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["ratios"])),
+        rule="onebit_ratios",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:ratios_step")
@@ -99,6 +101,7 @@ rule onebit_lag:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["lag"])),
+        rule="onebit_lag",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:lag_step")
@@ -120,6 +123,7 @@ rule onebit_convergence:
         runtime=10,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["convergence"])),
+        rule="onebit_convergence",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:convergence_step")
@@ -148,6 +152,7 @@ rule onebit_estimator_shard:
                 "n_shards": len(shards("onebit_estimator")),
             }
         ),
+        rule="onebit_estimator_shard",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:estimator_shard_step")
@@ -172,6 +177,7 @@ rule onebit_estimator:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["estimator"])),
+        rule="onebit_estimator",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:estimator_step")
@@ -193,6 +199,7 @@ rule onebit_alpha_scan:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["alpha_scan"])),
+        rule="onebit_alpha_scan",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:alpha_scan_step")
@@ -213,6 +220,7 @@ rule onebit_vector_check:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["vector_check"])),
+        rule="onebit_vector_check",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.steps:vector_check_step")
@@ -245,6 +253,7 @@ rule onebit_evidence:
         runtime=5,
     params:
         cfg=as_json(pick(OCFG, *ONEBIT_KEYS["evidence"])),
+        rule="onebit_evidence",
         io=io_json,
     shell:
         step("netrepro.papers.onebit.evidence:evidence_step")

@@ -30,6 +30,7 @@ rule scale_verdicts:
         CONDA_ENV
     params:
         cfg=as_json({"reference": SCALE_REFERENCE}),
+        rule="scale_verdicts",
         io=io_json,
     shell:
         step("netrepro.scale:scale_step")
@@ -70,6 +71,8 @@ rule report:
                 ),
             }
         ),
+        # a function: the plain string "report" prefixes the outputs' paths, which the lint flags
+        rule=lambda wildcards: "report",
         io=io_json,
     shell:
         step("netrepro.report.build:build_index")

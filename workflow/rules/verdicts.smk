@@ -31,6 +31,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
         params:
             func="netrepro.verdicts:verdicts_step",
             cfg=as_json({"slug": _slug}),
+            rule=f"{_slug}_claims",
             io=io_json,
         shell:
             step()
