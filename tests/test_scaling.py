@@ -97,13 +97,14 @@ def _sidecar(root: Path, output: str, seconds: float, rule: str | None, command:
     path.write_text(json.dumps(meta))
 
 
-def _command(rule, n):
-    return f"python -m netrepro run --func f --params '{{\"n\": {n}}}' --io " + shlex.quote(json.dumps({"rule": rule}))
+def _command(rule, n, old=False):
+    io = shlex.quote(json.dumps({"rule": rule} if old else {}))
+    return f"python -m netrepro run {'' if old else '--rule ' + rule + ' '}--func f --params '{{\"n\": {n}}}' --io {io}"
 
 
 def test_rule_work_and_job_table_from_sidecars(tmp_path):
     _sidecar(tmp_path, "results/shards/s_0.csv", 2.5, "shard", _command("shard", 0))
-    _sidecar(tmp_path, "results/shards/s_1.csv", 3.5, None, _command("shard", 1))  # rule from --io
+    _sidecar(tmp_path, "results/shards/s_1.csv", 3.5, None, _command("shard", 1))  # rule from --rule
     # one merge job, two outputs, the report's copy of one: one job of 1.25 s
     for out in ("results/merged.csv", "results/merged_runs.csv", "report/files/data/results/merged.csv"):
         _sidecar(tmp_path, out, 1.25, "merge", _command("merge", 9))
@@ -180,3 +181,10 @@ def test_job_table_sources_in_order():
     assert [(r["jobid"], r["seconds"], r["source"], r["measured"], r["local"]) for r in table] == [
         (1, 0.5, "fallback", 0, 1), (2, 4.0, "build", 1, 0), (3, 4.0, "rule", 0, 0)]
     assert [(r["seconds"], r["source"]) for r in scaling.job_table(jobs, {}, 10.0)] == [(10.0, "default")] * 3
+
+
+def test_rule_of_a_sidecar_from_its_field_its_command_or_an_older_command():
+    assert scaling._rule_of({"rule": "a", "command": _command("b", 0)}) == "a"
+    assert scaling._rule_of({"command": _command("b", 0)}) == "b"
+    assert scaling._rule_of({"command": _command("c", 0, old=True)}) == "c"  # before --rule existed
+    assert scaling._rule_of({"command": "python -m netrepro run --func f"}) is None

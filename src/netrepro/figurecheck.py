@@ -626,7 +626,7 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
 
 
 # ----------------------------------------------------------------------------- regenerating figures
-_RUN = re.compile(r"-m netrepro run (--func .*)$")
+_RUN = re.compile(r"-m netrepro run (--rule .*)$")
 
 
 def figure_jobs(root=".", targets=None) -> dict[str, dict]:

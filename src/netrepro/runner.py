@@ -1,6 +1,6 @@
 """The one entry point that Snakemake rules call, and the checker of cached results.
 
-``python -m netrepro run --func module:function --params JSON --io JSON``
+``python -m netrepro run --rule NAME --func module:function --params JSON --io JSON``
 runs one step; ``python -m netrepro verify [PATH ...]`` checks every result
 under ``results/`` and ``figures/`` (or the given files and directories)
 against the checksums in their provenance sidecars.

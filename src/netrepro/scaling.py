@@ -48,7 +48,8 @@ TOP_RULES = 20  # rules listed one by one in docs/scaling.md; the CSV has them a
 
 # ---- 1. per-rule work ----------------------------------------------------------------------------------
 def _rule_of(meta: dict) -> str | None:
-    """The rule a sidecar belongs to: its ``rule`` field, else the ``"rule"`` of the command's ``--io``."""
+    """The rule a sidecar belongs to: its ``rule`` field, else the command's ``--rule`` (or, in
+    runs recorded before that flag, the ``"rule"`` of its ``--io`` JSON)."""
     if meta.get("rule"):
         return str(meta["rule"])
     try:
@@ -56,6 +57,8 @@ def _rule_of(meta: dict) -> str | None:
     except ValueError:
         return None
     for flag, value in zip(words, words[1:]):
+        if flag == "--rule":
+            return value
         if flag == "--io":
             try:
                 return json.loads(value).get("rule")
