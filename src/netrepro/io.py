@@ -23,6 +23,16 @@ def load_yaml(text: str):
 
     The workflow parses the papers' claims, errata, findings and figure lists at every start
     (also a no-op rerun), where the pure-Python parser took seconds.
+
+    Parameters
+    ----------
+    text : str
+        YAML text (or an open stream, which PyYAML also accepts).
+
+    Returns
+    -------
+    object
+        The parsed document (dict, list, scalar, or None for an empty document).
     """
     import yaml
 
@@ -33,7 +43,18 @@ def load_yaml(text: str):
 def atomic_path(target: str | os.PathLike):
     """Yield a temporary path next to ``target``; rename it onto ``target`` on success.
 
-    On an exception the temporary file is removed and ``target`` is untouched.
+    The temporary file is fsynced before the rename and the directory after it. On an
+    exception the temporary file is removed and ``target`` is untouched.
+
+    Parameters
+    ----------
+    target : str or os.PathLike
+        The file to write; its parent directories are created.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary file (``.<name>.<random>.part<suffix>`` in the same directory) to write into.
     """
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -66,28 +87,76 @@ def _fsync_dir(directory: Path) -> None:
 
 
 def write_table(frame: pd.DataFrame, path: str | os.PathLike) -> Path:
-    """Write ``frame`` as CSV atomically, with a fixed float format for byte stability."""
+    r"""Write ``frame`` as CSV atomically, with a fixed float format for byte stability.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table; its index is not written, floats as ``%.12g``, lines end in ``\n``.
+    path : str or os.PathLike
+        Destination file (written through :func:`atomic_path`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     with atomic_path(path) as tmp:
         frame.to_csv(tmp, index=False, float_format="%.12g", lineterminator="\n")
     return Path(path)
 
 
 def read_table(path: str | os.PathLike) -> pd.DataFrame:
-    """Read a CSV table written by :func:`write_table`."""
+    """Read a CSV table written by :func:`write_table`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table, with pandas' default type inference.
+    """
     import pandas as pd
 
     return pd.read_csv(path)
 
 
 def write_json(obj, path: str | os.PathLike) -> Path:
-    """Write ``obj`` as sorted, indented JSON atomically."""
+    """Write ``obj`` as sorted, indented JSON atomically.
+
+    Parameters
+    ----------
+    obj : object
+        JSON-serialisable object; other values are written as their ``str``.
+    path : str or os.PathLike
+        Destination file (written through :func:`atomic_path`, with a final newline).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     with atomic_path(path) as tmp:
         tmp.write_text(json.dumps(obj, indent=2, sort_keys=True, default=str) + "\n")
     return Path(path)
 
 
 def sha256_file(path: str | os.PathLike) -> str:
-    """Hex SHA-256 of a file's bytes."""
+    """Hex SHA-256 of a file's bytes.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, read in 1 MiB chunks.
+
+    Returns
+    -------
+    str
+        The 64-character hexadecimal digest.
+    """
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for chunk in iter(lambda: fh.read(1 << 20), b""):

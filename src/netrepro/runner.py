@@ -49,7 +49,23 @@ log = logging.getLogger("netrepro")
 
 
 def resolve(spec: str):
-    """Import ``package.module:function`` and return the function."""
+    """Import ``package.module:function`` and return the function.
+
+    Parameters
+    ----------
+    spec : str
+        ``package.module:function``.
+
+    Returns
+    -------
+    callable
+        The attribute ``function`` of the imported module.
+
+    Raises
+    ------
+    ValueError
+        If ``spec`` has no ``:`` or the module has no such attribute.
+    """
     if ":" not in spec:
         raise ValueError(f"--func must look like 'package.module:function', got {spec!r}")
     module_name, func_name = spec.split(":", 1)
@@ -137,7 +153,38 @@ def _summarize_warnings(caught) -> list[dict]:
 
 
 def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dict) -> None:
-    """Run one step and write its outputs and their provenance sidecars."""
+    """Run one step and write its outputs and their provenance sidecars.
+
+    The step is called as ``func(params, inputs, outputs)``; the tables it returns (output
+    name -> DataFrame, plus an optional ``provenance`` dict) are written to their outputs,
+    then every file output gets its sidecar. Inputs are verified against their sidecars first.
+    On failure no sidecar is left behind and the exception propagates.
+
+    Parameters
+    ----------
+    rule : str
+        Name of the Snakemake rule (recorded in the sidecars).
+    func_spec : str
+        The step, ``package.module:function`` (see :func:`resolve`).
+    params : dict
+        The step's parameters (JSON-compatible).
+    inputs : dict
+        Input name -> path, or a list of paths.
+    outputs : dict
+        Output name -> path.
+
+    Raises
+    ------
+    CorruptOutputError
+        If an input does not match its sidecar, or an input under ``results/`` has none
+        (:class:`~netrepro.errors.UnfinishedOutputError`, a subclass, if its sidecar marks it unfinished).
+    KeyError
+        If the step returns a table that is not one of the rule's outputs.
+    TypeError
+        If a returned table is not a DataFrame.
+    FileNotFoundError
+        If an output was not written.
+    """
     func = resolve(func_spec)
     inputs = {k: _as_paths(v) for k, v in inputs.items()}
     outputs = {k: Path(v) for k, v in outputs.items()}
@@ -215,14 +262,32 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
 def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, stream=None) -> int:
     """``python -m netrepro verify``: report every result that does not match its sidecar.
 
-    Returns 0 when every checked file verifies, 1 otherwise. Reported but harmless: leftover
-    temporary files, sidecars whose table is missing (Snakemake deletes the outputs of a job
-    it interrupts, which can happen after the runner wrote both; nothing can read a missing
-    table, and the next ``snakemake`` run rebuilds it), and outputs marked unfinished (their job
-    is running or was killed; no step reads them and Snakemake reruns the job), except with
-    ``inputs_only``: a rule must not start on an unfinished input. With ``remove_corrupt``, corrupt files
-    and their sidecars (and leftover temporary files and orphaned sidecars) are deleted, so the
-    next ``snakemake`` run rebuilds them.
+    Reported but harmless: leftover temporary files, sidecars whose table is missing
+    (Snakemake deletes the outputs of a job it interrupts, which can happen after the runner
+    wrote both; nothing can read a missing table, and the next ``snakemake`` run rebuilds it),
+    and outputs marked unfinished (their job is running or was killed; no step reads them and
+    Snakemake reruns the job), except with ``inputs_only``: a rule must not start on an
+    unfinished input.
+
+    Parameters
+    ----------
+    paths : list of str or Path
+        Files or directories to check; empty: ``results/`` and ``figures/`` (those that exist).
+    inputs_only : bool, default False
+        Check only the given files that have a sidecar (a rule's inputs); unfinished is then an error.
+    remove_corrupt : bool, default False
+        Delete corrupt files, files without a sidecar and unfinished outputs, with their sidecars
+        (and leftover temporary files and orphaned sidecars), so the next ``snakemake`` run
+        rebuilds them.
+    quiet : bool, default False
+        Print only problems and the summary.
+    stream : file-like, optional
+        Where to print (default ``sys.stdout``).
+
+    Returns
+    -------
+    int
+        0 when every checked file verifies (always 0 with ``remove_corrupt``), 1 otherwise.
     """
     stream = stream or sys.stdout
     if not paths:
@@ -269,6 +334,18 @@ def exit_process(code: int) -> None:
 
 
 def main(argv=None) -> int:
+    """``python -m netrepro {run,verify}``: run one pipeline step, or verify results against their sidecars.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        Exit status: 0, or 1 when the step failed (logged) or verification found a problem.
+    """
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0],
                                      epilog="Also: new-paper, check-paper, diff (netrepro.commands; each with --help).")
     sub = parser.add_subparsers(dest="command", required=True)

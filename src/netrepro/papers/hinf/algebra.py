@@ -51,7 +51,9 @@ def kernel_operand(a, shape):
     Parameters
     ----------
     a : array_like
+        The operand (a scalar, or an array broadcastable to ``shape``).
     shape : tuple of int
+        The shape the compiled kernel expects.
 
     Returns
     -------
@@ -70,6 +72,7 @@ def det2(a):
     Parameters
     ----------
     a : ndarray, shape ``(..., 2, 2)``
+        A stack of 2x2 matrices.
 
     Returns
     -------
@@ -85,6 +88,7 @@ def inv2(a):
     Parameters
     ----------
     a : ndarray, shape ``(..., 2, 2)``
+        A stack of 2x2 matrices, each nonsingular (a singular one gives inf or nan, not an error).
 
     Returns
     -------
@@ -106,6 +110,7 @@ def sym2(a):
     Parameters
     ----------
     a : ndarray, shape ``(..., n, n)``
+        A stack of square matrices.
 
     Returns
     -------
@@ -121,6 +126,7 @@ def min_eig2(a):
     Parameters
     ----------
     a : ndarray, shape ``(..., 2, 2)``
+        A stack of 2x2 matrices (need not be symmetric: their symmetric part is used).
 
     Returns
     -------

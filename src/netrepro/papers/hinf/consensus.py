@@ -26,6 +26,7 @@ def adjacency(positions, radius: float):
     Parameters
     ----------
     positions : ndarray, shape ``(..., N, 2)``
+        Agent positions ``p_i`` in the plane (same length unit as ``radius``), a stack of runs allowed.
     radius : float
         Communication radius ``r``.
 
@@ -48,10 +49,12 @@ def laplacian(adj):
     Parameters
     ----------
     adj : ndarray, shape ``(..., N, N)``
+        Adjacency (link weights, e.g. the 0/1 links of eq (25) from :func:`adjacency`), zero diagonal.
 
     Returns
     -------
     ndarray, shape ``(..., N, N)``
+        The Laplacian: each agent's degree on the diagonal, ``-adj`` off it.
     """
     deg = adj.sum(-1)
     lap = -adj.copy()
@@ -151,6 +154,7 @@ def consensus_h_max(lap, gamma_c, K_p, K_i, h_hi: float = 10.0, tol: float = 1e-
     Parameters
     ----------
     lap : ndarray, shape ``(N, N)``
+        Graph Laplacian of the fixed communication graph.
     gamma_c, K_p, K_i : float
         Parameters of eq (5).
     h_hi : float
@@ -194,6 +198,7 @@ def run_pi_consensus(u, lap, gamma_c, h, K_p, K_i, n_iter: int, v0=None):
     u : ndarray, shape ``(N, d)``
         Constant inputs.
     lap : ndarray, shape ``(N, N)``
+        Graph Laplacian of the fixed communication graph.
     gamma_c, h, K_p, K_i : float
         Parameters of eq (5).
     n_iter : int

@@ -32,13 +32,18 @@ def overbounding_ellipse(A, b, rho):
     Parameters
     ----------
     A : ndarray, shape ``(..., 2, 2)``
+        Symmetric positive definite matrices ``A > 0``.
     b : ndarray, shape ``(..., 2)``
+        Vectors ``b``.
     rho : ndarray, shape ``(...)``
+        Scalars ``rho``.
 
     Returns
     -------
     q : ndarray, shape ``(..., 2)``
+        Centre ``q = A^{-1} b`` of the ellipse.
     Q : ndarray, shape ``(..., 2, 2)``
+        Shape matrix ``[1 + b^T A^{-1} b - rho] A^{-1}`` of the ellipse.
     """
     Ai = inv2(A)
     q = (Ai @ b[..., None])[..., 0]
@@ -79,6 +84,7 @@ def min_fused_trace(Minv, n_iter: int = 60, step: float = 1.0):
     Parameters
     ----------
     Minv : ndarray, shape ``(..., N, 2, 2)``
+        The agents' informations ``M_j^{-1}`` (inverse measurement covariances, eq (3)) at a (candidate) target position.
     n_iter : int
         Mirror-descent iterations.
     step : float
@@ -189,6 +195,7 @@ def min_fused_trace_pairwise(Minv, n_iter: int = 60, lam0=None):
     Parameters
     ----------
     Minv : ndarray, shape ``(..., N, 2, 2)``
+        The agents' informations ``M_j^{-1}`` (inverse measurement covariances, eq (3)) at a (candidate) target position.
     n_iter : int
         Iterations.
     lam0 : ndarray, shape ``(..., N)``, optional
@@ -199,6 +206,7 @@ def min_fused_trace_pairwise(Minv, n_iter: int = 60, lam0=None):
     trace : ndarray, shape ``(...)``
         ``f`` at the final weights (non-increasing over the iterations).
     lam : ndarray, shape ``(..., N)``
+        The final weights.
     """
     Minv = np.asarray(Minv, dtype=float)
     n, lam, lead = _start_weights(Minv, lam0)
@@ -495,6 +503,7 @@ def fused_trace_bounds(Minv, lam):
     Parameters
     ----------
     Minv : ndarray, shape ``(..., N, 2, 2)``
+        The agents' informations ``M_j^{-1}`` (inverse measurement covariances, eq (3)) at a (candidate) target position.
     lam : ndarray, shape ``(..., N)``
         Weights on the simplex.
 
@@ -527,9 +536,9 @@ def evader_decisions(x_t, agents, model: NoiseModel, step: float, n_headings: in
                      solver: str = "mirror"):
     """The evader's choice among its candidate steps (eq (19)) with a certificate of the inner minimisation.
 
-    For each decision, every candidate's ``min_lambda tr Q_fused`` is bracketed by
-    :func:`min_fused_trace` (upper bound: the best value found in ``n_iter`` iterations) and
-    :func:`fused_trace_bounds` (lower bound). The choice (largest upper bound, as
+    For each decision, every candidate's ``min_lambda tr Q_fused`` is bracketed by the inner
+    ``solver`` (upper bound: the value it returns; the iterative solvers after ``n_iter`` iterations) and
+    :func:`fused_trace_bounds` at the solver's weights (lower bound). The choice (largest upper bound, as
     :func:`evader_move`) is certified when its lower bound is at least every other candidate's
     upper bound: then no amount of further iteration can change it.
 
@@ -538,9 +547,13 @@ def evader_decisions(x_t, agents, model: NoiseModel, step: float, n_headings: in
     x_t : ndarray, shape ``(D, 2)``
         Target positions of ``D`` decisions.
     agents : ndarray, shape ``(D, N, 2)``
+        The ``N`` agents' positions at each decision.
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
     step : float
+        Step length of the target (the candidates' distance from ``x_t``).
     n_headings : int
+        Number of equally spaced headings (candidates besides standing still).
     n_iter : int
         Iterations of the inner solver.
     solver : {"mirror", "pairwise", "exact"}
@@ -589,7 +602,9 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     x_t : ndarray, shape ``(R, 2)``
         Target positions of ``R`` runs.
     agents : ndarray, shape ``(R, N, 2)``
+        The ``N`` agents' positions in each run.
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
     step : float
         Step length.
     n_headings : int
@@ -603,6 +618,7 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     Returns
     -------
     x_next : ndarray, shape ``(R, 2)``
+        The chosen next target positions.
     value : ndarray, shape ``(R,)``
         The maximised ``tr Q_fused``.
     """

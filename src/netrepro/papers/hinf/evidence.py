@@ -67,7 +67,25 @@ def _get(cfg, dotted):
 
 
 def sensitivity_text(sens: pd.DataFrame, parameter: str) -> str:
-    """A sentence summarising the sweep of ``parameter`` in ``sensitivity.csv``."""
+    """A sentence summarising the sweep of ``parameter`` in ``sensitivity.csv``.
+
+    Per scenario: for ``Gamma``, ``v_max`` and ``gamma_evasive`` the decentralized error and settling
+    step at each value, for the other parameters the ratio decentralized / local error; then the
+    values without a result (the filter does not exist or the error is not finite).
+
+    Parameters
+    ----------
+    sens : pandas.DataFrame
+        The sweep rows (``sensitivity.csv`` and/or ``sensitivity_evasive.csv``).
+    parameter : str
+        The swept parameter (the ``parameter`` column), e.g. ``"gamma"`` or ``"K_i"``.
+
+    Returns
+    -------
+    str
+        ``"sweep (results/hinf/sensitivity.csv): <scenario> [...]; ..."``, or ``""`` if ``sens`` has
+        no row of ``parameter``.
+    """
     sub = sens[sens["parameter"] == parameter]
     if sub.empty:
         return ""
@@ -92,7 +110,23 @@ def _solver_label(solver: str, n_iter) -> str:
 
 
 def evader_text(ev: pd.DataFrame) -> str:
-    """A sentence summarising ``evader_convergence.csv``: is the evader's inner minimisation converged?"""
+    """A sentence summarising ``evader_convergence.csv``: is the evader's inner minimisation converged?
+
+    One clause per solver row (certified fraction, agreement with the certified reference, objective
+    lost); then, for the configured solver, "converged" if at least 99 % of its choices are certified
+    (else "NOT converged"), with its median duality gap against the median margin between the best
+    and second-best candidate steps.
+
+    Parameters
+    ----------
+    ev : pandas.DataFrame
+        The table ``results/hinf/evader_convergence.csv`` (:func:`.steps.evader_check_step`).
+
+    Returns
+    -------
+    str
+        The sentence, starting ``"convergence check (results/hinf/evader_convergence.csv): "``.
+    """
     parts = [f"{_solver_label(r.solver, r.n_iter)}{' (configured)' if r.configured else ''}: choice certified in "
              f"{r.certified_fraction:.1%} of {r.decisions} decisions, same as the certified reference in "
              f"{r.same_as_reference:.1%}, objective lost mean {r.mean_loss:.2g} / max {r.max_loss:.2g} "
@@ -548,6 +582,26 @@ def evidence_step(params, inputs, outputs):
     (consensus check, attenuation and filter checks, summary, paired, per-run pieces of the
     stationary-target scenarios, errors, trajectories, connectivity, sensitivity sweeps, paired
     evasive comparison, per-agent table, consensus modes, evader checks).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration section (``claims``, ``consensus``, ``filter``, ``scenarios``,
+        ``loop_variants`` and the reconstructed settings are read).
+    inputs : dict
+        ``claims`` and the result tables named above (``consensus``, ``attenuation``, ``checks``,
+        ``summary``, ``paired``, ``errors``, ``trajectories``, ``per_run_static_fixed``,
+        ``per_run_static_mobile``, ``connectivity``, ``sensitivity``, ``sensitivity_evasive``,
+        ``paired_evasive``, ``per_agent``, ``modes``, ``evader``, ``evader_paired``,
+        ``fig5_control``, ``evasive_network``, ``loop_variants``, ``kalman_best``).
+    outputs : dict
+        ``table``: ``results/evidence/hinf.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: the evidence rows (columns ``quantity, variant, value, note``,
+        :func:`netrepro.verdicts.evidence_frame`).
     """
     cfg = params
     z_sig = float(cfg["claims"]["z_significant"])

@@ -108,9 +108,13 @@ def hinf_update_kernel(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar, xpred_g
     Parameters
     ----------
     xhat, y_info : ndarray ``(B, 2)``
+        Previous estimates ``xhat_{k-1}`` and the informations ``C^T M^{-1} y`` of the ``B`` filters.
     Sigma, S : ndarray ``(B, 2, 2)``
+        Previous ``Sigma_{k-1}`` and ``C^T M^{-1} C`` of the ``B`` filters.
     A, BWB, Lbar : ndarray ``(2, 2)``
+        Target dynamics ``A``, ``B W B^T`` and ``Lbar = L^T Q L``.
     gamma_inv2 : float
+        ``gamma^{-2}`` (0: the Kalman filter).
     xpred_gemv : bool
         ``xhat @ A.T`` is a ``dgemv`` in numpy (one row per stack), else a ``dgemm``.
     xnew : ndarray ``(B, 2)``
@@ -160,11 +164,15 @@ def exists_kernel(S_seq, Sigma0, A, BWB, gamma_inv2, Lbar):
     S_seq : ndarray ``(K, B, 2, 2)``
         ``C^T M_k^{-1} C`` of ``B`` filters at each step.
     Sigma0, A, BWB, Lbar : ndarray ``(2, 2)``
+        Initial ``Sigma_0`` (every filter's), target dynamics ``A``, ``B W B^T`` and ``Lbar = L^T Q L``.
     gamma_inv2 : float
+        ``gamma^{-2}`` of the attenuation level tested.
 
     Returns
     -------
     bool
+        True iff ``Sigma_k^{-1} = Delta_k^{-1} + S_k - gamma^{-2} L^T Q L`` has a positive smallest
+        eigenvalue at every step of every filter.
     """
     gL00, gL01, gL10, gL11 = gamma_inv2 * Lbar[0, 0], gamma_inv2 * Lbar[0, 1], gamma_inv2 * Lbar[1, 0], gamma_inv2 * Lbar[1, 1]
     for b in range(S_seq.shape[1]):
@@ -187,8 +195,11 @@ def sigma_gradient_kernel(Delta, dDelta, S, dS, gamma_inv2, Lbar, Sigma, dSigma)
     Parameters
     ----------
     Delta, dDelta, S, dS : ndarray ``(B, 2, 2)``
+        ``Delta_k``, ``Delta_k^z`` (eq (14)), ``C^T M^{-1} C`` and ``C^T (dM^{-1}/dz) C`` of the ``B`` filters.
     gamma_inv2 : float
+        ``gamma^{-2}``.
     Lbar : ndarray ``(2, 2)``
+        ``L^T Q L``.
     Sigma, dSigma : ndarray ``(B, 2, 2)``
         Receive ``Sigma_k`` and ``Sigma_k^z``.
     """
@@ -229,6 +240,7 @@ def noise_information_kernel(c, s, rinv_r, rinv_b, d_r, d_b, derivatives, Minv, 
     c, s, rinv_r, rinv_b, d_r, d_b : ndarray ``(B,)``
         ``cos theta``, ``sin theta``, the diagonals of ``R^{-1}`` and of ``R^{-2} diag(1, alpha) g``.
     derivatives : bool
+        Also compute the derivatives (else ``dMinv_dr`` and ``dMinv_dtheta`` are not written).
     Minv, dMinv_dr, dMinv_dtheta : ndarray ``(B, 2, 2)``
         Receive ``M^{-1}`` and (with ``derivatives``) its derivatives.
     """

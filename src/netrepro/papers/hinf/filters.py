@@ -156,13 +156,17 @@ def decentralized_update(xhat, Sigma, y_tilde, C_tilde, n_agents: int, A, BWB, g
     Parameters
     ----------
     xhat, Sigma : ndarray, shapes ``(..., 2)``, ``(..., 2, 2)``
+        The agent's previous estimate ``xhat_{k-1}`` and ``Sigma_{k-1}``.
     y_tilde, C_tilde : ndarray, shapes ``(..., 2)``, ``(..., 2, 2)``
         Consensus estimates of the averages (8) and (7).
     n_agents : int
         ``N``.
     A, BWB, Lbar : ndarray, shape ``(2, 2)``
+        Target dynamics ``A``, ``B W B^T`` and ``Lbar = L^T Q L``.
     gamma_inv2 : float
+        ``gamma^{-2}`` (0: the Kalman filter).
     check : bool
+        Raise :class:`FilterDoesNotExist` when ``Sigma_k^{-1}`` is not positive definite.
 
     Returns
     -------
@@ -191,6 +195,7 @@ def kalman_update(xhat, P, y, M, A, BWB):
     M : ndarray, shape ``(..., N, 2, 2)``
         Their noise covariances.
     A, BWB : ndarray, shape ``(2, 2)``
+        Target dynamics ``A`` and process noise covariance ``B W B^T``.
 
     Returns
     -------
@@ -237,7 +242,9 @@ def minimum_attenuation(S_seq, Sigma0, A, BWB, Lbar, lo=1e-3, hi=1e3, tol=1e-6, 
     S_seq : ndarray, shape ``(K, ..., 2, 2)``
         ``C^T M_k^{-1} C`` for each step (leading axes after time are batched; gamma_0 is the max).
     Sigma0 : ndarray, shape ``(2, 2)``
+        Initial ``Sigma_0`` of the recursion.
     A, BWB, Lbar : ndarray, shape ``(2, 2)``
+        Target dynamics ``A``, ``B W B^T`` and ``Lbar = L^T Q L``.
     lo, hi : float
         Bracket of the bisection.
     tol : float

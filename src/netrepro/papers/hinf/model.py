@@ -380,6 +380,7 @@ def attenuation_levels(information, P0: float, A, BWB, Lbar) -> dict:
     P0 : float
         ``Sigma_0 = P0 I``.
     A, BWB, Lbar : ndarray, shape ``(2, 2)``
+        Target dynamics ``A``, the filters' ``B W B^T`` and ``Lbar = L^T Q L``.
 
     Returns
     -------
@@ -401,13 +402,17 @@ def window_means(errors, start: int, stop: int | None = None):
     Parameters
     ----------
     errors : ndarray, shape ``(R, n, K + 1)``
+        Position-error norms ``|xhat - x|`` of ``R`` runs, ``n`` agents (1 for the centralized filter)
+        and steps ``0..K`` (``simulate(...)["errors"][name]``).
     start : int
+        First step included.
     stop : int, optional
         Last step included (default ``K``).
 
     Returns
     -------
     ndarray, shape ``(R,)``
+        Each run's mean error over the window and the agents.
     """
     stop = errors.shape[-1] - 1 if stop is None else int(stop)
     return errors[..., int(start):stop + 1].mean(axis=(1, 2))

@@ -76,8 +76,11 @@ def printed_sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
     Parameters
     ----------
     Delta, dDelta, S, dS : ndarray, shape ``(..., 2, 2)``
+        ``Delta_k``, ``Delta_k^z`` (eq (14)), ``C^T M^{-1} C`` and ``C^T (dM^{-1}/dz) C``.
     gamma_inv2 : float
+        ``gamma^{-2}``.
     Lbar : ndarray, shape ``(2, 2)``
+        ``L^T Q L``.
 
     Returns
     -------
@@ -129,11 +132,14 @@ def printed_control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float):
     Parameters
     ----------
     dJ_dr, dJ_dtheta, r, theta : ndarray, same shape
+        Derivatives of ``J`` w.r.t. range and bearing (eq (13)), range and bearing (radians).
     Gamma : float
+        Control gain of eq (12).
 
     Returns
     -------
     ndarray, shape ``r.shape + (2,)``
+        The printed steps ``u_i`` (wrong: the sign and ``T_i^T`` for ``T_i``, erratum E5).
     """
     local = np.stack([dJ_dr, dJ_dtheta / r], -1)
     return -Gamma * (np.swapaxes(rotation(theta), -1, -2) @ local[..., None])[..., 0]

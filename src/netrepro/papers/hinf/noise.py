@@ -77,12 +77,14 @@ def noise_variances(r, model: NoiseModel):
     Parameters
     ----------
     r : array_like
-        Ranges.
+        Ranges ``r_i = |x - p_i|`` (the length unit of ``a1``).
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
 
     Returns
     -------
     f_r, f_b : ndarray, shape of ``r``
+        Range and bearing noise variances.
     """
     r = np.asarray(r, dtype=float)
     fr = model.a2 * (r - model.a1) ** 2 + model.a0
@@ -97,12 +99,14 @@ def noise_covariance(r, theta, model: NoiseModel):
     Parameters
     ----------
     r, theta : array_like
-        Range and bearing (same shape).
+        Range and bearing (radians) of the target from the agent (same shape).
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
 
     Returns
     -------
     ndarray, shape ``r.shape + (2, 2)``
+        The covariance ``M`` (world frame).
     """
     fr, fb = noise_variances(r, model)
     T = rotation(theta)
@@ -127,8 +131,9 @@ def noise_information(r, theta, model: NoiseModel, derivatives: bool = False, ke
     Parameters
     ----------
     r, theta : array_like
-        Range and bearing (same shape).
+        Range and bearing (radians) of the target from the agent (same shape).
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
     derivatives : bool
         Also return the derivatives with respect to ``r`` and ``theta``.
     kernel : {"auto", "compiled", "numpy"}
@@ -185,7 +190,9 @@ def printed_dinfo_dtheta(r, theta, model: NoiseModel):
     Parameters
     ----------
     r, theta : array_like
+        Range and bearing (radians) of the target from the agent (same shape).
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
 
     Returns
     -------
@@ -241,9 +248,11 @@ def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel, kernel: 
     Parameters
     ----------
     rng : numpy.random.Generator
+        The random generator the standard normal ``eps_i`` are drawn from.
     r, theta : array_like
-        Range and bearing (same shape).
+        Range and bearing (radians) of the target from the agent (same shape).
     model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4) (``a0``, ``a1``, ``a2``, ``alpha``).
     kernel : {"auto", "compiled", "numpy"}
         ``"compiled"``: the rotation by :func:`.filter_kernels.rotate_kernel`, the same arithmetic sensor by
         sensor (bit-identical; ``r`` and ``theta`` of one shape); ``"numpy"``: the reference form;
@@ -252,6 +261,7 @@ def sample_noise(rng: np.random.Generator, r, theta, model: NoiseModel, kernel: 
     Returns
     -------
     ndarray, shape ``r.shape + (2,)``
+        One noise vector ``m_i`` (world frame) per range.
     """
     fr, fb = noise_variances(r, model)
     eps = rng.standard_normal(np.shape(fr) + (2,))

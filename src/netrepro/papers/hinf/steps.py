@@ -121,7 +121,30 @@ PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); differ
 
 # --------------------------------------------------------------------------- noise model (Fig 1)
 def noise_model_step(params, inputs, outputs):
-    """Fig-1 ellipses and an empirical check of eqs (3)-(4) by sampling."""
+    """Fig-1 ellipses and an empirical check of eqs (3)-(4) by sampling.
+
+    Fig 1: three sensors at the configured ranges and bearings from a target at the origin, with the
+    1-sigma semi-axes of their noise ellipses ``M_i`` (eqs (3)-(4)). Check: at each range of
+    ``noise_check.r_grid``, ``noise_check.n_samples`` noise vectors drawn by eq (3) (corrected,
+    erratum E1) at bearing ``noise_check.theta``, and their empirical variances along and across the
+    line of sight next to ``f_r`` and ``f_b`` of eq (4).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``noise`` (``a0, a1, a2, alpha`` of eq (4)) and
+        ``noise_check`` (``fig1_ranges``, ``fig1_bearings_deg`` in degrees, ``r_grid``, ``theta`` in
+        radians, ``n_samples``, ``seed``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``fit``: ``results/hinf/noise_model.csv`` and ``noise_fit.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "fit": DataFrame}``: the columns listed in the module docstring.
+    """
     model = NoiseModel.from_config(params["noise"])
     nc = params["noise_check"]
     rows = []
@@ -148,7 +171,30 @@ def noise_model_step(params, inputs, outputs):
 
 # --------------------------------------------------------------------------- consensus (5)
 def consensus_check_step(params, inputs, outputs):
-    """Stability range of the step h of eq (5) and the steady-state error with constant inputs."""
+    """Stability range of the step h of eq (5) and the steady-state error with constant inputs.
+
+    On the graph (25) of the layout ``consensus_check.layout``, with constant random inputs (six
+    components per agent, standard normal, seed ``consensus_check.seed``): for each ``h`` of
+    ``consensus_check.h_grid`` the spectral radius of eq (5) and the largest ``|v_i - mean(u)|`` after
+    ``consensus_check.n_iter`` steps (:func:`.consensus.run_pi_consensus`; inf when it diverged), and
+    ``h_max``, the largest step for which eq (5) is stable (:func:`.consensus.consensus_h_max`).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``consensus_check`` (``layout``, ``h_grid``, ``n_iter``,
+        ``seed``), ``consensus`` (``gamma_c``, ``K_p``, ``K_i``), ``layouts`` and ``comm_radius``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/consensus_check.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"h_max": float}}``: one row per ``h`` (columns
+        ``h, steady_state_error, stable, spectral_radius, h_max``).
+    """
     cc, cons = params["consensus_check"], params["consensus"]
     ag = layout_positions(params["layouts"][cc["layout"]])
     lap = laplacian(adjacency(ag, params["comm_radius"]))
@@ -174,7 +220,36 @@ def _fig2_information(cfg):
 
 
 def attenuation_step(params, inputs, outputs):
-    """Minimum attenuation level gamma_0 of eq (6), filter existence, and the two filter identities."""
+    """Minimum attenuation level gamma_0 of eq (6), filter existence, and the two filter identities.
+
+    gamma_0 (:func:`.filters.minimum_attenuation`) of the local filters (worst agent) and of the
+    centralized filter, for the Fig-2 agents around a target at the origin over
+    ``attenuation.horizon`` steps (``B W B^T = W_filter I`` of scenario ``fig2``); then whether
+    scenario ``fig2`` with that filter alone (``attenuation.runs`` runs, ``attenuation.horizon``
+    steps) can be simulated, i.e. the filter exists, at the configured gamma and at ``0.9 gamma_0``.
+    Identities, over 50 steps of a random-walk target (``attenuation.runs`` runs, seed
+    ``attenuation.seed``): eq (6) with ``gamma = attenuation.gamma_large`` against a textbook
+    Kalman filter, and eq (9) fed the exact averages (7)-(8) against eq (6) with the same gamma (the
+    largest absolute differences of the estimates and covariances).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``filter`` (``L``, ``Q``, ``A``, ``P0``, ``gamma``),
+        ``attenuation`` (``horizon``, ``runs``, ``seed``, ``gamma_large``), ``noise``, ``layouts``
+        and ``scenarios.fig2`` (and what :func:`.model.resolve_scenario` reads for it).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``checks``: ``results/hinf/attenuation.csv`` and ``filter_checks.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "checks": DataFrame, "provenance": {"gamma0_local": float,
+        "gamma0_central": float}}``: one row per filter (``local``, ``centralized``) and the two
+        identity checks (``check, value, note``).
+    """
     cfg = params
     f = cfg["filter"]
     at = cfg["attenuation"]
@@ -239,7 +314,32 @@ def _late(errors, start):
 
 
 def scenario_tables(name: str, out: dict, sc: dict, cfg: dict) -> dict:
-    """Reduce one :func:`simulate` output to the tables of the module docstring."""
+    """Reduce one :func:`simulate` output to the tables of the module docstring.
+
+    The late window is ``k >= min(claims.late_start, horizon)``.
+
+    Parameters
+    ----------
+    name : str
+        The scenario's name (its ``scenario`` column).
+    out : dict
+        What :func:`.model.simulate` returned for it (``errors``, ``target``, ``agents``,
+        ``connected``, ``max_degree``, ``fused_trace``).
+    sc : dict
+        The resolved scenario (:func:`.model.resolve_scenario`; ``horizon``, ``runs`` and ``model``
+        are read).
+    cfg : dict
+        The ``hinf`` configuration; read: ``output`` (``band``, ``single_agent``, ``single_run``,
+        ``traj_runs``) and ``claims`` (``late_start``, ``settle_threshold``).
+
+    Returns
+    -------
+    dict
+        ``{"errors", "single", "trajectories", "summary", "per_run": DataFrame}``: the scenario's
+        pieces of ``errors.csv``, ``errors_single.csv``, ``trajectories.csv`` and ``summary.csv``, and
+        each run's late-window mean error of every filter (one column per filter, and ``run``), from
+        which :func:`tables_step` forms the paired comparisons.
+    """
     oc, cl = cfg["output"], cfg["claims"]
     lo_q, hi_q = oc["band"]
     K = sc["horizon"]
@@ -286,7 +386,30 @@ def scenario_tables(name: str, out: dict, sc: dict, cfg: dict) -> dict:
 
 
 def simulate_step(params, inputs, outputs):
-    """Simulate one scenario of Section VI (``params['scenario']``) and write its tables."""
+    """Simulate one scenario of Section VI (``params['scenario']``) and write its tables.
+
+    Parameters
+    ----------
+    params : dict
+        ``scenario`` (a scenario name of ``hinf.scenarios``) and ``cfg`` (the whole ``hinf``
+        configuration).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``errors``, ``single``, ``trajectories``, ``summary`` and ``per_run``:
+        ``results/hinf/sim/<scenario>_<name>.csv``.
+
+    Returns
+    -------
+    dict
+        The tables of :func:`scenario_tables` and ``"provenance"``: ``{"scenario", "n_psd_fix",
+        "runs", "horizon"}`` (``n_psd_fix`` from :func:`.model.simulate`).
+
+    Raises
+    ------
+    FilterDoesNotExist
+        If an H-infinity filter of the scenario does not exist at some step (gamma below gamma_0).
+    """
     name = params["scenario"]
     cfg = params["cfg"]
     sc = resolve_scenario(cfg, name)
@@ -297,7 +420,29 @@ def simulate_step(params, inputs, outputs):
 
 
 def tables_step(params, inputs, outputs):
-    """Concatenate the per-scenario tables into errors/trajectories/summary, and the paired comparisons."""
+    """Concatenate the per-scenario tables into errors/trajectories/summary, and the paired comparisons.
+
+    Paired comparisons: for each entry of :data:`PAIRED` whose scenarios and filters were simulated,
+    the per-run differences ``a - b`` of the late-window mean errors (same seeds), their mean, standard
+    error and ``z = mean / se``.
+
+    Parameters
+    ----------
+    params : dict
+        Not read (the rule passes ``{}``).
+    inputs : dict
+        ``<piece>_<scenario>`` for each piece (``errors``, ``single``, ``trajectories``, ``summary``,
+        ``per_run``) and scenario: the tables of :func:`simulate_step`.
+    outputs : dict
+        ``errors``, ``single``, ``trajectories``, ``summary`` and ``paired``:
+        ``results/hinf/errors.csv``, ``errors_single.csv``, ``trajectories.csv``, ``summary.csv`` and
+        ``paired.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"errors", "single", "trajectories", "summary", "paired": DataFrame}``.
+    """
     cat = {}
     for kind in ("errors", "single", "trajectories", "summary", "per_run"):
         files = sorted(p for k, p in inputs.items() if k.startswith(kind + "_"))
@@ -320,13 +465,59 @@ def tables_step(params, inputs, outputs):
 
 # --------------------------------------------------------------------------- sensitivity
 def sensitivity_step(params, inputs, outputs):
-    """One-at-a-time sweeps of the main reconstructed parameters (gamma, consensus gains, h, control gain)."""
+    """One-at-a-time sweeps of the main reconstructed parameters (gamma, consensus gains, h, control gain).
+
+    For each scenario of ``sensitivity.random_scenarios``: the H-infinity gamma and each consensus
+    parameter of eq (5) (``gamma_c``, ``K_p``, ``K_i``, ``h``, ``iters``) over its values; for
+    ``sensitivity.mobile_scenario``: the control gain ``Gamma`` of eq (12) and the speed limit
+    ``v_max``; the others at their configured values, with the sensitivity runs, horizon and seed.
+    Errors are means over the window ``k >= min(claims.late_start, horizon // 2)``; ``exists`` is
+    False (errors NaN) where an H-infinity filter does not exist; ``consensus_stable`` is eq (5)'s
+    spectral radius < 1 on the Fig-2 graph.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``sensitivity`` (``runs``, ``horizon``, ``seed``,
+        ``random_scenarios``, ``mobile_scenario`` and the value lists), ``claims`` (``late_start``,
+        ``settle_threshold``), ``scenarios``, ``layouts``, ``comm_radius`` and what
+        :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/sensitivity.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per parameter value and scenario (columns in the module
+        docstring).
+    """
     from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     return {"table": _sensitivity(params, evasive=False)}
 
 
 def sensitivity_evasive_step(params, inputs, outputs):
-    """Sweep of gamma against the evasive target; the row ``gamma = inf`` is the Kalman-driven scenario."""
+    """Sweep of gamma against the evasive target; the row ``gamma = inf`` is the Kalman-driven scenario.
+
+    Scenario ``evasive_hinf`` at each gamma of ``sensitivity.gamma`` (parameter ``gamma_evasive``),
+    and ``evasive_kalman`` as ``gamma = inf``; runs, horizon, seed and window as in
+    :func:`sensitivity_step`.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration (as for :func:`sensitivity_step`).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/sensitivity_evasive.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: the columns of ``sensitivity.csv``.
+    """
     return {"table": _sensitivity(params, evasive=True)}
 
 
@@ -394,6 +585,24 @@ def paired_evasive_step(params, inputs, outputs):
     ``factor x gamma_0``; and the structural comparisons (decentralized vs local, centralized vs
     decentralized) for both families. ``mean_diff`` = error of ``filter_a`` minus error of ``filter_b``,
     each the mean over the claims' window ``late_start <= k <= horizon`` and the agents, paired per run.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``paired`` (``scenario``, ``targets``, ``runs``, ``seed``,
+        ``gamma_factors``), ``claims.late_start``, ``filter.gamma`` and what
+        :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/paired_evasive.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"paired": {target: {"gamma0": ..., "driver": ...}}}}``:
+        one row per comparison and target (columns in the module docstring), and each target's
+        gamma_0 per filter kind and the driver.
     """
     from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, pc = params, params["paired"]
@@ -433,6 +642,30 @@ def fig2_horizon_step(params, inputs, outputs):
     Each scenario of ``fig2_horizon.scenarios`` is simulated once to the longest horizon with its own
     seed and ``fig2_horizon.runs`` runs, with the configured ``K_i`` and
     with ``K_i = 0`` (scenario ``<name>_ki0``); a horizon ``H`` uses the window ``late_start <= k <= H``.
+    It is also simulated at each other value of ``gamma_c`` and ``K_p`` of ``sensitivity`` (scenario
+    ``<name>_gamma_c<v>`` / ``<name>_K_p<v>``; mean over the agents only). The consensus modes
+    (:func:`.consensus.pi_consensus_time_constants`) are those of the first scenario's graph (25),
+    with the configured ``K_i`` and with ``K_i = 0``;
+    their time constants are converted from consensus iterations to filter steps (``consensus.iters``
+    iterations per step).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``fig2_horizon`` (``scenarios``, ``horizons``, ``runs``,
+        ``interior_agent``), ``claims`` (``late_start``, ``z_significant``), ``sensitivity``
+        (``gamma_c``, ``K_p``), ``consensus`` and what :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``, ``series`` and ``modes``: ``results/hinf/per_agent.csv``, ``per_agent_errors.csv``
+        and ``consensus_modes.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "series": DataFrame, "modes": DataFrame}``: the columns listed in the
+        module docstring.
     """
     from . import filter_kernels  # noqa: F401  numba: this step runs enough filter updates to pay its load
     cfg, fh = params, params["fig2_horizon"]
@@ -498,6 +731,23 @@ def evader_check_step(params, inputs, outputs):
     ``paired_evasive`` (configured gamma) repeated on ``paired_runs`` runs with the configured evader, the
     mirror-descent evader (``evader.n_iter`` iterations) and the pairwise evader (``pairwise_iterations``).
     ``n_iter`` is 0 for the exact solver (no iterations).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``evader_check`` (``runs``, ``mirror_iterations``,
+        ``reference_iterations``, ``paired_runs``, ``pairwise_iterations``), ``evader``,
+        ``paired.seed``, ``claims.late_start`` and what :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``paired``: ``results/hinf/evader_convergence.csv`` and ``evader_paired.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "paired": DataFrame}``: one row per solver and iteration count, and
+        one row per evader and filter kind (columns in the module docstring).
     """
     cfg, ec = params, params["evader_check"]
     sc = resolve_scenario(cfg, "evasive_hinf", runs=int(ec["runs"]))
@@ -549,7 +799,27 @@ def evader_check_step(params, inputs, outputs):
 
 
 def network_step(params, inputs, outputs):
-    """Communication links (eq (25)) at the time marks of Fig 6, and the connected fraction of each run."""
+    """Communication links (eq (25)) at the time marks of Fig 6, and the connected fraction of each run.
+
+    For each scenario and run of the trajectories table: the links of eq (25) at each mark
+    ``k <= K``; the fraction of steps with a connected graph (second Laplacian eigenvalue > 1e-9), the
+    smallest second eigenvalue, and the number of steps at which the graph changed.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``comm_radius`` and ``network.marks``.
+    inputs : dict
+        ``trajectories``: ``results/hinf/trajectories.csv``.
+    outputs : dict
+        ``table`` and ``connectivity``: ``results/hinf/network.csv`` and ``connectivity.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "connectivity": DataFrame}``: columns ``scenario, run, k, i, j`` and
+        ``scenario, run, steps, connected_fraction, min_lambda2, topology_changes``.
+    """
     tr = pd.read_csv(inputs["trajectories"], dtype={"who": str})
     radius = float(params["comm_radius"])
     marks = [int(m) for m in params["network"]["marks"]]
@@ -576,6 +846,23 @@ def fig5_control_step(params, inputs, outputs):
     For each value of ``sensitivity.Gamma`` and ``sensitivity.v_max`` (the other at its configured value) the
     mobile scenario is simulated with the sensitivity runs, horizon and seed, and compared run by run with the
     stationary scenario simulated once with the same settings (same seed: same target and noise stream).
+    The window is ``min(claims.late_start, horizon // 2) <= k <= horizon``.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``sensitivity`` (``horizon``, ``runs``, ``seed``,
+        ``mobile_scenario``, ``Gamma``, ``v_max``), ``claims.late_start`` and what
+        :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/fig5_control.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per parameter value (columns in the module docstring).
     """
     cfg, sv = params, params["sensitivity"]
     horizon, runs, seed = int(sv["horizon"]), int(sv["runs"]), int(sv["seed"])
@@ -600,7 +887,23 @@ def evasive_network_step(params, inputs, outputs):
     """Is the Fig-6 network's disconnection what costs the decentralized filter? Per-run connectivity and errors.
 
     The scenario ``paired.scenario`` is run against each target of ``paired.targets`` (agents moved by its
-    driver), with ``paired.network_runs`` runs and seed ``paired.seed``.
+    driver), with ``paired.network_runs`` runs and seed ``paired.seed``. Window: ``k >= claims.late_start``.
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``paired`` (``scenario``, ``targets``, ``network_runs``,
+        ``seed``), ``claims.late_start`` and what :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/evasive_network.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per target and run (``target, run, connected_fraction,
+        local, decentralized``).
     """
     cfg, pc = params, params["paired"]
     start = int(cfg["claims"]["late_start"])

@@ -9,7 +9,26 @@ __all__ = ["check_config"]
 
 
 def check_config(section: dict) -> None:
-    """Checks the schema cannot express: grids, the vector model's shapes and definiteness."""
+    """Checks the schema cannot express: grids, the vector model's shapes and definiteness.
+
+    Called by :func:`netrepro.config.validate_config` after the schema check. Checked: the SNR
+    grid's ``stop`` exceeds its ``start``; ``fig1_one_minus_alpha`` is one of ``one_minus_alpha``;
+    ``convergence.n_steps`` and ``convergence.n_lag_steps`` have one entry per ``one_minus_alpha``;
+    ``estimator.snr_db`` is strictly increasing; the optional ``estimator.crossing`` has strictly
+    increasing SNRs, more of them than its fit ``degree``, and only ``one_minus_alpha`` values of
+    ``estimator.one_minus_alpha``; in ``vector_check``, ``A`` is square (n x n), ``C`` is m x n,
+    and ``Q`` (n x n), ``R`` (m x m) and ``P0`` (n x n) are symmetric positive definite.
+
+    Parameters
+    ----------
+    section : dict
+        The ``onebit`` section of the configuration.
+
+    Raises
+    ------
+    ConfigError
+        Naming the configuration key whose value fails one of the checks above.
+    """
     g = section["snr_grid_db"]
     if g["stop"] <= g["start"]:
         raise ConfigError(f"config key 'onebit.snr_grid_db' = {g!r}: stop must exceed start")

@@ -63,7 +63,18 @@ INNOVATION = "innovation"
 
 
 def alpha_label(eps: float) -> str:
-    """``'alpha -> 1'`` for ``eps = 0``, else ``'alpha = 1 - eps'``."""
+    """``'alpha -> 1'`` for ``eps = 0``, else ``'alpha = 1 - eps'``: how the evidence notes name an alpha.
+
+    Parameters
+    ----------
+    eps : float
+        ``1 - alpha`` of the random walk (21); 0 stands for the alpha -> 1 limit.
+
+    Returns
+    -------
+    str
+        ``"alpha -> 1"``, or ``"alpha = 1 - <eps>"`` with ``eps`` in ``format(eps, 'g')``.
+    """
     return "alpha -> 1" if eps == 0 else f"alpha = 1 - {eps:g}"
 
 
@@ -88,7 +99,25 @@ def variant_label(key: str, text: str) -> str:
 def low_snr_cases(nominal_eps: float, grid_start: float, other_ends, other_eps) -> list:
     """(eps, snr) cases of a low-SNR claim: the nominal first, then each other end and each other alpha.
 
-    ``other_eps`` should hold 0 for the limit; duplicates of the nominal are dropped.
+    The nominal alpha and the alpha -> 1 limit (``eps = 0``) are taken at every low-SNR end
+    (``grid_start``, then ``other_ends``); every other alpha only at ``grid_start``. ``other_eps``
+    should hold 0 for the limit; duplicates of the nominal (and repeated cases) are dropped.
+
+    Parameters
+    ----------
+    nominal_eps : float
+        ``1 - alpha`` of the claim's nominal case (0: the alpha -> 1 limit).
+    grid_start : float
+        The nominal low-SNR end (dB): the start of ``snr_grid_db``.
+    other_ends : iterable of float
+        The other low-SNR ends (dB) of the declared range (``evidence.low_snr_db``).
+    other_eps : iterable of float
+        The other ``1 - alpha`` values the claim is re-judged at.
+
+    Returns
+    -------
+    list of tuple of float
+        ``(eps, snr_db)`` pairs, the nominal ``(nominal_eps, grid_start)`` first, without repeats.
     """
     ends = [grid_start] + [float(x) for x in other_ends if float(x) != grid_start]
     cases = [(nominal_eps, grid_start)]
@@ -532,6 +561,26 @@ def evidence_step(params, inputs, outputs):
     ``at:`` fields (and those of ``claims.yaml`` beside it) give the settings the evidence quotes.
     Low-SNR values are recomputed at each case from (29), (34)/(36) and (47)-(49)
     (:func:`.randomwalk.ratios_at`), the same functions as ``ratios.csv``.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``sigma_eta``, ``sigma_theta0``, ``mu_theta0``,
+        ``snr_definition``, ``one_minus_alpha``, ``fig1_one_minus_alpha``, ``reference_snr_db``,
+        ``snr_grid_db``, ``quadrature``, ``lag_tol_db``, ``estimator``, ``evidence`` (the declared
+        ranges: ``low_snr_db``, ``low_regime_max_db``, ``medium_regime_max_db``, ...) and
+        ``vector_check``.
+    inputs : dict
+        The paths named above (``results/onebit/*.csv``, the shard files, the paper's
+        ``findings.yaml``, ``errata.yaml`` and ``claims.yaml``).
+    outputs : dict
+        ``table``: ``results/evidence/onebit.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: the evidence rows (columns ``quantity, variant, value, note``,
+        :func:`netrepro.verdicts.evidence_frame`) of every claim, erratum, reconstruction and finding.
     """
     at, claims = _paper_side(inputs.get("findings_file"))
     params = dict(params, _at=at, _claims=claims)

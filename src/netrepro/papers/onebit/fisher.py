@@ -83,6 +83,7 @@ def expected_fisher_1bit(var_theta, sigma_eta: float = 1.0, mean_theta=0.0, half
     var_theta : array_like
         Variance of theta (any shape).
     sigma_eta : float
+        Standard deviation of the measurement noise eta, (20) and (28) (units of theta).
     mean_theta : array_like
         Mean of theta, (31); broadcast against ``var_theta``.
     half_width, step : float

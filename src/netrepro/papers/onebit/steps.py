@@ -113,7 +113,31 @@ def _db(x):
 
 
 def efq_step(params, inputs, outputs):
-    """Table ``efq.csv``: (29) on a fine SNR grid by the trapezoid form and by adaptive quadrature."""
+    """Table ``efq.csv``: (29) on a fine SNR grid by the trapezoid form and by adaptive quadrature.
+
+    At each SNR of the grid, ``var_ratio = 10^(snr_db/10) = Var[theta]/sigma_eta^2`` (the stationary
+    SNR) and theta has mean zero; ``efq = sigma_eta^2 E[F_q]`` (dimensionless) by
+    :func:`.fisher.expected_fisher_1bit` and ``efq_quad`` by :func:`.fisher.expected_fisher_1bit_quad`
+    (an independent computation of the same integral).
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``quadrature`` (``half_width``, ``step``: the trapezoid
+        range in standard deviations and its spacing) and ``efq_grid_db`` (``start``, ``stop``,
+        ``step``, in dB).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/onebit/efq.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"max_rel_err": float}}``: columns ``snr_db,
+        var_ratio, efq, efq_db, efq_quad, rel_err`` (``rel_err = |efq/efq_quad - 1|``), and the largest
+        ``rel_err``.
+    """
     q = params["quadrature"]
     g = params["efq_grid_db"]
     snr_db = np.arange(g["start"], g["stop"] + g["step"] / 2, g["step"])
@@ -126,7 +150,32 @@ def efq_step(params, inputs, outputs):
 
 
 def ratios_step(params, inputs, outputs):
-    """Table ``ratios.csv``: steady-state (47)-(49) for each alpha and the alpha -> 1 limit."""
+    """Table ``ratios.csv``: steady-state (47)-(49) for each alpha and the alpha -> 1 limit.
+
+    For each ``1 - alpha`` the steady-state filtering and smoothing BIMs, unquantized (24)/(26) and
+    1-bit (34)/(36), with E[F_q] (29) under the stationary law of theta (mean 0, variance (33)), and
+    their ratios rho_SL (47), rho_F (48), rho_S (49) in dB (:func:`.randomwalk.information_ratios`).
+    With the stationary SNR definition the alpha -> 1 limit is added (``alpha = 1``,
+    :func:`.randomwalk.information_ratios_limit`; its BIM columns are NaN).
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``snr_grid_db`` (``start``, ``stop``, ``step`` in dB),
+        ``quadrature`` (``half_width``, ``step``), ``one_minus_alpha`` (list of ``1 - alpha``),
+        ``sigma_eta`` (noise standard deviation) and ``snr_definition`` (``"stationary"`` or
+        ``"innovation"``).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/onebit/ratios.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: one row per alpha and SNR, columns ``alpha, snr_db, efq_db,
+        rho_sl_db, rho_f_db, rho_s_db, one_minus_alpha, sigma_z2, j_f_inf, j_f_q, j_s_inf, j_s_q``.
+    """
     snr_db = snr_grid(**params["snr_grid_db"])
     q = params["quadrature"]
     frames = []
@@ -149,7 +198,34 @@ def ratios_step(params, inputs, outputs):
 
 
 def lag_step(params, inputs, outputs):
-    """Table ``lag.csv``: the smoothing lag Delta each SNR needs (closed form, checked by iteration)."""
+    """Table ``lag.csv``: the smoothing lag Delta each SNR needs (closed form, checked by iteration).
+
+    For each ``1 - alpha`` and SNR: the smallest lag at which the steady-state smoothing BIM is within
+    ``lag_tol_db`` of its Delta -> infinity value, 1-bit (information E[F_q] of (29) under the
+    stationary law) and unquantized (``1/sigma_eta^2``, (23)), in closed form
+    (:func:`.randomwalk.rw_lag_needed`) and, when both closed-form lags are at most
+    ``lag_iterate_max``, by iterating (27)/(37)-(38) (:func:`.randomwalk.rw_lag_iterated`; else
+    -1); and the break-even lag, the smallest with J_{k|k+Delta,q} > J_{k|k,inf}
+    (:func:`.randomwalk.rw_break_even_lag`; NaN: never).
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``snr_grid_db`` (``start``, ``stop``, ``step`` in dB),
+        ``lag_tol_db`` (tolerance in dB), ``lag_iterate_max`` (largest lag checked by iteration),
+        ``one_minus_alpha``, ``sigma_eta`` and ``snr_definition``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/onebit/lag.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: columns ``alpha, snr_db, delta_needed, delta_q, delta_inf,
+        delta_q_iterated, delta_inf_iterated, tol_db, delta_scaled, delta_break_even``
+        (``delta_needed`` is the larger of ``delta_q`` and ``delta_inf``).
+    """
     snr_db = snr_grid(**params["snr_grid_db"])
     tol = params["lag_tol_db"]
     se = params["sigma_eta"]
@@ -172,7 +248,37 @@ def lag_step(params, inputs, outputs):
 
 
 def convergence_step(params, inputs, outputs):
-    """Tables ``convergence.csv`` and ``transient.csv``: fixed points against long iterations."""
+    """Tables ``convergence.csv`` and ``transient.csv``: fixed points against long iterations.
+
+    For each ``1 - alpha`` and SNR: the stationary variance (33) against the recursion (32) after
+    ``n_steps``; the filtering BIMs (24) and (34) iterated from the prior ``J_{0|0} = 1/sigma_theta0^2``
+    with the transient E[F_q(theta_k)] (mean (31), variance (32)) against their fixed points
+    (:func:`.randomwalk.iterate_transient`); and the smoothing gains kappa (27) and kappa_q
+    (37)-(38), with the stationary E[F_q], iterated ``n_lag_steps`` times from 0 against their fixed
+    points. ``k_converged`` is the last step farther than ``rtol`` from the fixed point, + 1.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``convergence`` (``snr_db``: SNRs in dB; ``n_steps`` and
+        ``n_lag_steps``: one per ``one_minus_alpha``; ``rtol``: relative convergence tolerance;
+        ``n_record``: number of log-spaced steps recorded), ``one_minus_alpha``, ``sigma_eta``,
+        ``sigma_theta0`` (prior standard deviation), ``mu_theta0`` (prior mean) and
+        ``snr_definition``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``transient``: ``results/onebit/convergence.csv`` and ``transient.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "transient": DataFrame, "provenance": {"n_filter_steps": int}}``:
+        ``table`` has one row per alpha, SNR and quantity (``var_theta, j_f_q, j_f_inf, kappa_q,
+        kappa_inf``) with ``fixed_point, iterated, rel_diff, n_steps, k_converged``; ``transient``
+        the trajectories over fixed point at the recorded steps; ``n_filter_steps`` the number of
+        filter steps iterated (``n_steps`` times the number of SNRs, summed over alpha).
+    """
     c = params["convergence"]
     se, sig0 = params["sigma_eta"], params["sigma_theta0"]
     rows, trace_frames = [], []
@@ -242,7 +348,35 @@ def _estimator_simulator(params, eps, snr):
 
 
 def estimator_shard_step(params, inputs, outputs):
-    """Step: per-run window MSEs of one shard's blocks, for every case; block ``b`` has its own generator."""
+    """Step: per-run window MSEs of one shard's blocks, for every case; block ``b`` has its own generator.
+
+    For every case of :func:`.shards.estimator_cases` (``1 - alpha``, SNR, seed, number of runs), the
+    shard's blocks of ``estimator.block_size`` runs are simulated, block ``b`` with the generator
+    :func:`netrepro.engines.montecarlo.block_rng` of the case's seed and ``b``: random-walk paths, one noise draw per path giving both the unquantized
+    data y and the 1-bit data ``r = sign(y)``; the banded grid filter and smoother on r, the Kalman
+    filter and RTS smoother on y; each run's mean squared error over the evaluation steps of the
+    design (:func:`.randomwalk.estimator_design`). The results do not depend on the number of shards.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``estimator`` (cases, ``block_size``, ``seed``, the run design
+        ``burn_in_taus``, ``window_taus``, ``tail_taus``, ``evals_per_tau`` and the grid filter's
+        ``grid_half_width``, ``points_per_sigma_z``, ``band_sigmas``), ``sigma_eta`` and
+        ``snr_definition``, plus ``shard`` (this shard, 0-based) and ``n_shards``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``runs``: ``results/onebit/shards/estimator_<shard>.npz``, written by the step (atomically):
+        per case key ``<key>|blocks`` and ``<key>|counts`` (block indices and their run counts) and
+        ``<key>|<kind>`` (per-run MSEs) for each kind of :data:`.shards.ESTIMATOR_KINDS`.
+
+    Returns
+    -------
+    dict
+        ``{"provenance": {"blocks": list of int, "seed": int}}``: the block indices of the first
+        case (every grid case has the same) and ``estimator.seed``; no table.
+    """
     from ...engines.montecarlo import block_rng, shard_blocks
     from ...io import atomic_path
 
@@ -348,6 +482,23 @@ def estimator_step(params, inputs, outputs):
     at which the achievable rho_S crosses 0 dB by a local polynomial fit with a bootstrap interval
     over runs (:func:`.estimators.local_crossing_fit`), the former straight-line estimate, and the
     bound's crossing.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``estimator`` (cases, run design, ``n_boot``: bootstrap
+        resamples, ``crossing``: the crossing cases and fit ``degree``), ``sigma_eta`` and
+        ``snr_definition``.
+    inputs : dict
+        ``shards``: the files written by :func:`estimator_shard_step` (any number of shards).
+    outputs : dict
+        ``table``, ``ratios`` and ``crossing``: ``results/onebit/estimator_mse.csv``,
+        ``estimator_ratios.csv`` and ``estimator_crossing.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "ratios": DataFrame, "crossing": DataFrame}``: the three tables above.
     """
     est, se = params["estimator"], params["sigma_eta"]
     mse_rows, ratio_rows, boot = [], [], {}
@@ -393,7 +544,22 @@ def estimator_step(params, inputs, outputs):
 
 
 def run_estimator(params):
-    """Shard and merge in one process (tests, notebooks): the same tables as the two pipeline steps."""
+    """Shard and merge in one process (tests, notebooks): the same tables as the two pipeline steps.
+
+    Runs :func:`estimator_shard_step` as the only shard into a temporary file, then
+    :func:`estimator_step` on it.
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``estimator``, ``sigma_eta`` and ``snr_definition`` (as for
+        :func:`estimator_step`).
+
+    Returns
+    -------
+    dict
+        What :func:`estimator_step` returns: ``{"table", "ratios", "crossing": DataFrame}``.
+    """
     import tempfile
     from pathlib import Path
 
@@ -410,6 +576,23 @@ def alpha_scan_step(params, inputs, outputs):
     on the configured grid. ``alpha_threshold.csv``: per SNR the largest ``1 - alpha`` with
     rho_S > 0 dB (bisection), and ``single_sign_change``: whether rho_S changes sign once along the
     grid (the bisection's premise).
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``alpha_scan`` (``one_minus_alpha``: the ``1 - alpha`` grid;
+        ``snr_db``: the SNRs in dB), ``sigma_eta`` and ``snr_definition``.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table`` and ``threshold``: ``results/onebit/alpha_scan.csv`` and ``alpha_threshold.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "threshold": DataFrame}``: the scan (one row per alpha and SNR; the
+        break-even lag NaN where there is none) and, per SNR, ``snr_db, one_minus_alpha_max,
+        alpha_min, single_sign_change``.
     """
     sc, se = params["alpha_scan"], params["sigma_eta"]
     snr = np.asarray(sc["snr_db"], dtype=float)
@@ -431,7 +614,28 @@ def alpha_scan_step(params, inputs, outputs):
 
 
 def vector_check_step(params, inputs, outputs):
-    """Table ``vector_check.csv``: the general recursions on a 2-D non-symmetric model vs Kalman/RTS."""
+    """Table ``vector_check.csv``: the general recursions on a 2-D non-symmetric model vs Kalman/RTS.
+
+    The general recursions (7), (14), (16), (17)-(19), corrected and as printed, against the inverse
+    Kalman/RTS covariances of the same linear-Gaussian model (:func:`.model.vector_check`; errata
+    E1-E3).
+
+    Parameters
+    ----------
+    params : dict
+        The ``onebit`` configuration's ``vector_check``: ``A, Q, C, R, P0`` (nested lists) and
+        ``horizon`` (number of steps).
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/onebit/vector_check.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame}``: columns ``quantity, form, max_rel_err`` (largest relative
+        Frobenius error of the inverse BIM over all steps).
+    """
     res = vector_check(params["vector_check"])
     frame = pd.DataFrame([dict(quantity=q, form=f, max_rel_err=v) for (q, f), v in res.items()])
     return {"table": frame}
