@@ -6,6 +6,8 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import subprocess  # noqa: E402
+
 import numpy as np  # noqa: E402
 import pytest
 from hypothesis import settings
@@ -19,9 +21,36 @@ def rng():
     return np.random.default_rng(12345)
 
 
+# ----------------------------------------------------------------------------- the fast lane stays fast
+def runs_snakemake(args) -> bool:
+    """Whether a subprocess command line (list or shell string) starts Snakemake."""
+    import shlex
+
+    words = [str(args)] if isinstance(args, (str, bytes, os.PathLike)) else [str(w) for w in args]
+    if len(words) == 1:
+        words = shlex.split(words[0])
+    return (bool(words) and os.path.basename(words[0]) == "snakemake") or any(
+        a == "-m" and b == "snakemake" for a, b in zip(words, words[1:]))
+
+
+@pytest.fixture(autouse=True)
+def _snakemake_only_in_slow_tests(request, monkeypatch):
+    """A test that starts Snakemake must be marked ``slow`` (``make test-fast`` leaves those out)."""
+    if request.node.get_closest_marker("slow"):
+        return
+    real = subprocess.Popen
+
+    class Guarded(real):
+        def __init__(self, args, *rest, **kwargs):
+            if runs_snakemake(args):
+                raise AssertionError(f"{request.node.nodeid} starts Snakemake but is not marked slow")
+            super().__init__(args, *rest, **kwargs)
+
+    monkeypatch.setattr(subprocess, "Popen", Guarded)
+
+
 # ----------------------------------------------------------------------------- one built workflow per session
 import shutil  # noqa: E402
-import subprocess  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 

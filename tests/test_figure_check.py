@@ -19,7 +19,8 @@ from netrepro.figurecheck import (RMS_TOLERANCE, compare_figures, figure_jobs, l
 from netrepro.regression import PLATFORM_RULES
 
 ROOT = Path(__file__).resolve().parents[1]
-pytestmark = pytest.mark.xdist_group("figures")
+# every test reads the figure jobs from a dry run of the workflow (Snakemake), hence slow
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("figures")]
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
 from yte import process_yaml
 
@@ -39,6 +40,7 @@ def _workflow_rules() -> set[str]:
     return {line.strip() for line in out.stdout.splitlines() if line.strip() and " " not in line.strip()}
 
 
+@pytest.mark.slow  # the workflow's rule list comes from Snakemake
 def test_array_list_names_exactly_the_shard_rules():
     rules = _workflow_rules()
     shard_rules = {name for name in rules if name.endswith("_shard")}
