@@ -260,6 +260,28 @@ rule hinf_evasive_network:
         step("netrepro.papers.hinf.steps:evasive_network_step")
 
 
+rule hinf_fig6_paths:
+    input:
+        code=code("netrepro.papers.hinf.steps:fig6_paths_step"),
+    output:
+        table="results/hinf/fig6_paths.csv",
+        paths="results/hinf/fig6_paths_run0.csv",
+    log:
+        "logs/hinf/fig6_paths.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=10,
+    params:
+        cfg=as_json(HCFG),
+        rule="hinf_fig6_paths",
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:fig6_paths_step")
+
+
 rule hinf_loop_variants_shard:
     input:
         code=code("netrepro.papers.hinf.steps:loop_variants_shard_step"),
@@ -387,6 +409,7 @@ rule hinf_evidence:
     input:
         code=code("netrepro.papers.hinf.evidence:evidence_step"),
         claims="src/netrepro/papers/hinf/claims.yaml",
+        findings="src/netrepro/papers/hinf/findings.yaml",
         consensus=rules.hinf_consensus_check.output.table,
         attenuation=rules.hinf_attenuation.output.table,
         checks=rules.hinf_attenuation.output.checks,
@@ -410,6 +433,7 @@ rule hinf_evidence:
         evasive_network=rules.hinf_evasive_network.output.table,
         loop_variants=rules.hinf_loop_variants.output.table,
         kalman_best=rules.hinf_kalman_best.output.table,
+        fig6_paths=rules.hinf_fig6_paths.output.table,
     output:
         table="results/evidence/hinf.csv",
     log:
@@ -456,5 +480,7 @@ if enabled("hinf"):
         rules.hinf_loop_variants.output.table,
         rules.hinf_loop_variants.output.runs,
         rules.hinf_kalman_best.output.table,
+        rules.hinf_fig6_paths.output.table,
+        rules.hinf_fig6_paths.output.paths,
         rules.hinf_evidence.output.table,
     ]

@@ -101,6 +101,8 @@ def hinf_run(tmp_path_factory):
             merged["runs"].to_csv(files[f"{name}_runs"], index=False)
     run(steps.network_step, cfg, {"trajectories": files["trajectories"]}, ["table", "connectivity"])
     files["network"] = files.pop("table")
+    run(steps.fig6_paths_step, cfg, {}, ["table", "paths"])
+    files["fig6_paths"], files["fig6_paths_run0"] = files.pop("table"), files.pop("paths")
     return cfg, files
 
 

@@ -16,14 +16,16 @@ from netrepro.verdicts import read_evidence, verdicts_step
 
 INPUTS = ("consensus", "attenuation", "checks", "summary", "paired", "errors", "trajectories", "per_run_static_fixed",
           "per_run_static_mobile", "connectivity", "sensitivity", "sensitivity_evasive", "paired_evasive", "per_agent",
-          "modes", "evader", "evader_paired", "fig5_control", "evasive_network", "loop_variants", "kalman_best")
+          "modes", "evader", "evader_paired", "fig5_control", "evasive_network", "loop_variants", "kalman_best",
+          "fig6_paths")
 
 
 @pytest.fixture(scope="module")
 def evidence_table(hinf_run, tmp_path_factory):
     cfg, files = hinf_run
-    claims = Path(evidence.__file__).with_name("claims.yaml")
-    table = evidence.evidence_step(cfg, {"claims": claims, **{k: files[k] for k in INPUTS}}, {})["table"]
+    claims, findings = (Path(evidence.__file__).with_name(f"{name}.yaml") for name in ("claims", "findings"))
+    table = evidence.evidence_step(cfg, {"claims": claims, "findings": findings, **{k: files[k] for k in INPUTS}},
+                                   {})["table"]
     path = tmp_path_factory.mktemp("evidence") / "hinf.csv"
     table.to_csv(path, index=False)
     return cfg, files, table, path

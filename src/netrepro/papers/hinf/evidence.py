@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...paperdata import load_claims
+from ...paperdata import load_claims, load_findings
 from ...verdicts import erratum_evidence, evidence_frame
 from .analysis import (E9_RADII, ERRATA_POINT, difference_correlation, disturbance_weight, errata_residuals,
                        information_at_positions, mean_gain_norms, order_violation, settles_first, sweet_spot_grid)
@@ -494,6 +494,41 @@ def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
     return rows
 
 
+def _fig6_path_rows(fp: pd.DataFrame, at: dict) -> list[dict]:
+    """Issue 28: why Fig 6's agent paths zig-zag (fig6_paths.csv), with F_fig6_zigzag_cause's settings ``at``."""
+    t = fp.set_index("variant")
+    nom = t.loc["nominal"]
+    base = float(nom["reversal_fraction"])  # no nominal reversal (a very short run): no share, and no cause shown
+    share = {v: float(t.loc[v, "reversal_fraction"]) / base if base > 0 else math.nan for v in t.index if v != "nominal"}
+
+    def describe(v):
+        r = t.loc[v]
+        text = (f"{v}: heading reversals in {r['reversal_fraction']:.2%} of consecutive step pairs "
+                f"(SE {r['reversal_se']:.2%}), {r['clipped_fraction']:.0%} of steps clipped to v_max, mean step "
+                f"{r['mean_step']:.3f}, {r['topology_changes']:.0f} topology changes per run, late error {r['error_late']:.3f}")
+        if r["reversal_se"] == 0:
+            text += " (the same in every run: with no estimate in the loop, nothing random moves the agents or the target)"
+        if v != "nominal":
+            text += (f"; {share[v]:.0%} of the nominal reversals, paired difference {r['reversal_diff']:+.2%} "
+                     f"(z = {r['z']:+.1f}, {r['tag']} at |z| > {r['z_crit']:.2f})")
+        return text
+
+    head = (f"{int(nom['runs'])} closed-loop runs per variant (Fig 6's scenario, agents moved by the driver), same seeds; "
+            f"Bonferroni over the {len(share)} variants at the 5 % family-wise level")
+    rows = [{"quantity": "fig6.reversals", "value": float(nom["reversal_fraction"]), "note": f"{head}. {describe('nominal')}"}]
+    rows += [{"quantity": "fig6.reversals", "variant": v, "value": float(t.loc[v, "reversal_fraction"]), "note": describe(v)}
+             for v in share]
+    truth, gain = at["truth_variant"], at["gain_variant"]
+    cause = bool(share[truth] >= float(at["truth_keeps_at_least"]) and share[gain] <= float(at["gain_leaves_at_most"])
+                 and t.loc[gain, "tag"] == "holds")
+    rows.append({"quantity": "fig6.zigzag_cause", "value": cause,
+                 "note": (f"steering by the true target position keeps {share[truth]:.0%} of the nominal heading reversals "
+                          f"(rule: at least {float(at['truth_keeps_at_least']):.0%}); {gain} leaves {share[gain]:.0%} "
+                          f"(rule: at most {float(at['gain_leaves_at_most']):.0%}, and significantly fewer: "
+                          f"{t.loc[gain, 'tag']}). " + "; ".join(describe(v) for v in t.index))})
+    return rows
+
+
 def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
     """Issue 28, part 2: H-infinity against Kalman filters at their best, and the control targets (kalman_best.csv)."""
     zc, m = float(kb["z_crit"].iloc[0]), len(kb)
@@ -593,7 +628,8 @@ def evidence_step(params, inputs, outputs):
         ``summary``, ``paired``, ``errors``, ``trajectories``, ``per_run_static_fixed``,
         ``per_run_static_mobile``, ``connectivity``, ``sensitivity``, ``sensitivity_evasive``,
         ``paired_evasive``, ``per_agent``, ``modes``, ``evader``, ``evader_paired``,
-        ``fig5_control``, ``evasive_network``, ``loop_variants``, ``kalman_best``).
+        ``fig5_control``, ``evasive_network``, ``loop_variants``, ``kalman_best``, ``fig6_paths``);
+        ``findings`` (the paper's ``findings.yaml``, whose ``at`` fields hold the findings' decision settings).
     outputs : dict
         ``table``: ``results/evidence/hinf.csv``.
 
@@ -606,6 +642,7 @@ def evidence_step(params, inputs, outputs):
     cfg = params
     z_sig = float(cfg["claims"]["z_significant"])
     at = {c.claim_id: c.at for c in load_claims(inputs["claims"])}  # the claims' settings (their YAML 'at' fields)
+    finding_settings = {f.finding_id: f.at for f in load_findings(inputs["findings"])}  # the findings' decision settings
     rows = _errata_rows(cfg)
     # consensus (5)
     cc = pd.read_csv(inputs["consensus"])
@@ -698,6 +735,7 @@ def evidence_step(params, inputs, outputs):
     loop_horizon = int(cfg["scenarios"][cfg["loop_variants"]["scenario"]]["horizon"])
     rows += _loop_rows(pd.read_csv(inputs["loop_variants"]), loop_horizon)
     rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]))
+    rows += _fig6_path_rows(pd.read_csv(inputs["fig6_paths"]), finding_settings["F_fig6_zigzag_cause"])
     ev_conv = pd.read_csv(inputs["evader"])
     rows.append({"quantity": "evader.convergence", "value": float(ev_conv.loc[ev_conv["configured"], "certified_fraction"].iloc[0]),
                  "note": evader_text(ev_conv)})

@@ -14,7 +14,7 @@ from ...plotting import new_figure, save_figure
 
 __all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
            "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired",
-           "figure_loop_variants", "figure_kalman_best"]
+           "figure_loop_variants", "figure_kalman_best", "figure_fig6_paths"]
 
 
 def figure_noise(params, inputs, outputs):
@@ -322,5 +322,33 @@ def figure_kalman_best(params, inputs, outputs):
         ax.legend(fontsize=6)
     fig.suptitle(f"Kalman at its best: {int(kb['runs'].iloc[0])} judged runs, best settings chosen on separate runs "
                  "(below 0: H-infinity better)", fontsize=9)
+    save_figure(fig, outputs["figure"])
+    return {}
+
+
+def figure_fig6_paths(params, inputs, outputs):
+    """Fig S7: run 0 of Fig 6's scenario under each control variant (issue 28: why the paths zig-zag)."""
+    table = pd.read_csv(inputs["table"]).set_index("variant")
+    paths = pd.read_csv(inputs["paths"], dtype={"who": str})
+    variants = list(table.index)
+    fig, axes = new_figure(1, len(variants), figsize=(4.2 * len(variants), 4.4), squeeze=False)
+    for ax, variant in zip(axes[0], variants):
+        sub = paths[paths["variant"] == variant]
+        for who, g in sub.groupby("who", sort=False):
+            if who == "target":
+                ax.plot(g["x"], g["y"], color="0.3", lw=0.8)
+                ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "ks", ms=6)
+            else:
+                ax.plot(g["x"], g["y"], color=f"C{int(who)}", lw=0.7)
+                ax.plot(g["x"].iloc[0], g["y"].iloc[0], "o", mfc="none", color=f"C{int(who)}", ms=6)
+                ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "o", color=f"C{int(who)}", ms=6)
+        r = table.loc[variant]
+        ax.set_title(f"{variant}\nreversals {r['reversal_fraction']:.2%} of step pairs, {r['clipped_fraction']:.0%} "
+                     "of steps clipped", fontsize=8)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+    fig.suptitle(f"Why Fig 6's paths zig-zag: run 0 under each control variant (same seed); rates over "
+                 f"{int(table['runs'].iloc[0])} runs (open: start, filled: end, square: target's end)", fontsize=9)
     save_figure(fig, outputs["figure"])
     return {}

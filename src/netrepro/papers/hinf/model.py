@@ -329,7 +329,8 @@ def simulate(sc: dict) -> dict:
         # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
         if mobile:
             gi = gi_of[driver]
-            xh = est[driver]  # (R, N, 2)
+            # each agent steers by its own estimate; ``steer_on_truth`` (a cause test) by the true position
+            xh = np.broadcast_to(x[:, None, :], est[driver].shape) if ctrl.get("steer_on_truth") else est[driver]
             d = xh - P
             rh, thh = np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])
             rh = np.maximum(rh, 1e-6)

@@ -12,7 +12,7 @@ import numpy as np
 
 from .algebra import I2, inv2, kernel_operand, rotation, use_compiled
 
-__all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law"]
+__all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law", "path_statistics"]
 
 
 def sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar, kernel: str = "auto"):
@@ -143,3 +143,33 @@ def printed_control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float):
     """
     local = np.stack([dJ_dr, dJ_dtheta / r], -1)
     return -Gamma * (np.swapaxes(rotation(theta), -1, -2) @ local[..., None])[..., 0]
+
+
+def path_statistics(paths, v_max: float) -> dict[str, np.ndarray]:
+    """How the agents' paths move: heading reversals, clipped steps and step length, per run.
+
+    A step is ``p_i(k+1) - p_i(k)``. A heading reversal is a pair of consecutive steps of one agent
+    whose directions are more than 90 degrees apart (negative inner product): the zig-zag of Fig 6.
+    A clipped step is one the speed limit of :func:`control_law` shortened (length ``v_max`` to
+    within 1e-9 relative).
+
+    Parameters
+    ----------
+    paths : array_like, shape (runs, steps + 1, agents, 2)
+        Agent positions over time (``simulate(...)["agents"]``).
+    v_max : float
+        The speed limit of the control law (largest step length).
+
+    Returns
+    -------
+    dict of str to ndarray, each of shape (runs,)
+        ``reversal_fraction`` (reversals per pair of consecutive steps, over agents and time),
+        ``clipped_fraction`` (clipped steps per step) and ``mean_step`` (mean step length).
+    """
+    paths = np.asarray(paths, dtype=float)
+    steps = np.diff(paths, axis=1)
+    length = np.linalg.norm(steps, axis=-1)
+    turns = np.einsum("rkad,rkad->rka", steps[:, 1:], steps[:, :-1])
+    return {"reversal_fraction": (turns < 0).mean(axis=(1, 2)),
+            "clipped_fraction": (length >= v_max * (1 - 1e-9)).mean(axis=(1, 2)),
+            "mean_step": length.mean(axis=(1, 2))}

@@ -98,6 +98,7 @@ from .evader import evader_decisions
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
 from .model import (FILTER_KINDS, KINDS, FilterDoesNotExist, bonferroni_z, layout_positions, paired_z, resolve_scenario,
                     run_paired, simulate, tag_z, window_means)
+from .motion import path_statistics
 from .noise import NoiseModel, geometry, noise_covariance, noise_information, noise_variances, sample_noise
 
 __all__ = [
@@ -1184,3 +1185,66 @@ def kalman_best_merge_step(params, inputs, outputs):
     table["z_crit"] = zc
     table["tag"] = [tag_z(z, zc) for z in table["z"]]
     return {"table": table}
+
+
+# --------------------------------------------------------------------------- issue 28: why Fig 6's paths zig-zag
+def fig6_paths_step(params, inputs, outputs):
+    """Why do Fig 6's agent paths zig-zag? Heading reversals under control variants, paired by seed.
+
+    The scenario ``fig6_paths.scenario`` (agents moved by its driver) is run with the configured
+    control law and with each variant of ``fig6_paths.variants``, which replaces keys of ``control``:
+    ``steer_on_truth`` (each agent steers by the true target position instead of its estimate),
+    a smaller gain ``Gamma`` of eq (12), a smaller speed limit ``v_max``. Every variant uses the
+    same seeds, so its per-run statistics are compared with the nominal ones run by run
+    (:func:`.model.paired_z`; Bonferroni over the variants at ``tests.alpha``).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration; read: ``fig6_paths`` (``scenario``, ``runs``, ``seed``,
+        ``variants``), ``tests.alpha``, ``claims.late_start`` and what :func:`.model.resolve_scenario` reads.
+    inputs : dict
+        Only the step's code (no table is read).
+    outputs : dict
+        ``table``: ``results/hinf/fig6_paths.csv``; ``paths``: ``results/hinf/fig6_paths_run0.csv``.
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "paths": DataFrame}``. ``table``: one row per variant (``variant``, ``runs``,
+        ``reversal_fraction``, ``reversal_se``, ``clipped_fraction``, ``mean_step``, ``topology_changes``,
+        ``connected_fraction``, ``error_late``, and against the nominal run by run ``reversal_diff``,
+        ``reversal_diff_se``, ``z``, ``z_crit``, ``tag``). ``paths``: run 0's agent and target positions
+        (``variant, k, who, x, y``; ``who`` is the agent index or ``target``).
+    """
+    cfg, fp = params, params["fig6_paths"]
+    start = int(cfg["claims"]["late_start"])
+    variants = [{"label": "nominal", "control": {}}] + list(fp["variants"])
+    z_crit = bonferroni_z(float(cfg["tests"]["alpha"]), max(1, len(fp["variants"])))
+    rows, paths, nominal = [], [], None
+    for v in variants:
+        sc = resolve_scenario({**cfg, "control": {**cfg["control"], **v["control"]}}, fp["scenario"],
+                              runs=int(fp["runs"]), seed=int(fp["seed"]))
+        sc["filters"] = [sc["driver"]]
+        out = simulate(sc)
+        stats = path_statistics(out["agents"], float(sc["control"]["v_max"]))
+        rev = stats["reversal_fraction"]
+        row = {"variant": v["label"], "runs": len(rev), "reversal_fraction": float(rev.mean()),
+               "reversal_se": float(rev.std(ddof=1) / math.sqrt(len(rev))),
+               "clipped_fraction": float(stats["clipped_fraction"].mean()), "mean_step": float(stats["mean_step"].mean()),
+               "topology_changes": float(np.mean(out["topology_changes"])),
+               "connected_fraction": float(np.asarray(out["connected_runs"], dtype=float).mean()),
+               "error_late": float(window_means(out["errors"][sc["driver"]], start).mean())}
+        if nominal is None:
+            nominal = rev
+            row.update(reversal_diff=0.0, reversal_diff_se=0.0, z=np.nan, z_crit=z_crit, tag="")
+        else:
+            mean, se, z = paired_z(rev, nominal)
+            row.update(reversal_diff=mean, reversal_diff_se=se, z=z, z_crit=z_crit, tag=tag_z(z, z_crit))
+        rows.append(row)
+        ags, tgt = np.asarray(out["agents"])[0], np.asarray(out["target"])[0]
+        k = np.arange(ags.shape[0])
+        for i in range(ags.shape[1]):
+            paths.append(pd.DataFrame({"variant": v["label"], "k": k, "who": str(i), "x": ags[:, i, 0], "y": ags[:, i, 1]}))
+        paths.append(pd.DataFrame({"variant": v["label"], "k": k, "who": "target", "x": tgt[:, 0], "y": tgt[:, 1]}))
+    return {"table": pd.DataFrame(rows), "paths": pd.concat(paths, ignore_index=True)}
