@@ -549,13 +549,22 @@ def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
                      "note": ", ".join(f"{r.kind} {r.label_a} vs {r.label_b}: {r.tag} (z = {r.z:+.1f})" for r in g.itertuples())})
 
     def pattern(t):
+        # H-infinity beats Kalman(W), loses to Kalman(W_f) for every W_f from above W up to the kind's best setting
+        # (chosen on the selection runs) and loses best against best; W_f beyond the best (over-tuned) is reported only
         g = kb[kb["target"] == t]
-        at_w = g[g["W_factor_b"] == 1.0]
-        at_w = at_w[~at_w["comparison"].str.startswith("best")]
-        above = g[(g["W_factor_b"] > 1.0) & ~g["comparison"].str.startswith("best")]
-        best = g[g["comparison"].str.startswith("best")]
-        return bool((at_w["tag"] == "holds").all() and (above["tag"] == "reversed").all()
-                    and (best["tag"] == "reversed").all())
+        is_best = g["comparison"].str.startswith("best")
+        w_best = g[is_best].set_index("kind")["W_factor_b"]
+        at_w = g[(g["W_factor_b"] == 1.0) & ~is_best]
+        up_to_best = g[(g["W_factor_b"] > 1.0) & (g["W_factor_b"] <= g["kind"].map(w_best)) & ~is_best]
+        return bool((at_w["tag"] == "holds").all() and (up_to_best["tag"] == "reversed").all()
+                    and (g[is_best]["tag"] == "reversed").all())
+
+    def beyond_best(t):
+        g = kb[kb["target"] == t]
+        is_best = g["comparison"].str.startswith("best")
+        w_best = g[is_best].set_index("kind")["W_factor_b"]
+        over = g[(g["W_factor_b"] > g["kind"].map(w_best)) & ~is_best]
+        return ", ".join(f"{r.kind} W_f = {r.W_factor_b:g} {r.tag} (z = {r.z:+.1f})" for r in over.itertuples()) or "none"
 
     def text(t):
         g = kb[kb["target"] == t]
@@ -566,12 +575,13 @@ def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
 
     targets = list(dict.fromkeys(kb["target"]))
     rows.append({"quantity": "premise.kalman_at_best", "value": pattern("evasive"),
-                 "note": head + ". " + " | ".join(text(t) for t in targets)})
+                 "note": head + ". Above each kind's best W_f (over-tuned, not judged), evasive target: "
+                         + beyond_best("evasive") + ". " + " | ".join(text(t) for t in targets)})
     controls = [t for t in targets if t in ("drift", "evasive_noise")]
     rows.append({"quantity": "premise.control_targets", "value": bool(controls and all(pattern(t) for t in controls)),
                  "note": "the pattern of the evasive target (H-infinity beats the Kalman filter designed for W, loses to it "
-                         f"designed for {kb.loc[kb['W_factor_b'] > 1.0, 'W_factor_b'].min():g} W or more and at the best "
-                         "settings) at the control targets: "
+                         f"designed for {kb.loc[kb['W_factor_b'] > 1.0, 'W_factor_b'].min():g} W up to the kind's best "
+                         "setting and at the best settings) at the control targets: "
                          + ", ".join(f"{t} {'same' if pattern(t) else 'different'}" for t in controls)})
     return rows
 

@@ -316,6 +316,7 @@ def figure_kalman_best(params, inputs, outputs):
             ax.errorbar([b["W_factor_b"]], [b["mean_diff"]], yerr=[2 * b["se"]], fmt="*", ms=11, color=f"C{i}",
                         capsize=3, label=f"{kind}: best vs best ({b['label_a']} vs W_f = {b['W_factor_b']:g})")
         ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xscale("log")  # W_f from 1 to 50 x W
         ax.set_xlabel("Kalman design W_f / W")
         ax.set_ylabel("error(H-inf) - error(Kalman), +- 2 SE")
         ax.set_title(f"{target} target (20-step displacement {sub['displacement'].iloc[0]:.2f})", fontsize=9)
