@@ -26,6 +26,20 @@ def test_shards_merged_in_any_order_equal_single_run():
         merge_block_sums([parts[0], parts[0]])
 
 
+def test_parts_without_blocks_are_left_out_of_the_merge():
+    # more shards than blocks: some shards get no block (and no keys); first, middle or all empty
+    ref = run_monte_carlo(_sim, 5000, 500, seed=9)
+    empty = run_blocks(_sim, 5000, 500, 9, blocks=[])
+    assert len(empty.blocks) == 0 and not empty.sums
+    full = [run_blocks(_sim, 5000, 500, 9, blocks=b) for b in ([0, 1, 2, 3, 4], [5, 6, 7, 8, 9])]
+    for parts in ([empty] + full, [full[0], empty, full[1]], full + [empty, empty]):
+        merged = merge_block_sums(parts)
+        assert np.array_equal(merged.blocks, ref.blocks) and np.array_equal(ref.std("x2"), merged.std("x2"))
+    assert len(merge_block_sums([empty, empty]).blocks) == 0
+    with pytest.raises(ValueError, match="no part"):
+        merge_block_sums([])
+
+
 def test_mean_and_interval_cover_truth():
     res = run_monte_carlo(_sim, 200_000, 20_000, seed=1)
     m, lo, hi = res.ci("x")

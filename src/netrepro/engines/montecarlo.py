@@ -173,7 +173,8 @@ def merge_block_sums(parts) -> MonteCarloSums:
     Parameters
     ----------
     parts : iterable of MonteCarloSums
-        Results over disjoint sets of blocks, with the same keys.
+        Results over disjoint sets of blocks, with the same keys. A part without blocks (a shard
+        that got none, when there are more shards than blocks) has no keys and is left out.
 
     Returns
     -------
@@ -183,9 +184,12 @@ def merge_block_sums(parts) -> MonteCarloSums:
     Raises
     ------
     ValueError
-        If a block appears in two parts.
+        If a block appears in two parts, or no part is given.
     """
-    parts = list(parts)
+    given = list(parts)
+    if not given:
+        raise ValueError("merge_block_sums: no part to merge")
+    parts = [p for p in given if len(p.blocks)] or given[:1]
     blocks = np.concatenate([p.blocks for p in parts])
     order = np.argsort(blocks, kind="stable")
     if len(np.unique(blocks)) != len(blocks):
