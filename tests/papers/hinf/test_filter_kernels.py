@@ -89,3 +89,34 @@ def test_sample_noise_rotation_kernel_matches_numpy(lead):
         a = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="numpy")
         b = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="compiled")
         assert a.shape == lead + (2,) and a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("lead", [(40, 10), (60,), (1,), (9, 1), ()])
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_hinf_update_batch_matches_each_filter(lead, kernel):
+    """The stacked update of filters with their own gamma and design W equals hinf_update filter by filter."""
+    rng = np.random.default_rng(7)
+    r, th = _information(lead, 8)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    gi = np.array([0.0, 1 / 9, 0.3, 0.0])  # Kalman, gamma = 3, gamma ~ 1.8, Kalman at another W
+    BWB = np.stack([w * np.eye(2) for w in (0.01, 0.01, 0.02, 0.05)])
+    xh = rng.normal(size=(4,) + lead + (2,))
+    Sig = np.broadcast_to(4.0 * np.eye(2), (4,) + lead + (2, 2)).copy()
+    for _ in range(20):
+        y = rng.normal(size=lead + (2,))
+        got = F.hinf_update_batch(xh, Sig, y, S, A_ROT, BWB, gi, np.eye(2), check=False, kernel=kernel)
+        for f in range(4):
+            ref = F.hinf_update(xh[f], Sig[f], y, S, A_ROT, BWB[f], gi[f], np.eye(2), check=False, kernel="numpy")
+            assert _same(ref, [g[f] for g in got])
+        xh, Sig = got[0], got[1]
+
+
+def test_hinf_update_batch_raises_if_any_filter_does_not_exist():
+    r, th = _information((5, 3), 9)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    xh, Sig = np.zeros((2, 5, 3, 2)), np.broadcast_to(4.0 * np.eye(2), (2, 5, 3, 2, 2)).copy()
+    args = (xh, Sig, np.zeros((5, 3, 2)), S, np.eye(2), np.stack([0.01 * np.eye(2)] * 2))
+    for kernel in ("numpy", "compiled"):
+        F.hinf_update_batch(*args, np.array([0.0, 1 / 9]), np.eye(2), kernel=kernel)
+        with pytest.raises(F.FilterDoesNotExist):
+            F.hinf_update_batch(*args, np.array([0.0, 100.0]), np.eye(2), kernel=kernel)

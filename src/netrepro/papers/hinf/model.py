@@ -22,7 +22,7 @@ from .algebra import I2, min_eig2, sym2
 from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, component_sums, laplacian,
                         pi_consensus_step, topology_changed)
 from .evader import SOLVERS, evader_move
-from .filters import FilterDoesNotExist, decentralized_update, hinf_update, minimum_attenuation
+from .filters import FilterDoesNotExist, hinf_update_batch, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
 
@@ -232,18 +232,25 @@ def simulate(sc: dict) -> dict:
     x = np.broadcast_to(np.asarray(sc["target0"], dtype=float), (R, 2)).copy()
     x0hat = x + np.sqrt(float(sc["P0"])) * rng0.standard_normal((R, 2))
     Sig0 = float(sc["P0"]) * I2
-    est, cov = {}, {}
+    # the filters of one kind are fed the same measurements: updated together, stacked on a leading axis
+    groups = {}
     for name in names:
-        kind, _ = kind_of[name]
-        shape = (R,) if kind == "centralized" else (R, N)
-        est[name] = np.broadcast_to(x0hat[:, None, :] if kind != "centralized" else x0hat, shape + (2,)).copy()
-        cov[name] = np.broadcast_to(Sig0, shape + (2, 2)).copy()
-    errors = {n: np.empty((R, 1 if kind_of[n][0] == "centralized" else N, K + 1)) for n in names}
-    trace_sigma = {n: np.empty((R, K + 1)) for n in names}
-    for n in names:
-        e = np.linalg.norm(est[n] - (x if kind_of[n][0] == "centralized" else x[:, None, :]), axis=-1)
-        errors[n][..., 0] = e if e.ndim == 2 else e[:, None]
-        trace_sigma[n][:, 0] = 2 * float(sc["P0"])
+        groups.setdefault(kind_of[name][0], []).append(name)
+    slot = {n: (kind, i) for kind, labs in groups.items() for i, n in enumerate(labs)}
+    est, cov, delta, err_g, tr_g, bwb_g, gi_g = {}, {}, {}, {}, {}, {}, {}
+    for kind, labs in groups.items():
+        shape = (len(labs), R) if kind == "centralized" else (len(labs), R, N)
+        est[kind] = np.broadcast_to(x0hat[:, None, :] if kind != "centralized" else x0hat, shape + (2,)).copy()
+        cov[kind] = np.broadcast_to(Sig0, shape + (2, 2)).copy()
+        err_g[kind] = np.empty((len(labs), R, 1 if kind == "centralized" else N, K + 1))
+        tr_g[kind] = np.empty((len(labs), R, K + 1))
+        bwb_g[kind] = np.stack([bwb_of[n] for n in labs])
+        gi_g[kind] = np.array([gi_of[n] for n in labs])
+        e = np.linalg.norm(est[kind] - (x if kind == "centralized" else x[:, None, :]), axis=-1)
+        err_g[kind][..., 0] = e if e.ndim == 3 else e[..., None]
+        tr_g[kind][:, :, 0] = 2 * float(sc["P0"])
+    errors = {n: err_g[slot[n][0]][slot[n][1]] for n in names}
+    trace_sigma = {n: tr_g[slot[n][0]][slot[n][1]] for n in names}
     tgt = np.empty((R, K + 1, 2))
     tgt[:, 0] = x
     ags = np.empty((R, K + 1, N, 2))
@@ -309,32 +316,30 @@ def simulate(sc: dict) -> dict:
         if record:
             info_hist["local"][k - 1] = Minv
         # 4. filters (6), (9) and their Kalman counterparts
-        deltas = {}
-        for n in names:
-            kind, _ = kind_of[n]
-            gi = gi_of[n]
+        for kind in groups:
             if kind == "local":
-                out = hinf_update(est[n], cov[n], yinfo, Minv, A, bwb_of[n], gi, Lbar)
+                y_k, S_k = yinfo, Minv
             elif kind == "centralized":
-                out = hinf_update(est[n], cov[n], yinfo.sum(1), Minv.sum(1), A, bwb_of[n], gi, Lbar)
-            else:
-                out = decentralized_update(est[n], cov[n], yt, Ct, N, A, bwb_of[n], gi, Lbar)
-            est[n], cov[n], deltas[n] = out[0], out[1], out[2]
+                y_k, S_k = yinfo.sum(1), Minv.sum(1)
+            else:  # eq (9) is eq (6) with S = N C~, y_info = N y~ (decentralized_update)
+                y_k, S_k = N * yt, N * Ct
+            est[kind], cov[kind], delta[kind], _ = hinf_update_batch(est[kind], cov[kind], y_k, S_k, A, bwb_g[kind],
+                                                                     gi_g[kind], Lbar)
             if kind == "centralized":
-                errors[n][:, 0, k] = np.linalg.norm(est[n] - x, axis=-1)
-                trace_sigma[n][:, k] = cov[n][..., 0, 0] + cov[n][..., 1, 1]
+                err_g[kind][:, :, 0, k] = np.linalg.norm(est[kind] - x, axis=-1)
+                tr_g[kind][:, :, k] = cov[kind][..., 0, 0] + cov[kind][..., 1, 1]
             else:
-                errors[n][:, :, k] = np.linalg.norm(est[n] - x[:, None, :], axis=-1)
-                trace_sigma[n][:, k] = (cov[n][..., 0, 0] + cov[n][..., 1, 1]).mean(1)
+                err_g[kind][:, :, :, k] = np.linalg.norm(est[kind] - x[:, None, :], axis=-1)
+                tr_g[kind][:, :, k] = (cov[kind][..., 0, 0] + cov[kind][..., 1, 1]).mean(2)
         # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
         if mobile:
             gi = gi_of[driver]
-            xh = est[driver]  # (R, N, 2)
+            xh = est[slot[driver][0]][slot[driver][1]]  # (R, N, 2)
             d = xh - P
             rh, thh = np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])
             rh = np.maximum(rh, 1e-6)
             _, dMr, dMt = noise_information(rh, thh, model, derivatives=True)
-            Delta = deltas[driver]
+            Delta = delta[slot[driver][0]][slot[driver][1]]
             S_hat = N * Ct if kind_of[driver][0] == "decentralized" else Minv
             grads = []
             for z, dM in enumerate((dMr, dMt)):
