@@ -287,6 +287,7 @@ def scenario_tables(name: str, out: dict, sc: dict, cfg: dict) -> dict:
 
 def simulate_step(params, inputs, outputs):
     """Simulate one scenario of Section VI (``params['scenario']``) and write its tables."""
+    from . import filter_kernels  # noqa: F401  numba: pays its load (~0.3 s) in the 200-run scenarios, even elsewhere
     name = params["scenario"]
     cfg = params["cfg"]
     sc = resolve_scenario(cfg, name)
@@ -602,6 +603,7 @@ def evasive_network_step(params, inputs, outputs):
     The scenario ``paired.scenario`` is run against each target of ``paired.targets`` (agents moved by its
     driver), with ``paired.network_runs`` runs and seed ``paired.seed``.
     """
+    from . import filter_kernels  # noqa: F401  numba: the filters and the evader's exact solver compiled (~0.2 s less)
     cfg, pc = params, params["paired"]
     start = int(cfg["claims"]["late_start"])
     rows = []
