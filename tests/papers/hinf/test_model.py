@@ -443,3 +443,24 @@ def test_connected_matches_the_laplacian_spectrum():
         a = a + np.swapaxes(a, -1, -2)
         got = _connected(a)
         assert np.array_equal(got, by_spectrum(a)) and 0 < got.sum() < len(a)
+
+
+@pytest.mark.parametrize("mobile", [False, True])
+def test_consensus_variants_equal_their_own_simulations(mobile):
+    """A decentralized filter on a consensus variant gives the numbers of the simulation with that consensus alone
+    (stationary agents; mobile agents move by the driver on the configured consensus, unchanged by the variants)."""
+    variants = {"ki0": {"K_i": 0.0}, "gc2": {"gamma_c": 2.0}, "reset": {"design": "pi_reset"},
+                "exact": {"design": "exact_component"}, "complete": {"design": "complete", "iters": 2}}
+    sc = _scenario(agents0=_agents(4, 30.0, 30.0, -135.0), mobile=mobile, filters=["local", "decentralized"])
+    out = simulate({**sc, "consensus_variants": variants})
+    alone = simulate(sc)
+    for name in ("local", "decentralized"):
+        assert np.array_equal(out["errors"][name], alone["errors"][name])
+    assert np.array_equal(out["agents"], alone["agents"]) and out["n_psd_fix"] == alone["n_psd_fix"]
+    assert list(out["errors"]) == ["local", "decentralized"] + list(variants)
+    for lab, over in variants.items():
+        if not mobile:
+            one = simulate({**sc, "consensus": {**sc["consensus"], **over}})
+            assert np.array_equal(out["errors"][lab], one["errors"]["decentralized"]), lab
+        if lab != "reset" or alone["topology_changes"].any():  # no topology change: nothing to reset
+            assert not np.array_equal(out["errors"][lab], alone["errors"]["decentralized"]), lab

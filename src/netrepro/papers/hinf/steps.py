@@ -446,13 +446,17 @@ def fig2_horizon_step(params, inputs, outputs):
     gain_variants = [(f"_{key}{float(v):g}", {"consensus": {key: float(v)}}, False)
                      for key in ("gamma_c", "K_p") for v in cfg["sensitivity"][key]
                      if float(v) != float(cfg["consensus"][key])]
+    variants = [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants
     for scen in fh["scenarios"]:
-        for suffix, over, per_agent in [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants:
-            sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]), **over)
-            sc["filters"] = ["local", "decentralized"]
-            out = simulate(sc)
-            e_loc, e_dec = out["errors"]["local"], out["errors"]["decentralized"]
-            c = sc["consensus"]
+        # one simulation per scenario: the variants differ only in the consensus, so they share the target,
+        # the measurements and the local filter; each has its own decentralized filter (same numbers as alone)
+        sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]))
+        sc["filters"] = ["local", "decentralized"]
+        sc["consensus_variants"] = {suffix: over["consensus"] for suffix, over, _ in variants if suffix}
+        out = simulate(sc)
+        for suffix, over, per_agent in variants:
+            e_loc, e_dec = out["errors"]["local"], out["errors"][suffix or "decentralized"]
+            c = {**sc["consensus"], **over.get("consensus", {})}
             for H in fh["horizons"]:
                 H = int(H)
                 agents = list(range(e_loc.shape[1])) if per_agent else []
@@ -474,7 +478,6 @@ def fig2_horizon_step(params, inputs, outputs):
             if scen == fh["scenarios"][0]:
                 lap = laplacian(adjacency(sc["agents0"], sc["radius"]))
                 lam = np.linalg.eigvalsh(lap)
-                c = sc["consensus"]
                 rho, tau = pi_consensus_time_constants(lam, c["gamma_c"], c["h"], c["K_p"], c["K_i"])
                 modes.append(pd.DataFrame({"scenario": scen + suffix, "K_i": c["K_i"], "mode": np.arange(len(lam)),
                                            "laplacian_eigenvalue": lam, "modulus": rho,
