@@ -479,7 +479,10 @@ def _fused_trace_bounds_flat(Mf, lam, compiled: bool):
     lam = np.ascontiguousarray(lam, dtype=float)
     value, grad = np.empty(len(lam)), np.empty(lam.shape)
     bounds_kernel(Mf, lam, value, grad)
-    gap = np.einsum("...n,...n->...", grad, lam) - grad.min(-1)
+    gmin = grad[:, 0].copy()  # grad.min(-1) column by column (a minimum is exact: the same numbers, ~10x faster)
+    for j in range(1, grad.shape[1]):
+        np.minimum(gmin, grad[:, j], out=gmin)
+    gap = np.einsum("...n,...n->...", grad, lam) - gmin
     return value, value - gap
 
 
