@@ -338,7 +338,7 @@ def _sensitivity(params, evasive):
     rows = []
     lap = laplacian(adjacency(layout_positions(cfg["layouts"][cfg["scenarios"]["fig2"]["layout"]]), cfg["comm_radius"]))
 
-    def run(parameter, value, scen, overrides):
+    def prepare(parameter, value, scen, overrides):
         sc = resolve_scenario(cfg, scen, runs=int(sv["runs"]), horizon=int(sv["horizon"]), seed=int(sv["seed"]),
                               **overrides)
         sc["filters"] = [f for f in ("local", "decentralized", "centralized") if f in sc["filters"]] or sc["filters"]
@@ -349,6 +349,23 @@ def _sensitivity(params, evasive):
         row = {"parameter": parameter, "value": value, "W": float(cfg["scenarios"][scen]["W"]), "scenario": scen,
                "exists": True, "consensus_stable": bool(stable), "local_error": np.nan, "decentralized_error": np.nan,
                "centralized_error": np.nan, "ratio_dec_local": np.nan, "settle_k": -1}
+        return sc, row
+
+    def fill(row, sc, errors):
+        for f in ("local", "decentralized", "centralized"):
+            key = sc["driver"] if (sc["mobile"] and f == "decentralized") else f
+            if key in errors:
+                e = errors[key]
+                row[f + "_error"] = float(e[..., start:].mean()) if np.all(np.isfinite(e)) else np.inf
+        row["ratio_dec_local"] = row["decentralized_error"] / row["local_error"]
+        dec = sc["driver"] if sc["mobile"] else "decentralized"
+        mean = errors[dec].reshape(-1, sc["horizon"] + 1).mean(0)
+        below = mean <= float(cfg["claims"]["settle_threshold"])
+        row["settle_k"] = next((k for k in range(len(mean)) if below[k:].all()), -1)
+        rows.append(row)
+
+    def run(parameter, value, scen, overrides):
+        sc, row = prepare(parameter, value, scen, overrides)
         try:
             with np.errstate(all="ignore"):
                 out = simulate(sc)
@@ -356,17 +373,24 @@ def _sensitivity(params, evasive):
             row["exists"] = False
             rows.append(row)
             return
-        for f in ("local", "decentralized", "centralized"):
-            key = sc["driver"] if (sc["mobile"] and f == "decentralized") else f
-            if key in out["errors"]:
-                e = out["errors"][key]
-                row[f + "_error"] = float(e[..., start:].mean()) if np.all(np.isfinite(e)) else np.inf
-        row["ratio_dec_local"] = row["decentralized_error"] / row["local_error"]
-        dec = sc["driver"] if sc["mobile"] else "decentralized"
-        mean = out["errors"][dec].reshape(-1, sc["horizon"] + 1).mean(0)
-        below = mean <= float(cfg["claims"]["settle_threshold"])
-        row["settle_k"] = next((k for k in range(len(mean)) if below[k:].all()), -1)
-        rows.append(row)
+        fill(row, sc, out["errors"])
+
+    def run_consensus(scen, sweep):
+        """The rows of ``run(key, val, scen, {"consensus": {key: val}})`` for each ``(key, val)`` of ``sweep``, from
+        one simulation with a decentralized filter per consensus variant (stationary agents: the same target,
+        measurements, local and centralized filters in every variant; the same numbers as one run each)."""
+        base, _ = prepare(None, None, scen, {})
+        if base["mobile"]:
+            return [run(key, val, scen, {"consensus": {key: val}}) for key, val in sweep]
+        base["consensus_variants"] = {f"{key}={val!r}": {key: val} for key, val in sweep}
+        try:
+            with np.errstate(all="ignore"):
+                out = simulate(base)
+        except FilterDoesNotExist:  # some variant's filter does not exist: each variant on its own
+            return [run(key, val, scen, {"consensus": {key: val}}) for key, val in sweep]
+        for key, val in sweep:
+            sc, row = prepare(key, val, scen, {"consensus": {key: val}})
+            fill(row, sc, {**out["errors"], "decentralized": out["errors"][f"{key}={val!r}"]})
 
     if evasive:
         # does H-infinity pay off against the evasive target? gamma sweep; gamma = inf is the Kalman-driven scenario
@@ -377,9 +401,7 @@ def _sensitivity(params, evasive):
     for scen in sv["random_scenarios"]:
         for g in sv["gamma"]:
             run("gamma", g, scen, {"filter": {"gamma": g}})
-        for key in ("gamma_c", "K_p", "K_i", "h", "iters"):
-            for val in sv[key]:
-                run(key, val, scen, {"consensus": {key: val}})
+        run_consensus(scen, [(key, val) for key in ("gamma_c", "K_p", "K_i", "h", "iters") for val in sv[key]])
     for key in ("Gamma", "v_max"):
         for val in sv[key]:
             run(key, val, sv["mobile_scenario"], {"control": {key: val}})
