@@ -120,3 +120,25 @@ def test_hinf_update_batch_raises_if_any_filter_does_not_exist():
         F.hinf_update_batch(*args, np.array([0.0, 1 / 9]), np.eye(2), kernel=kernel)
         with pytest.raises(F.FilterDoesNotExist):
             F.hinf_update_batch(*args, np.array([0.0, 100.0]), np.eye(2), kernel=kernel)
+
+
+def _steady_state_prior_all_iterations(S, W, gamma_inv2, Lbar, n_iter):
+    """Reference: every one of the ``n_iter`` fixed-point iterations of filters.steady_state_prior."""
+    S = np.asarray(S, dtype=float)
+    eye = np.broadcast_to(np.eye(2), S.shape)
+    Delta = W * eye.copy()
+    for _ in range(n_iter):
+        Sigma = Delta @ np.linalg.inv(eye - gamma_inv2 * Lbar @ Delta + S @ Delta)
+        Delta = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+    return Delta
+
+
+@pytest.mark.parametrize("n_iter", [1, 2, 7, 300, 3000, 3001])
+@pytest.mark.parametrize("gamma_inv2", [0.0, 1 / 9, 0.3])
+def test_steady_state_prior_stops_early_on_the_same_bits(n_iter, gamma_inv2):
+    """Stopping once the iterates repeat (period 1 or 2) gives the last of the n_iter iterates, bit for bit."""
+    r, th = _information((3, 10), 21)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    for s in (S, S.sum(1), S[0, 0]):
+        got = F.steady_state_prior(s, 0.001, gamma_inv2, np.eye(2), n_iter=n_iter)
+        assert got.tobytes() == _steady_state_prior_all_iterations(s, 0.001, gamma_inv2, np.eye(2), n_iter).tobytes()

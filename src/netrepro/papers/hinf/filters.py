@@ -371,9 +371,15 @@ def steady_state_prior(S, W: float, gamma_inv2: float, Lbar, n_iter: int = 3000)
     S = np.asarray(S, dtype=float)
     eye = np.broadcast_to(np.eye(2), S.shape)
     Delta = W * eye.copy()
-    for _ in range(n_iter):
+    prev = None
+    for i in range(n_iter):
         Sigma = Delta @ np.linalg.inv(eye - gamma_inv2 * Lbar @ Delta + S @ Delta)
-        Delta = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+        new = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+        if prev is not None and new.tobytes() == prev.tobytes():
+            # the iterates now repeat with period 1 or 2, bit for bit (the map is deterministic): the last one
+            # of the n_iter is known without computing the rest
+            return new if (n_iter - 1 - i) % 2 == 0 else Delta
+        prev, Delta = Delta, new
     return Delta
 
 
