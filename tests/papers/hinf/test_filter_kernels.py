@@ -142,3 +142,27 @@ def test_steady_state_prior_stops_early_on_the_same_bits(n_iter, gamma_inv2):
     for s in (S, S.sum(1), S[0, 0]):
         got = F.steady_state_prior(s, 0.001, gamma_inv2, np.eye(2), n_iter=n_iter)
         assert got.tobytes() == _steady_state_prior_all_iterations(s, 0.001, gamma_inv2, np.eye(2), n_iter).tobytes()
+
+
+@pytest.mark.parametrize("lead", [(30, 4), (7,), (1,), ()])
+@pytest.mark.parametrize("A", [np.eye(2), A_ROT, -A_ROT])
+def test_congruence_kernel_matches_numpy(lead, A):
+    rng = np.random.default_rng(22)
+    X = rng.normal(size=lead + (2, 2))
+    X.reshape(-1, 4)[::3] = [-0.0, 0.0, -0.0, -0.0]  # signed zeros: numpy's dgemm returns +0.0
+    a = F.congruence(A, X, kernel="numpy")
+    b = F.congruence(A, X, kernel="compiled")
+    assert a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("lead", [(30, 4), (7,), ()])
+def test_control_law_kernel_matches_numpy(lead):
+    from netrepro.papers.hinf.motion import control_law
+
+    r, th = _information(lead, 23)
+    rng = np.random.default_rng(24)
+    dr, dt = rng.normal(size=lead), rng.normal(size=lead)
+    for v_max in (np.inf, 0.5):
+        a = control_law(dr, dt, r, th, 2e4, v_max, kernel="numpy")
+        b = control_law(dr, dt, r, th, 2e4, v_max, kernel="compiled")
+        assert a.shape == b.shape and a.tobytes() == b.tobytes()

@@ -21,7 +21,7 @@ from llvmlite import ir as llvm_ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-__all__ = ["fma", "hinf_update_kernel", "hinf_update_batch_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
+__all__ = ["fma", "hinf_update_kernel", "hinf_update_batch_kernel", "congruence_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
            "rotate_kernel"]
 
 
@@ -191,6 +191,25 @@ def _hinf_one(x0, x1, s00, s01, s10, s11, y0, y1, S00, S01, S10, S11, A, BWB, gL
     f00, f01, f10, f11 = _information(d00, d01, d10, d11, S00, S01, S10, S11, gL00, gL01, gL10, gL11)
     return (p0 + c0, p1 + c1, 0.5 * (e00 + e00), 0.5 * (e01 + e10), 0.5 * (e10 + e01), 0.5 * (e11 + e11),
             d00, d01, d10, d11, _min_eig2(f00, f01, f10, f11))
+
+
+@njit(cache=True, error_model="numpy")
+def congruence_kernel(X, A, out):
+    """``A X A^T`` of ``B`` flattened 2x2 matrices as numpy's ``A @ X @ A.T`` rounds it (two ``dgemm``), into ``out``.
+
+    Parameters
+    ----------
+    X : ndarray ``(B, 2, 2)``
+        The matrices.
+    A : ndarray ``(2, 2)``
+        The transformation (target dynamics).
+    out : ndarray ``(B, 2, 2)``
+        Receives ``A X A^T``.
+    """
+    for b in range(X.shape[0]):
+        t00, t01, t10, t11 = _mm(A[0, 0], A[0, 1], A[1, 0], A[1, 1], X[b, 0, 0], X[b, 0, 1], X[b, 1, 0], X[b, 1, 1])
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = _mm(t00, t01, t10, t11, A[0, 0], A[1, 0], A[0, 1],
+                                                                     A[1, 1])
 
 
 @njit(cache=True, error_model="numpy")

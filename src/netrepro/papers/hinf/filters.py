@@ -12,7 +12,7 @@ from ...errors import ModelError
 from .algebra import I2, inv2, kernel_operand, min_eig2, sym2, use_compiled
 
 __all__ = [
-    "FilterDoesNotExist", "hinf_information", "hinf_update", "hinf_update_batch", "decentralized_update", "kalman_update",
+    "FilterDoesNotExist", "hinf_information", "hinf_update", "hinf_update_batch", "congruence", "decentralized_update", "kalman_update",
     "minimum_attenuation", "steady_state_prior", "gain_norms",
 ]
 
@@ -204,6 +204,34 @@ def hinf_update_batch(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar, check: b
     if check and not np.all(out[3] > 0):
         raise FilterDoesNotExist(
             f"Sigma^-1 not positive definite (min eigenvalue {np.min(out[3]):.3g}): gamma below gamma_0")
+    return out
+
+
+def congruence(A, X, kernel: str = "auto"):
+    """``A X A^T`` for a stack of 2x2 matrices (the prior's propagation in eqs (6) and (14)), as ``A @ X @ A.T``.
+
+    Parameters
+    ----------
+    A : ndarray, shape ``(2, 2)``
+        Target dynamics.
+    X : ndarray, shape ``(..., 2, 2)``
+        The matrices.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: :func:`.filter_kernels.congruence_kernel` (bit-identical to numpy's ``matmul``);
+        ``"numpy"``: ``A @ X @ A.T``; ``"auto"``: see :func:`.algebra.use_compiled`.
+
+    Returns
+    -------
+    ndarray, shape of ``X``
+    """
+    X = np.asarray(X, dtype=float)
+    if not use_compiled(kernel, X.size // 4):
+        return A @ X @ A.T
+    from .filter_kernels import congruence_kernel  # numba: imported by the steps that run a filter
+
+    out = np.empty(X.shape)
+    congruence_kernel(kernel_operand(X, X.shape).reshape(-1, 2, 2), np.array(A, dtype=float, order="C"),
+                      out.reshape(-1, 2, 2))
     return out
 
 

@@ -22,7 +22,7 @@ from .algebra import I2, min_eig2, sym2
 from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, component_membership, component_sums,
                         laplacian, pi_consensus_step, topology_changed)
 from .evader import SOLVERS, evader_move
-from .filters import FilterDoesNotExist, hinf_update_batch, minimum_attenuation
+from .filters import FilterDoesNotExist, congruence, hinf_update_batch, minimum_attenuation
 from .motion import control_law, sigma_gradient
 from .noise import NoiseModel, geometry, noise_information, sample_noise
 
@@ -362,7 +362,7 @@ def simulate(sc: dict) -> dict:
             S_hat = N * Ct[None] if kind_of[driver][0] == "decentralized" else Minv
             grads = []
             for z, dM in enumerate((dMr, dMt)):
-                dDelta = A @ dsig[z] @ A.T if ctrl.get("recursion", True) else np.zeros_like(Delta)
+                dDelta = congruence(A, dsig[z]) if ctrl.get("recursion", True) else np.zeros_like(Delta)
                 _, dS = sigma_gradient(Delta, dDelta, S_hat, dM, gi, Lbar)
                 dsig[z] = dS
                 grads.append(dS[..., 0, 0] + dS[..., 1, 1])
