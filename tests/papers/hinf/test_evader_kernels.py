@@ -113,3 +113,17 @@ def test_faces_kernel_matches_numpy_form_on_arbitrary_faces(k):
     assert not np.array_equal(f1, best_f0)  # the faces did improve some rows
     if k == 2:
         assert (l2[70:80, :2] == [0.0, 1.0]).all() and not np.signbit(l2[70:80]).any()
+
+
+@pytest.mark.parametrize("case", range(7))
+def test_compiled_bounds_match_numpy_form(case):
+    """The certificate (value, lower bound) of the compiled path, whose gradient minimum is taken column by column."""
+    M = np.ascontiguousarray(list(_exact_cases())[case], dtype=float)
+    n = M.shape[-3]
+    Mf = M.reshape(-1, n, 2, 2)
+    lam = np.random.default_rng(case).dirichlet(np.ones(n), size=len(Mf))
+    lam[::3, 0] = 0.0
+    lam /= lam.sum(-1, keepdims=True)
+    a = E.fused_trace_bounds(Mf, lam)
+    b = E._fused_trace_bounds_flat(Mf, lam, True)
+    assert all(u.tobytes() == v.tobytes() for u, v in zip(a, b))

@@ -89,3 +89,80 @@ def test_sample_noise_rotation_kernel_matches_numpy(lead):
         a = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="numpy")
         b = sample_noise(np.random.default_rng(3), r, theta, MODEL, kernel="compiled")
         assert a.shape == lead + (2,) and a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("lead", [(40, 10), (60,), (1,), (9, 1), ()])
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_hinf_update_batch_matches_each_filter(lead, kernel):
+    """The stacked update of filters with their own gamma and design W equals hinf_update filter by filter."""
+    rng = np.random.default_rng(7)
+    r, th = _information(lead, 8)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    gi = np.array([0.0, 1 / 9, 0.3, 0.0])  # Kalman, gamma = 3, gamma ~ 1.8, Kalman at another W
+    BWB = np.stack([w * np.eye(2) for w in (0.01, 0.01, 0.02, 0.05)])
+    xh = rng.normal(size=(4,) + lead + (2,))
+    Sig = np.broadcast_to(4.0 * np.eye(2), (4,) + lead + (2, 2)).copy()
+    for _ in range(20):
+        y = rng.normal(size=lead + (2,))
+        got = F.hinf_update_batch(xh, Sig, y, S, A_ROT, BWB, gi, np.eye(2), check=False, kernel=kernel)
+        for f in range(4):
+            ref = F.hinf_update(xh[f], Sig[f], y, S, A_ROT, BWB[f], gi[f], np.eye(2), check=False, kernel="numpy")
+            assert _same(ref, [g[f] for g in got])
+        xh, Sig = got[0], got[1]
+
+
+def test_hinf_update_batch_raises_if_any_filter_does_not_exist():
+    r, th = _information((5, 3), 9)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    xh, Sig = np.zeros((2, 5, 3, 2)), np.broadcast_to(4.0 * np.eye(2), (2, 5, 3, 2, 2)).copy()
+    args = (xh, Sig, np.zeros((5, 3, 2)), S, np.eye(2), np.stack([0.01 * np.eye(2)] * 2))
+    for kernel in ("numpy", "compiled"):
+        F.hinf_update_batch(*args, np.array([0.0, 1 / 9]), np.eye(2), kernel=kernel)
+        with pytest.raises(F.FilterDoesNotExist):
+            F.hinf_update_batch(*args, np.array([0.0, 100.0]), np.eye(2), kernel=kernel)
+
+
+def _steady_state_prior_all_iterations(S, W, gamma_inv2, Lbar, n_iter):
+    """Reference: every one of the ``n_iter`` fixed-point iterations of filters.steady_state_prior."""
+    S = np.asarray(S, dtype=float)
+    eye = np.broadcast_to(np.eye(2), S.shape)
+    Delta = W * eye.copy()
+    for _ in range(n_iter):
+        Sigma = Delta @ np.linalg.inv(eye - gamma_inv2 * Lbar @ Delta + S @ Delta)
+        Delta = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+    return Delta
+
+
+@pytest.mark.parametrize("n_iter", [1, 2, 7, 300, 3000, 3001])
+@pytest.mark.parametrize("gamma_inv2", [0.0, 1 / 9, 0.3])
+def test_steady_state_prior_stops_early_on_the_same_bits(n_iter, gamma_inv2):
+    """Stopping once the iterates repeat (period 1 or 2) gives the last of the n_iter iterates, bit for bit."""
+    r, th = _information((3, 10), 21)
+    S = noise_information(r, th, MODEL, kernel="numpy")
+    for s in (S, S.sum(1), S[0, 0]):
+        got = F.steady_state_prior(s, 0.001, gamma_inv2, np.eye(2), n_iter=n_iter)
+        assert got.tobytes() == _steady_state_prior_all_iterations(s, 0.001, gamma_inv2, np.eye(2), n_iter).tobytes()
+
+
+@pytest.mark.parametrize("lead", [(30, 4), (7,), (1,), ()])
+@pytest.mark.parametrize("A", [np.eye(2), A_ROT, -A_ROT])
+def test_congruence_kernel_matches_numpy(lead, A):
+    rng = np.random.default_rng(22)
+    X = rng.normal(size=lead + (2, 2))
+    X.reshape(-1, 4)[::3] = [-0.0, 0.0, -0.0, -0.0]  # signed zeros: numpy's dgemm returns +0.0
+    a = F.congruence(A, X, kernel="numpy")
+    b = F.congruence(A, X, kernel="compiled")
+    assert a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("lead", [(30, 4), (7,), ()])
+def test_control_law_kernel_matches_numpy(lead):
+    from netrepro.papers.hinf.motion import control_law
+
+    r, th = _information(lead, 23)
+    rng = np.random.default_rng(24)
+    dr, dt = rng.normal(size=lead), rng.normal(size=lead)
+    for v_max in (np.inf, 0.5):
+        a = control_law(dr, dt, r, th, 2e4, v_max, kernel="numpy")
+        b = control_law(dr, dt, r, th, 2e4, v_max, kernel="compiled")
+        assert a.shape == b.shape and a.tobytes() == b.tobytes()

@@ -419,3 +419,48 @@ def test_math_modules_public_api_has_numpydoc_sections(name):
         assert "Parameters\n----------" in doc, f"{name}.{attr}: no Parameters section"
         if inspect.isfunction(obj):
             assert "Returns\n-------" in doc, f"{name}.{attr}: no Returns section"
+
+
+def test_connected_matches_the_laplacian_spectrum():
+    """model._connected (reachability) against the algebraic connectivity lambda_2 > 1e-9 it replaced."""
+    from itertools import product
+
+    from netrepro.papers.hinf.consensus import laplacian
+    from netrepro.papers.hinf.model import _connected
+
+    def by_spectrum(adj):
+        return np.linalg.eigvalsh(laplacian(adj))[..., 1] > 1e-9
+
+    pairs = [(i, j) for i in range(4) for j in range(i + 1, 4)]
+    every4 = np.zeros((2 ** len(pairs), 4, 4))  # all 64 graphs on 4 agents
+    for g, bits in enumerate(product((0.0, 1.0), repeat=len(pairs))):
+        for (i, j), b in zip(pairs, bits):
+            every4[g, i, j] = every4[g, j, i] = b
+    assert np.array_equal(_connected(every4), by_spectrum(every4))
+    rng = np.random.default_rng(3)
+    for n, p in ((10, 0.15), (10, 0.3), (7, 0.4), (2, 0.5)):
+        a = np.triu((rng.random((500, n, n)) < p).astype(float), 1)
+        a = a + np.swapaxes(a, -1, -2)
+        got = _connected(a)
+        assert np.array_equal(got, by_spectrum(a)) and 0 < got.sum() < len(a)
+
+
+@pytest.mark.parametrize("mobile", [False, True])
+def test_consensus_variants_equal_their_own_simulations(mobile):
+    """A decentralized filter on a consensus variant gives the numbers of the simulation with that consensus alone
+    (stationary agents; mobile agents move by the driver on the configured consensus, unchanged by the variants)."""
+    variants = {"ki0": {"K_i": 0.0}, "gc2": {"gamma_c": 2.0}, "reset": {"design": "pi_reset"},
+                "exact": {"design": "exact_component"}, "complete": {"design": "complete", "iters": 2}}
+    sc = _scenario(agents0=_agents(4, 30.0, 30.0, -135.0), mobile=mobile, filters=["local", "decentralized"])
+    out = simulate({**sc, "consensus_variants": variants})
+    alone = simulate(sc)
+    for name in ("local", "decentralized"):
+        assert np.array_equal(out["errors"][name], alone["errors"][name])
+    assert np.array_equal(out["agents"], alone["agents"]) and out["n_psd_fix"] == alone["n_psd_fix"]
+    assert list(out["errors"]) == ["local", "decentralized"] + list(variants)
+    for lab, over in variants.items():
+        if not mobile:
+            one = simulate({**sc, "consensus": {**sc["consensus"], **over}})
+            assert np.array_equal(out["errors"][lab], one["errors"]["decentralized"]), lab
+        if lab != "reset" or alone["topology_changes"].any():  # no topology change: nothing to reset
+            assert not np.array_equal(out["errors"][lab], alone["errors"]["decentralized"]), lab

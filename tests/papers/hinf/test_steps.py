@@ -134,3 +134,48 @@ def test_evasive_network_table(hinf_run):
     assert set(t["target"]) == set(cfg["paired"]["targets"])
     assert (t.groupby("target").size() == cfg["paired"]["network_runs"]).all()
     assert t["connected_fraction"].between(0, 1).all()
+
+
+def _sensitivity_consensus_rows_one_by_one(cfg, scen):
+    """Reference: the consensus rows of the sensitivity table, one simulation per value (the former loop)."""
+    from netrepro.papers.hinf.model import FilterDoesNotExist, resolve_scenario, simulate
+
+    sv = cfg["sensitivity"]
+    start = min(int(cfg["claims"]["late_start"]), int(sv["horizon"]) // 2)
+    rows = []
+    for key in ("gamma_c", "K_p", "K_i", "h", "iters"):
+        for val in sv[key]:
+            sc = resolve_scenario(cfg, scen, runs=int(sv["runs"]), horizon=int(sv["horizon"]), seed=int(sv["seed"]),
+                                  consensus={key: val})
+            sc["filters"] = ["local", "decentralized", "centralized"]
+            try:
+                with np.errstate(all="ignore"):
+                    err = simulate(sc)["errors"]
+            except FilterDoesNotExist:
+                rows.append((key, val, False, np.nan, np.nan, np.nan))
+                continue
+            rows.append((key, val, True) + tuple(
+                float(err[f][..., start:].mean()) if np.all(np.isfinite(err[f])) else np.inf
+                for f in ("local", "decentralized", "centralized")))
+    return rows
+
+
+def test_sensitivity_consensus_rows_equal_one_simulation_each():
+    """The consensus sweeps share one simulation per scenario; the rows equal those of one run per value, also
+    when a value makes the filter fail (then every value is simulated on its own)."""
+    from tests.papers.hinf.conftest import tiny_section
+
+    cfg = tiny_section()
+    cfg["sensitivity"].update(gamma_c=[0.25, 2.0], K_p=[0.1], K_i=[0.0, 0.4], h=[0.25], iters=[2])
+    for h in ([0.25], [0.25, 40.0]):  # h = 40: the consensus diverges and the filter fails
+        cfg["sensitivity"]["h"] = h
+        got = steps.sensitivity_step(cfg, {}, {})["table"]
+        for scen in cfg["sensitivity"]["random_scenarios"]:
+            ref = _sensitivity_consensus_rows_one_by_one(cfg, scen)
+            g = got[(got["scenario"] == scen) & got["parameter"].isin(["gamma_c", "K_p", "K_i", "h", "iters"])]
+            assert len(g) == len(ref)
+            for (_, row), (key, val, exists, loc, dec, cen) in zip(g.iterrows(), ref):
+                assert (row["parameter"], row["value"], row["exists"]) == (key, val, exists)
+                assert np.array_equal(row[["local_error", "decentralized_error", "centralized_error"]].to_numpy(float),
+                                      np.array([loc, dec, cen]), equal_nan=True)
+            assert any(not r[2] for r in ref) == (40.0 in h)  # the fallback is exercised

@@ -21,7 +21,7 @@ from llvmlite import ir as llvm_ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-__all__ = ["fma", "hinf_update_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
+__all__ = ["fma", "hinf_update_kernel", "hinf_update_batch_kernel", "congruence_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
            "rotate_kernel"]
 
 
@@ -126,30 +126,94 @@ def hinf_update_kernel(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar, xpred_g
     """
     gL00, gL01, gL10, gL11 = gamma_inv2 * Lbar[0, 0], gamma_inv2 * Lbar[0, 1], gamma_inv2 * Lbar[1, 0], gamma_inv2 * Lbar[1, 1]
     for b in range(xhat.shape[0]):
-        S00, S01, S10, S11 = S[b, 0, 0], S[b, 0, 1], S[b, 1, 0], S[b, 1, 1]
-        d00, d01, d10, d11 = _prior(Sigma[b, 0, 0], Sigma[b, 0, 1], Sigma[b, 1, 0], Sigma[b, 1, 1], A, BWB)
-        if xpred_gemv:  # xpred = xhat @ A.T
-            p0, p1 = _mv(A[0, 0], A[0, 1], A[1, 0], A[1, 1], xhat[b, 0], xhat[b, 1])
-        else:
-            p0 = fma(xhat[b, 1], A[0, 1], xhat[b, 0] * A[0, 0]) + 0.0
-            p1 = fma(xhat[b, 1], A[1, 1], xhat[b, 0] * A[1, 0]) + 0.0
-        sd00, sd01, sd10, sd11 = _mm(S00, S01, S10, S11, d00, d01, d10, d11)
-        m00, m01, m10, m11 = _inv2(1.0 + sd00, 0.0 + sd01, 0.0 + sd10, 1.0 + sd11)
-        G00, G01, G10, G11 = _mm(d00, d01, d10, d11, m00, m01, m10, m11)
-        q0, q1 = _mv(S00, S01, S10, S11, p0, p1)
-        c0, c1 = _mv(G00, G01, G10, G11, y_info[b, 0] - q0, y_info[b, 1] - q1)
-        xnew[b, 0] = p0 + c0
-        xnew[b, 1] = p1 + c1
-        l00, l01, l10, l11 = _mm(gL00, gL01, gL10, gL11, d00, d01, d10, d11)
-        o00, o01, o10, o11 = _inv2((1.0 - l00) + sd00, (0.0 - l01) + sd01, (0.0 - l10) + sd10, (1.0 - l11) + sd11)
-        e00, e01, e10, e11 = _mm(d00, d01, d10, d11, o00, o01, o10, o11)
-        Sig[b, 0, 0] = 0.5 * (e00 + e00)
-        Sig[b, 0, 1] = 0.5 * (e01 + e10)
-        Sig[b, 1, 0] = 0.5 * (e10 + e01)
-        Sig[b, 1, 1] = 0.5 * (e11 + e11)
-        Delta[b, 0, 0], Delta[b, 0, 1], Delta[b, 1, 0], Delta[b, 1, 1] = d00, d01, d10, d11
-        f00, f01, f10, f11 = _information(d00, d01, d10, d11, S00, S01, S10, S11, gL00, gL01, gL10, gL11)
-        info_eig[b] = _min_eig2(f00, f01, f10, f11)
+        (xnew[b, 0], xnew[b, 1], Sig[b, 0, 0], Sig[b, 0, 1], Sig[b, 1, 0], Sig[b, 1, 1], Delta[b, 0, 0], Delta[b, 0, 1],
+         Delta[b, 1, 0], Delta[b, 1, 1], info_eig[b]) = _hinf_one(
+            xhat[b, 0], xhat[b, 1], Sigma[b, 0, 0], Sigma[b, 0, 1], Sigma[b, 1, 0], Sigma[b, 1, 1], y_info[b, 0],
+            y_info[b, 1], S[b, 0, 0], S[b, 0, 1], S[b, 1, 0], S[b, 1, 1], A, BWB, gL00, gL01, gL10, gL11, xpred_gemv)
+
+
+@njit(cache=True, error_model="numpy")
+def hinf_update_batch_kernel(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar, xpred_gemv, xnew, Sig, Delta,
+                             info_eig):
+    """:func:`hinf_update_kernel` for ``F`` filters of their own ``B W B^T`` and gamma fed the same measurements.
+
+    Parameters
+    ----------
+    xhat : ndarray ``(F, B, 2)``
+        Previous estimates of the ``F`` filters (``B`` flattened runs and agents each).
+    Sigma : ndarray ``(F, B, 2, 2)``
+        Their previous ``Sigma_{k-1}``.
+    y_info : ndarray ``(B, 2)``
+        ``C^T M^{-1} y``, shared by the ``F`` filters.
+    S : ndarray ``(B, 2, 2)``
+        ``C^T M^{-1} C``, shared by the ``F`` filters.
+    A : ndarray ``(2, 2)``
+        Target dynamics.
+    BWB : ndarray ``(F, 2, 2)``
+        Each filter's design ``B W B^T``.
+    gamma_inv2 : ndarray ``(F,)``
+        Each filter's ``gamma^{-2}`` (0: Kalman filter).
+    Lbar : ndarray ``(2, 2)``
+        ``L^T Q L``.
+    xpred_gemv : bool
+        As in :func:`hinf_update_kernel` (one filter's ``xhat @ A.T``).
+    xnew : ndarray ``(F, B, 2)``
+        Receives the new estimates.
+    Sig, Delta : ndarray ``(F, B, 2, 2)``
+        Receive ``Sigma_k`` and ``Delta_k``.
+    info_eig : ndarray ``(F, B)``
+        Receives the smallest eigenvalue of ``Sigma_k^{-1}``.
+    """
+    for f in range(xhat.shape[0]):
+        g, bwb = gamma_inv2[f], BWB[f]
+        gL00, gL01, gL10, gL11 = g * Lbar[0, 0], g * Lbar[0, 1], g * Lbar[1, 0], g * Lbar[1, 1]
+        for b in range(xhat.shape[1]):
+            (xnew[f, b, 0], xnew[f, b, 1], Sig[f, b, 0, 0], Sig[f, b, 0, 1], Sig[f, b, 1, 0], Sig[f, b, 1, 1],
+             Delta[f, b, 0, 0], Delta[f, b, 0, 1], Delta[f, b, 1, 0], Delta[f, b, 1, 1], info_eig[f, b]) = _hinf_one(
+                xhat[f, b, 0], xhat[f, b, 1], Sigma[f, b, 0, 0], Sigma[f, b, 0, 1], Sigma[f, b, 1, 0], Sigma[f, b, 1, 1],
+                y_info[b, 0], y_info[b, 1], S[b, 0, 0], S[b, 0, 1], S[b, 1, 0], S[b, 1, 1], A, bwb, gL00, gL01, gL10,
+                gL11, xpred_gemv)
+
+
+@njit(cache=True, error_model="numpy")
+def _hinf_one(x0, x1, s00, s01, s10, s11, y0, y1, S00, S01, S10, S11, A, BWB, gL00, gL01, gL10, gL11, xpred_gemv):
+    """One filter of :func:`hinf_update_kernel`: ``xnew (2), Sigma_k (4), Delta_k (4)`` row-major and the eigenvalue."""
+    d00, d01, d10, d11 = _prior(s00, s01, s10, s11, A, BWB)
+    if xpred_gemv:  # xpred = xhat @ A.T
+        p0, p1 = _mv(A[0, 0], A[0, 1], A[1, 0], A[1, 1], x0, x1)
+    else:
+        p0 = fma(x1, A[0, 1], x0 * A[0, 0]) + 0.0
+        p1 = fma(x1, A[1, 1], x0 * A[1, 0]) + 0.0
+    sd00, sd01, sd10, sd11 = _mm(S00, S01, S10, S11, d00, d01, d10, d11)
+    m00, m01, m10, m11 = _inv2(1.0 + sd00, 0.0 + sd01, 0.0 + sd10, 1.0 + sd11)
+    G00, G01, G10, G11 = _mm(d00, d01, d10, d11, m00, m01, m10, m11)
+    q0, q1 = _mv(S00, S01, S10, S11, p0, p1)
+    c0, c1 = _mv(G00, G01, G10, G11, y0 - q0, y1 - q1)
+    l00, l01, l10, l11 = _mm(gL00, gL01, gL10, gL11, d00, d01, d10, d11)
+    o00, o01, o10, o11 = _inv2((1.0 - l00) + sd00, (0.0 - l01) + sd01, (0.0 - l10) + sd10, (1.0 - l11) + sd11)
+    e00, e01, e10, e11 = _mm(d00, d01, d10, d11, o00, o01, o10, o11)
+    f00, f01, f10, f11 = _information(d00, d01, d10, d11, S00, S01, S10, S11, gL00, gL01, gL10, gL11)
+    return (p0 + c0, p1 + c1, 0.5 * (e00 + e00), 0.5 * (e01 + e10), 0.5 * (e10 + e01), 0.5 * (e11 + e11),
+            d00, d01, d10, d11, _min_eig2(f00, f01, f10, f11))
+
+
+@njit(cache=True, error_model="numpy")
+def congruence_kernel(X, A, out):
+    """``A X A^T`` of ``B`` flattened 2x2 matrices as numpy's ``A @ X @ A.T`` rounds it (two ``dgemm``), into ``out``.
+
+    Parameters
+    ----------
+    X : ndarray ``(B, 2, 2)``
+        The matrices.
+    A : ndarray ``(2, 2)``
+        The transformation (target dynamics).
+    out : ndarray ``(B, 2, 2)``
+        Receives ``A X A^T``.
+    """
+    for b in range(X.shape[0]):
+        t00, t01, t10, t11 = _mm(A[0, 0], A[0, 1], A[1, 0], A[1, 1], X[b, 0, 0], X[b, 0, 1], X[b, 1, 0], X[b, 1, 1])
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = _mm(t00, t01, t10, t11, A[0, 0], A[1, 0], A[0, 1],
+                                                                     A[1, 1])
 
 
 @njit(cache=True, error_model="numpy")

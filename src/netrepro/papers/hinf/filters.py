@@ -12,7 +12,7 @@ from ...errors import ModelError
 from .algebra import I2, inv2, kernel_operand, min_eig2, sym2, use_compiled
 
 __all__ = [
-    "FilterDoesNotExist", "hinf_information", "hinf_update", "decentralized_update", "kalman_update",
+    "FilterDoesNotExist", "hinf_information", "hinf_update", "hinf_update_batch", "congruence", "decentralized_update", "kalman_update",
     "minimum_attenuation", "steady_state_prior", "gain_norms",
 ]
 
@@ -138,6 +138,101 @@ def _hinf_update_compiled(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar):
                        np.array(Lbar, dtype=float, order="C"), bool(xpred_gemv), xnew.reshape(-1, 2),
                        Sig.reshape(-1, 2, 2), Delta.reshape(-1, 2, 2), info_eig.reshape(-1))
     return xnew, Sig, Delta, info_eig
+
+
+def hinf_update_batch(xhat, Sigma, y_info, S, A, BWB, gamma_inv2, Lbar, check: bool = True, kernel: str = "auto"):
+    """:func:`hinf_update` of ``F`` filters (their own ``B W B^T`` and gamma) fed the same measurements, stacked.
+
+    Filter ``f`` gets ``hinf_update(xhat[f], Sigma[f], y_info, S, A, BWB[f], gamma_inv2[f], Lbar)``, with the
+    same numbers (the compiled form runs :func:`.filter_kernels.hinf_update_batch_kernel` in one call).
+
+    Parameters
+    ----------
+    xhat : ndarray, shape ``(F, ..., 2)``
+        Previous estimates of the ``F`` filters.
+    Sigma : ndarray, shape ``(F, ..., 2, 2)``
+        Their previous ``Sigma_{k-1}``.
+    y_info : ndarray, shape ``(..., 2)``
+        ``C^T M^{-1} y``, shared by the filters.
+    S : ndarray, shape ``(..., 2, 2)``
+        ``C^T M^{-1} C``, shared by the filters.
+    A : ndarray, shape ``(2, 2)``
+        Target dynamics.
+    Lbar : ndarray, shape ``(2, 2)``
+        ``L^T Q L``.
+    BWB : ndarray, shape ``(F, 2, 2)``
+        Each filter's ``B W B^T``.
+    gamma_inv2 : array_like, shape ``(F,)``
+        Each filter's ``gamma^{-2}`` (0: Kalman filter).
+    check : bool
+        Raise :class:`FilterDoesNotExist` when some filter's ``Sigma_k^{-1}`` is not positive definite.
+    kernel : {"auto", "compiled", "numpy"}
+        As in :func:`hinf_update` (``"numpy"``: :func:`hinf_update` filter by filter).
+
+    Returns
+    -------
+    xhat, Sigma, Delta, min_info_eig : ndarray
+        Stacked as :func:`hinf_update` returns them, with the leading axis ``F``.
+
+    Raises
+    ------
+    FilterDoesNotExist
+        If ``check`` and some filter does not exist at this step.
+    """
+    xhat, Sigma = np.asarray(xhat, dtype=float), np.asarray(Sigma, dtype=float)
+    BWB, gamma_inv2 = np.asarray(BWB, dtype=float), np.asarray(gamma_inv2, dtype=float)
+    F = xhat.shape[0]
+    if use_compiled(kernel, np.size(Sigma) // 4):
+        from .filter_kernels import hinf_update_batch_kernel  # numba: imported by the steps that run a filter
+
+        y_info, S = np.asarray(y_info, dtype=float), np.asarray(S, dtype=float)
+        lead = np.broadcast_shapes(xhat.shape[1:-1], Sigma.shape[1:-2], y_info.shape[:-1], S.shape[:-2])
+        xpred_gemv = xhat.ndim == 2 or xhat.shape[-2] == 1  # as in _hinf_update_compiled, for one filter's xhat
+        out = (np.empty((F,) + lead + (2,)), np.empty((F,) + lead + (2, 2)), np.empty((F,) + lead + (2, 2)),
+               np.empty((F,) + lead))
+        hinf_update_batch_kernel(
+            kernel_operand(xhat, (F,) + lead + (2,)).reshape(F, -1, 2),
+            kernel_operand(Sigma, (F,) + lead + (2, 2)).reshape(F, -1, 2, 2),
+            kernel_operand(y_info, lead + (2,)).reshape(-1, 2), kernel_operand(S, lead + (2, 2)).reshape(-1, 2, 2),
+            np.array(A, dtype=float, order="C"), kernel_operand(BWB, (F, 2, 2)), kernel_operand(gamma_inv2, (F,)),
+            np.array(Lbar, dtype=float, order="C"), bool(xpred_gemv), out[0].reshape(F, -1, 2),
+            out[1].reshape(F, -1, 2, 2), out[2].reshape(F, -1, 2, 2), out[3].reshape(F, -1))
+    else:
+        each = [hinf_update(xhat[f], Sigma[f], y_info, S, A, BWB[f], float(gamma_inv2[f]), Lbar, check=False,
+                            kernel="numpy") for f in range(F)]
+        out = tuple(np.stack([e[i] for e in each]) for i in range(4))
+    if check and not np.all(out[3] > 0):
+        raise FilterDoesNotExist(
+            f"Sigma^-1 not positive definite (min eigenvalue {np.min(out[3]):.3g}): gamma below gamma_0")
+    return out
+
+
+def congruence(A, X, kernel: str = "auto"):
+    """``A X A^T`` for a stack of 2x2 matrices (the prior's propagation in eqs (6) and (14)), as ``A @ X @ A.T``.
+
+    Parameters
+    ----------
+    A : ndarray, shape ``(2, 2)``
+        Target dynamics.
+    X : ndarray, shape ``(..., 2, 2)``
+        The matrices.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: :func:`.filter_kernels.congruence_kernel` (bit-identical to numpy's ``matmul``);
+        ``"numpy"``: ``A @ X @ A.T``; ``"auto"``: see :func:`.algebra.use_compiled`.
+
+    Returns
+    -------
+    ndarray, shape of ``X``
+    """
+    X = np.asarray(X, dtype=float)
+    if not use_compiled(kernel, X.size // 4):
+        return A @ X @ A.T
+    from .filter_kernels import congruence_kernel  # numba: imported by the steps that run a filter
+
+    out = np.empty(X.shape)
+    congruence_kernel(kernel_operand(X, X.shape).reshape(-1, 2, 2), np.array(A, dtype=float, order="C"),
+                      out.reshape(-1, 2, 2))
+    return out
 
 
 def decentralized_update(xhat, Sigma, y_tilde, C_tilde, n_agents: int, A, BWB, gamma_inv2, Lbar, check=True):
@@ -311,9 +406,15 @@ def steady_state_prior(S, W: float, gamma_inv2: float, Lbar, n_iter: int = 3000)
     S = np.asarray(S, dtype=float)
     eye = np.broadcast_to(np.eye(2), S.shape)
     Delta = W * eye.copy()
-    for _ in range(n_iter):
+    prev = None
+    for i in range(n_iter):
         Sigma = Delta @ np.linalg.inv(eye - gamma_inv2 * Lbar @ Delta + S @ Delta)
-        Delta = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+        new = 0.5 * (Sigma + np.swapaxes(Sigma, -1, -2)) + W * eye
+        if prev is not None and new.tobytes() == prev.tobytes():
+            # the iterates now repeat with period 1 or 2, bit for bit (the map is deterministic): the last one
+            # of the n_iter is known without computing the rest
+            return new if (n_iter - 1 - i) % 2 == 0 else Delta
+        prev, Delta = Delta, new
     return Delta
 
 

@@ -93,7 +93,7 @@ def printed_sigma_gradient(Delta, dDelta, S, dS, gamma_inv2, Lbar):
     return dDelta @ Oi + DOi @ dS @ DOi - DOi @ (S @ dDelta - gamma_inv2 * Lbar @ dDelta) @ Oi
 
 
-def control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float, v_max: float = np.inf):
+def control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float, v_max: float = np.inf, kernel: str = "auto"):
     """Gradient motion control law, eq (12) corrected, with a speed limit.
 
     With ``theta_i = angle(x - p_i)`` (Section II), ``grad_{p_i} J = -T_i [dJ/dr; dJ/dtheta / r]``,
@@ -113,14 +113,26 @@ def control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float, v_max: float = np.inf)
         Control gain of eq (12).
     v_max : float
         Largest step length.
+    kernel : {"auto", "compiled", "numpy"}
+        ``"compiled"``: ``T_i [...]`` by :func:`.filter_kernels.rotate_kernel` (bit-identical; arguments of one
+        shape); ``"numpy"``: the reference form; ``"auto"``: see :func:`.algebra.use_compiled`.
 
     Returns
     -------
     ndarray, shape ``r.shape + (2,)``
         The steps ``u_i``.
     """
-    local = np.stack([dJ_dr, dJ_dtheta / r], -1)
-    u = Gamma * (rotation(theta) @ local[..., None])[..., 0]
+    theta = np.asarray(theta, dtype=float)
+    if np.shape(dJ_dr) == np.shape(dJ_dtheta) == np.shape(r) == theta.shape and use_compiled(kernel, theta.size):
+        from .filter_kernels import rotate_kernel  # T(theta) v as numpy's matmul rounds it (bit-identical)
+
+        Tv = np.empty(theta.shape + (2,))
+        rotate_kernel(np.cos(theta).ravel(), np.sin(theta).ravel(), np.asarray(dJ_dr, dtype=float).ravel(),
+                      np.asarray(dJ_dtheta / r, dtype=float).ravel(), Tv.reshape(-1, 2))
+        u = Gamma * Tv
+    else:
+        local = np.stack([dJ_dr, dJ_dtheta / r], -1)
+        u = Gamma * (rotation(theta) @ local[..., None])[..., 0]
     norm = np.linalg.norm(u, axis=-1, keepdims=True)
     scale = np.where(norm > v_max, v_max / np.maximum(norm, 1e-300), 1.0)
     return u * scale

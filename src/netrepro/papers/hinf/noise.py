@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ...errors import InputError
-from .algebra import rotation, use_compiled
+from .algebra import kernel_operand, rotation, use_compiled
 
 __all__ = [
     "NoiseModel", "geometry", "noise_variances", "noise_covariance", "noise_information",
@@ -152,11 +152,11 @@ def noise_information(r, theta, model: NoiseModel, derivatives: bool = False, ke
 
     fr, fb = noise_variances(np.broadcast_to(r, shape), model)
     theta = np.asarray(theta, dtype=float)
-    c, s = (np.array(np.broadcast_to(f(theta), shape), dtype=float, order="C").ravel() for f in (np.cos, np.sin))
+    c, s = (kernel_operand(f(theta), shape).ravel() for f in (np.cos, np.sin))  # copied only if broadcast
     rinv_r, rinv_b = 1.0 / fr.ravel(), 1.0 / fb.ravel()
     if derivatives:
         g = -2.0 * model.a2 * (np.asarray(r, dtype=float) - model.a1)
-        d_r, d_b = (np.array(np.broadcast_to(v, shape), dtype=float, order="C").ravel()
+        d_r, d_b = (kernel_operand(v, shape).ravel()
                     for v in (g / fr**2, g * model.alpha / fb**2))  # R^{-2} diag(1, alpha)
     else:
         d_r = d_b = rinv_r

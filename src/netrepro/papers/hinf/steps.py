@@ -411,6 +411,7 @@ def simulate_step(params, inputs, outputs):
     FilterDoesNotExist
         If an H-infinity filter of the scenario does not exist at some step (gamma below gamma_0).
     """
+    from . import filter_kernels  # noqa: F401  numba: pays its load (~0.3 s) in the 200-run scenarios, even elsewhere
     name = params["scenario"]
     cfg = params["cfg"]
     sc = resolve_scenario(cfg, name)
@@ -519,6 +520,7 @@ def sensitivity_evasive_step(params, inputs, outputs):
     dict
         ``{"table": DataFrame}``: the columns of ``sensitivity.csv``.
     """
+    from . import filter_kernels  # noqa: F401  numba: the evader's exact solver and the filters compiled (~0.7 s less)
     return {"table": _sensitivity(params, evasive=True)}
 
 
@@ -528,7 +530,7 @@ def _sensitivity(params, evasive):
     rows = []
     lap = laplacian(adjacency(layout_positions(cfg["layouts"][cfg["scenarios"]["fig2"]["layout"]]), cfg["comm_radius"]))
 
-    def run(parameter, value, scen, overrides):
+    def prepare(parameter, value, scen, overrides):
         sc = resolve_scenario(cfg, scen, runs=int(sv["runs"]), horizon=int(sv["horizon"]), seed=int(sv["seed"]),
                               **overrides)
         sc["filters"] = [f for f in ("local", "decentralized", "centralized") if f in sc["filters"]] or sc["filters"]
@@ -539,6 +541,23 @@ def _sensitivity(params, evasive):
         row = {"parameter": parameter, "value": value, "W": float(cfg["scenarios"][scen]["W"]), "scenario": scen,
                "exists": True, "consensus_stable": bool(stable), "local_error": np.nan, "decentralized_error": np.nan,
                "centralized_error": np.nan, "ratio_dec_local": np.nan, "settle_k": -1}
+        return sc, row
+
+    def fill(row, sc, errors):
+        for f in ("local", "decentralized", "centralized"):
+            key = sc["driver"] if (sc["mobile"] and f == "decentralized") else f
+            if key in errors:
+                e = errors[key]
+                row[f + "_error"] = float(e[..., start:].mean()) if np.all(np.isfinite(e)) else np.inf
+        row["ratio_dec_local"] = row["decentralized_error"] / row["local_error"]
+        dec = sc["driver"] if sc["mobile"] else "decentralized"
+        mean = errors[dec].reshape(-1, sc["horizon"] + 1).mean(0)
+        below = mean <= float(cfg["claims"]["settle_threshold"])
+        row["settle_k"] = next((k for k in range(len(mean)) if below[k:].all()), -1)
+        rows.append(row)
+
+    def run(parameter, value, scen, overrides):
+        sc, row = prepare(parameter, value, scen, overrides)
         try:
             with np.errstate(all="ignore"):
                 out = simulate(sc)
@@ -546,17 +565,24 @@ def _sensitivity(params, evasive):
             row["exists"] = False
             rows.append(row)
             return
-        for f in ("local", "decentralized", "centralized"):
-            key = sc["driver"] if (sc["mobile"] and f == "decentralized") else f
-            if key in out["errors"]:
-                e = out["errors"][key]
-                row[f + "_error"] = float(e[..., start:].mean()) if np.all(np.isfinite(e)) else np.inf
-        row["ratio_dec_local"] = row["decentralized_error"] / row["local_error"]
-        dec = sc["driver"] if sc["mobile"] else "decentralized"
-        mean = out["errors"][dec].reshape(-1, sc["horizon"] + 1).mean(0)
-        below = mean <= float(cfg["claims"]["settle_threshold"])
-        row["settle_k"] = next((k for k in range(len(mean)) if below[k:].all()), -1)
-        rows.append(row)
+        fill(row, sc, out["errors"])
+
+    def run_consensus(scen, sweep):
+        """The rows of ``run(key, val, scen, {"consensus": {key: val}})`` for each ``(key, val)`` of ``sweep``, from
+        one simulation with a decentralized filter per consensus variant (stationary agents: the same target,
+        measurements, local and centralized filters in every variant; the same numbers as one run each)."""
+        base, _ = prepare(None, None, scen, {})
+        if base["mobile"]:
+            return [run(key, val, scen, {"consensus": {key: val}}) for key, val in sweep]
+        base["consensus_variants"] = {f"{key}={val!r}": {key: val} for key, val in sweep}
+        try:
+            with np.errstate(all="ignore"):
+                out = simulate(base)
+        except FilterDoesNotExist:  # some variant's filter does not exist: each variant on its own
+            return [run(key, val, scen, {"consensus": {key: val}}) for key, val in sweep]
+        for key, val in sweep:
+            sc, row = prepare(key, val, scen, {"consensus": {key: val}})
+            fill(row, sc, {**out["errors"], "decentralized": out["errors"][f"{key}={val!r}"]})
 
     if evasive:
         # does H-infinity pay off against the evasive target? gamma sweep; gamma = inf is the Kalman-driven scenario
@@ -567,9 +593,7 @@ def _sensitivity(params, evasive):
     for scen in sv["random_scenarios"]:
         for g in sv["gamma"]:
             run("gamma", g, scen, {"filter": {"gamma": g}})
-        for key in ("gamma_c", "K_p", "K_i", "h", "iters"):
-            for val in sv[key]:
-                run(key, val, scen, {"consensus": {key: val}})
+        run_consensus(scen, [(key, val) for key in ("gamma_c", "K_p", "K_i", "h", "iters") for val in sv[key]])
     for key in ("Gamma", "v_max"):
         for val in sv[key]:
             run(key, val, sv["mobile_scenario"], {"control": {key: val}})
@@ -679,13 +703,17 @@ def fig2_horizon_step(params, inputs, outputs):
     gain_variants = [(f"_{key}{float(v):g}", {"consensus": {key: float(v)}}, False)
                      for key in ("gamma_c", "K_p") for v in cfg["sensitivity"][key]
                      if float(v) != float(cfg["consensus"][key])]
+    variants = [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants
     for scen in fh["scenarios"]:
-        for suffix, over, per_agent in [("", {}, True), ("_ki0", {"consensus": {"K_i": 0.0}}, True)] + gain_variants:
-            sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]), **over)
-            sc["filters"] = ["local", "decentralized"]
-            out = simulate(sc)
-            e_loc, e_dec = out["errors"]["local"], out["errors"]["decentralized"]
-            c = sc["consensus"]
+        # one simulation per scenario: the variants differ only in the consensus, so they share the target,
+        # the measurements and the local filter; each has its own decentralized filter (same numbers as alone)
+        sc = resolve_scenario(cfg, scen, horizon=K, runs=int(fh["runs"]))
+        sc["filters"] = ["local", "decentralized"]
+        sc["consensus_variants"] = {suffix: over["consensus"] for suffix, over, _ in variants if suffix}
+        out = simulate(sc)
+        for suffix, over, per_agent in variants:
+            e_loc, e_dec = out["errors"]["local"], out["errors"][suffix or "decentralized"]
+            c = {**sc["consensus"], **over.get("consensus", {})}
             for H in fh["horizons"]:
                 H = int(H)
                 agents = list(range(e_loc.shape[1])) if per_agent else []
@@ -707,7 +735,6 @@ def fig2_horizon_step(params, inputs, outputs):
             if scen == fh["scenarios"][0]:
                 lap = laplacian(adjacency(sc["agents0"], sc["radius"]))
                 lam = np.linalg.eigvalsh(lap)
-                c = sc["consensus"]
                 rho, tau = pi_consensus_time_constants(lam, c["gamma_c"], c["h"], c["K_p"], c["K_i"])
                 modes.append(pd.DataFrame({"scenario": scen + suffix, "K_i": c["K_i"], "mode": np.arange(len(lam)),
                                            "laplacian_eigenvalue": lam, "modulus": rho,
@@ -906,6 +933,7 @@ def evasive_network_step(params, inputs, outputs):
         ``{"table": DataFrame}``: one row per target and run (``target, run, connected_fraction,
         local, decentralized``).
     """
+    from . import filter_kernels  # noqa: F401  numba: the filters and the evader's exact solver compiled (~0.2 s less)
     cfg, pc = params, params["paired"]
     start = int(cfg["claims"]["late_start"])
     rows = []
