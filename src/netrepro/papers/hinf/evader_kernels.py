@@ -29,6 +29,40 @@ __all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_ke
 # :func:`.filter_kernels.fma`, the correctly rounded ``llvm.fma``. Written as one function on scalars (no
 # helper functions, no scratch 2x2 arrays): numba then compiles it in about a third less time, which a
 # process that loads it cold pays once.
+@njit(cache=True, error_model="numpy", inline="always")
+def _fused_matrix(Minv, lam, r):
+    """The fused information ``A = sum_q lam[r, q] M_q^{-1}`` of instance ``r`` (eq (24)), entry by entry.
+
+    Parameters
+    ----------
+    Minv : ndarray, shape (m, n, 2, 2)
+        The agents' inverse informations ``M_q^{-1}`` per instance.
+    lam : ndarray, shape (m, n)
+        The weights ``lambda``.
+    r : int
+        The instance.
+
+    Returns
+    -------
+    tuple of float
+        ``(A00, A01, A10, A11)``, each summed over ``q`` in order (the rounding of the kernels' reference forms).
+    """
+    n = lam.shape[1]
+    A00 = 0.0
+    A01 = 0.0
+    A10 = 0.0
+    A11 = 0.0
+    for q in range(n):
+        A00 += lam[r, q] * Minv[r, q, 0, 0]
+    for q in range(n):
+        A01 += lam[r, q] * Minv[r, q, 0, 1]
+    for q in range(n):
+        A10 += lam[r, q] * Minv[r, q, 1, 0]
+    for q in range(n):
+        A11 += lam[r, q] * Minv[r, q, 1, 1]
+    return A00, A01, A10, A11
+
+
 @njit(cache=True, error_model="numpy")
 def pairwise_kernel(Minv, lam, n_iter):
     """:func:`min_fused_trace_pairwise` on ``Minv (M, N, 2, 2)`` from ``lam (M, N)`` (updated in place).
@@ -134,18 +168,7 @@ def pairwise_kernel(Minv, lam, n_iter):
             lam[r, s] += t
             lam[r, v] -= t
             lam[r, v] = max(lam[r, v], 0.0)
-        A00 = 0.0
-        A01 = 0.0
-        A10 = 0.0
-        A11 = 0.0
-        for q in range(n):
-            A00 += lam[r, q] * Minv[r, q, 0, 0]
-        for q in range(n):
-            A11 += lam[r, q] * Minv[r, q, 1, 1]
-        for q in range(n):
-            A01 += lam[r, q] * Minv[r, q, 0, 1]
-        for q in range(n):
-            A10 += lam[r, q] * Minv[r, q, 1, 0]
+        A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
         d = A00 * A11 - A01 * A10
         trace[r] = A11 / d + A00 / d
     return trace
@@ -334,18 +357,7 @@ def bounds_kernel(Minv, lam, value, grad):
     """
     m, n = lam.shape
     for r in range(m):
-        A00 = 0.0
-        A01 = 0.0
-        A10 = 0.0
-        A11 = 0.0
-        for q in range(n):
-            A00 += lam[r, q] * Minv[r, q, 0, 0]
-        for q in range(n):
-            A01 += lam[r, q] * Minv[r, q, 0, 1]
-        for q in range(n):
-            A10 += lam[r, q] * Minv[r, q, 1, 0]
-        for q in range(n):
-            A11 += lam[r, q] * Minv[r, q, 1, 1]
+        A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
         c = A00 * A11 - A01 * A10
         i00 = A11 / c
         i11 = A00 / c
