@@ -105,7 +105,7 @@ __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
     "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step", "loop_variants_shard_step",
-    "loop_variants_merge_step", "kalman_best_shard_step", "kalman_best_merge_step",
+    "loop_variants_merge_step", "kalman_best_shard_step", "kalman_best_merge_step", "fig6_paths_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
