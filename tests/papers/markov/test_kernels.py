@@ -60,3 +60,23 @@ def test_riccati_step_2x1_is_the_numpy_maps_bit_for_bit():
             assert np.array_equal(got, ref, equal_nan=True)
     with pytest.raises(ValueError, match="2-state|P \\(N, 2, 2\\)"):
         riccati_step_2x1(np.ones((4, 3, 3)), np.ones(4, bool), np.eye(3), np.ones((1, 3)), np.eye(3), np.eye(1))
+
+
+def test_riccati_branch_2x1_is_both_numpy_maps_bit_for_bit():
+    """The branching of the exact tree (every matrix's g, then every matrix's h) against numpy's maps."""
+    from netrepro.papers.markov.kernels import riccati_branch_2x1
+    from netrepro.papers.markov.model import riccati_g, riccati_h
+
+    rng = np.random.default_rng(12)
+    for A, C, Q, R in ((np.array(EX["I"]["A"]), np.array(EX["I"]["C"]), np.eye(2), np.array([[1.0]])),
+                       (rng.normal(size=(2, 2)), rng.normal(size=(1, 2)), np.array([[1.0, 0.3], [0.3, 0.5]]),
+                        np.array([[0.2]]))):
+        X = rng.normal(size=(2000, 2, 2))
+        P = X @ np.swapaxes(X, -1, -2) * 10.0 ** rng.uniform(-8, 8, size=(2000, 1, 1))
+        P[:2] = np.inf
+        with np.errstate(over="ignore", invalid="ignore"):
+            ref = np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
+            got = riccati_branch_2x1(P, A, C, Q, R)
+        assert np.array_equal(got, ref, equal_nan=True)
+    with pytest.raises(ValueError, match="riccati_branch_2x1 needs"):
+        riccati_branch_2x1(np.ones((4, 2, 2)), np.eye(2), np.ones((2, 2)), np.eye(2), np.eye(2))

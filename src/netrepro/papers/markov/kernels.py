@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import intrinsic
 
-__all__ = ["rb_norm_kernel", "pairwise_sum", "riccati_step_2x1"]
+__all__ = ["rb_norm_kernel", "pairwise_sum", "riccati_step_2x1", "riccati_branch_2x1"]
 
 
 @njit(cache=True, boundscheck=False)
@@ -320,39 +320,90 @@ def riccati_step_2x1(P, received, A, C, Q, R):
     return out
 
 
+
+def riccati_branch_2x1(P, A, C, Q, R):
+    """``np.concatenate([g(P), h(P)])`` for 2 states and 1 output: every path's reception, then its loss
+    (the branching of the exact tree of :mod:`.exact`), in one compiled loop with the rounding of
+    :func:`riccati_step_2x1` (the same numbers as numpy's :func:`.model.riccati_g`, :func:`.model.riccati_h`).
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, 2, 2)
+        Covariances.
+    A, Q : ndarray, shape (2, 2)
+        System matrix and process noise covariance.
+    C : ndarray, shape (1, 2)
+        Output matrix.
+    R : ndarray, shape (1, 1)
+        Measurement noise variance.
+
+    Returns
+    -------
+    ndarray, shape (2N, 2, 2)
+        ``g`` of every matrix, then ``h`` of every matrix.
+
+    Raises
+    ------
+    ValueError
+        If the shapes are not those of a 2-state, 1-output system.
+    """
+    P = np.ascontiguousarray(P, dtype=float)
+    A, C, Q, R = (np.ascontiguousarray(x, dtype=float) for x in (A, C, Q, R))
+    if (P.ndim != 3 or P.shape[1:] != (2, 2) or A.shape != (2, 2) or C.shape != (1, 2) or Q.shape != (2, 2)
+            or R.shape != (1, 1)):
+        raise ValueError("riccati_branch_2x1 needs P (N, 2, 2), A and Q (2, 2), C (1, 2), R (1, 1)")
+    out = np.empty((2 * len(P), 2, 2))
+    _riccati_branch_2x1(P, A, C, Q, R, out)
+    return out
+
+@njit(boundscheck=False, inline="always")
+def _riccati_2x1(x00, x01, x10, x11, g, A, C, Q, R):
+    """``g(X)`` (``g`` true) or ``h(X)`` of one 2 x 2 matrix ``X`` (entries in row order), one output:
+    explicit FMAs, no fastmath (module docstring); returns the four entries of the result."""
+    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
+    if g:  # P - P C' (C P C' + R)^{-1} C P: the scalar innovation divides
+        c0, c1 = C[0, 0], C[0, 1]
+        u0 = _fma(x00, c0, x01 * c1)  # P C' (gemv: last coordinate first)
+        u1 = _fma(x10, c0, x11 * c1)
+        s = (c0 * u0 + c1 * u1) + R[0, 0]  # C (P C') (dot: no FMA), + R
+        v0 = u0 / s
+        v1 = u1 / s
+        x00 = x00 - u0 * v0
+        x01 = x01 - u0 * v1
+        x10 = x10 - u1 * v0
+        x11 = x11 - u1 * v1
+    t00 = _fma(a01, x10, a00 * x00)  # A X (left to right by FMA)
+    t01 = _fma(a01, x11, a00 * x01)
+    t10 = _fma(a11, x10, a10 * x00)
+    t11 = _fma(a11, x11, a10 * x01)
+    o00 = _fma(t01, a01, t00 * a00) + Q[0, 0]  # (A X) A' + Q
+    o01 = _fma(t01, a11, t00 * a10) + Q[0, 1]
+    o10 = _fma(t11, a01, t10 * a00) + Q[1, 0]
+    o11 = _fma(t11, a11, t10 * a10) + Q[1, 1]
+    if g:  # riccati_g symmetrises, riccati_h does not
+        return 0.5 * (o00 + o00), 0.5 * (o01 + o10), 0.5 * (o10 + o01), 0.5 * (o11 + o11)
+    return o00, o01, o10, o11
+
+
 @njit(cache=True, boundscheck=False)
 def _riccati_step_2x1(P, received, A, C, Q, R, out):
-    """The loop of :func:`riccati_step_2x1` on checked arguments (explicit FMAs, no fastmath)."""
-    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
-    c0, c1, r = C[0, 0], C[0, 1], R[0, 0]
+    """The loop of :func:`riccati_step_2x1` on checked arguments."""
     for b in range(P.shape[0]):
         x00, x01, x10, x11 = P[b, 0, 0], P[b, 0, 1], P[b, 1, 0], P[b, 1, 1]
-        g = received[b]
-        if g:  # P - P C' (C P C' + R)^{-1} C P: the scalar innovation divides
-            u0 = _fma(x00, c0, x01 * c1)  # P C' (gemv: last coordinate first)
-            u1 = _fma(x10, c0, x11 * c1)
-            s = (c0 * u0 + c1 * u1) + r  # C (P C') (dot: no FMA), + R
-            v0 = u0 / s
-            v1 = u1 / s
-            x00 = x00 - u0 * v0
-            x01 = x01 - u0 * v1
-            x10 = x10 - u1 * v0
-            x11 = x11 - u1 * v1
-        t00 = _fma(a01, x10, a00 * x00)  # A X (left to right by FMA)
-        t01 = _fma(a01, x11, a00 * x01)
-        t10 = _fma(a11, x10, a10 * x00)
-        t11 = _fma(a11, x11, a10 * x01)
-        o00 = _fma(t01, a01, t00 * a00) + Q[0, 0]  # (A X) A' + Q
-        o01 = _fma(t01, a11, t00 * a10) + Q[0, 1]
-        o10 = _fma(t11, a01, t10 * a00) + Q[1, 0]
-        o11 = _fma(t11, a11, t10 * a10) + Q[1, 1]
-        if g:  # riccati_g symmetrises, riccati_h does not
-            out[b, 0, 0] = 0.5 * (o00 + o00)
-            out[b, 0, 1] = 0.5 * (o01 + o10)
-            out[b, 1, 0] = 0.5 * (o10 + o01)
-            out[b, 1, 1] = 0.5 * (o11 + o11)
+        if received[b]:  # a constant flag in each call: two branch-free bodies
+            y = _riccati_2x1(x00, x01, x10, x11, True, A, C, Q, R)
         else:
-            out[b, 0, 0] = o00
-            out[b, 0, 1] = o01
-            out[b, 1, 0] = o10
-            out[b, 1, 1] = o11
+            y = _riccati_2x1(x00, x01, x10, x11, False, A, C, Q, R)
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = y
+
+
+@njit(cache=True, boundscheck=False)
+def _riccati_branch_2x1(P, A, C, Q, R, out):
+    """The loop of :func:`riccati_branch_2x1` on checked arguments."""
+    N = P.shape[0]
+    for b in range(N):
+        x00, x01, x10, x11 = P[b, 0, 0], P[b, 0, 1], P[b, 1, 0], P[b, 1, 1]
+        y = _riccati_2x1(x00, x01, x10, x11, True, A, C, Q, R)
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = y
+        y = _riccati_2x1(x00, x01, x10, x11, False, A, C, Q, R)
+        out[N + b, 0, 0], out[N + b, 0, 1], out[N + b, 1, 0], out[N + b, 1, 1] = y
