@@ -53,3 +53,26 @@ def test_kernel_bit_identical_with_numpy_reference(kind, with_gains, runs, seed)
     got = simulate_draws(sys, gains, p_seq, x0, draw_noise(np.random.default_rng(seed + 10), 30, runs), kind,
                          xf0=[0.2, -0.1])
     np.testing.assert_array_equal(got, ref)
+
+
+@pytest.mark.parametrize("kind", [0, 1, 2])
+@pytest.mark.parametrize("has_gains", [True, False])
+def test_kernel_2x1_equals_the_generic_kernel(kind, has_gains):
+    """The written-out kernel of the paper's shapes (2 states, 1 output, 2 channels) against the generic
+    loop, bit for bit, with random plants, gains, initial states and draws (including large states)."""
+    from netrepro.papers.gainsched.kernels import simulate_kernel, simulate_kernel_2x1
+
+    rng = np.random.default_rng(40 + kind)
+    for _ in range(3):
+        A, B, D, Z = (rng.standard_normal((2, 2)) for _ in range(4))
+        C = rng.standard_normal((1, 2))
+        d1 = rng.uniform(0.1, 1.0, 2)
+        d2 = d1 + rng.uniform(0.1, 3.0, 2)
+        G0, Gf = rng.standard_normal((2, 2)), rng.standard_normal((2, 2))
+        H0, Hf = rng.standard_normal((2, 1)), rng.standard_normal((2, 1))
+        p_seq = rng.uniform(0.2, 0.9, 25)
+        x0, xf0 = 5.0 * rng.standard_normal((150, 2)), rng.standard_normal((150, 2))
+        u, g = rng.random((25, 150)), rng.standard_normal((25, 150))
+        args = (A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_seq, x0, xf0, u, g, 0.7)
+        with np.errstate(over="ignore", invalid="ignore"):
+            np.testing.assert_array_equal(simulate_kernel_2x1(*args), simulate_kernel(*args))

@@ -83,3 +83,24 @@ def test_mean_is_concave_in_p0_so_the_two_point_laws_bracket_the_p0_range():
     assert np.all(m[10.0] >= 0.5 * (m[5.0] + m[15.0]) - 1e-12)
     assert np.all(0.5 * (m[5.0] + m[15.0]) >= 0.5 * (m[0.0] + m[20.0]) - 1e-12)
     assert np.any(m[10.0][1:] > 0.5 * (m[0.0] + m[20.0])[1:] + 1e-6)
+
+
+def test_e19_gap_grid_batched_equals_the_scalar_calls():
+    """E19 evaluates X -> g(X) - X on its bracketing grid in one batched expected_riccati_map call: for
+    scalar sensors every entry is the per-X call's number bit for bit (1 x 1 products and divisions), which
+    is what the row relied on when it called the map once per grid point."""
+    from netrepro.engines.riccati import Sensor, expected_riccati_map
+
+    sensors = [Sensor([[1.0]], [[1.0]]), Sensor([[1.0]], [[4.0]])]
+    xs = np.logspace(-3, 8, 111)
+    for a, lams in ((1.25, [0.3, 0.0]), (1.25, [0.3, 0.57]), (2.0, [0.9, 1.0]), (0.7, [0.01, 0.99])):
+        batched = expected_riccati_map(xs[:, None, None], [[a]], [[1.0]], sensors, lams)[:, 0, 0] - xs
+        scalar = np.array([float(expected_riccati_map([[x]], [[a]], [[1.0]], sensors, lams)[0, 0]) - x for x in xs])
+        assert np.array_equal(batched, scalar)
+        # and against the closed form of the corrected eq. (15) (two scalar sensors, independent losses)
+        l1, l2 = lams
+        post = lambda x, r: x - x * x / (x + r)  # noqa: E731
+        both = post(post(xs, 1.0), 4.0)
+        ref = a * a * ((1 - l1) * (1 - l2) * xs + l1 * (1 - l2) * post(xs, 1.0) + (1 - l1) * l2 * post(xs, 4.0)
+                       + l1 * l2 * both) + 1.0 - xs
+        assert np.allclose(batched, ref, rtol=1e-9, atol=1e-9 * xs)

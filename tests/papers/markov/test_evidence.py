@@ -160,6 +160,23 @@ def test_path_weights_from_codes_equal_the_direct_form():
             assert np.array_equal(enumeration.path_weights(G, p, q, gamma1, enumeration.transition_codes(G)), ref)
 
 
+
+@pytest.mark.parametrize("system", [EX1, EX2])
+def test_mean_norms_enumerated_equal_the_per_p_form_bit_for_bit(system):
+    """mean_norms_enumerated (weights as prefix products along the path tree, all p at once) gives exactly
+    mean_norm_enumerated (every path's steps gathered and multiplied by numpy.prod) at every p, both starts;
+    paths not in enumerate_norms' order go through the per-p form (same numbers)."""
+    paths = enumeration.enumerate_norms(system, np.eye(system.n), 10)
+    ps = np.linspace(0.05, 0.999, 23)
+    for q in (0.3, 0.9, 0.999):
+        for start in ("gamma1", "stationary"):
+            ref = np.array([enumeration.mean_norm_enumerated(paths, p, q, start) for p in ps])
+            assert np.array_equal(enumeration.mean_norms_enumerated(paths, ps, q, start), ref)
+            shuffled = [(G[::-1], n[::-1]) for G, n in paths]   # same sums in another order: not the tree
+            got = enumeration.mean_norms_enumerated(shuffled, ps, q, start)
+            assert np.array_equal(got, np.array([enumeration.mean_norm_enumerated(shuffled, p, q, start) for p in ps]))
+            assert np.allclose(got, ref, rtol=1e-12)
+
 def test_evidence_imports_no_private_name_and_defines_no_mathematics():
     """evidence.py assembles: it imports no private name and defines only its step, the settings reader and
     private row builders (issue 29)."""

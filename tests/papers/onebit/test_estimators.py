@@ -159,6 +159,34 @@ def test_bootstrap_ratio_db_matches_a_plain_loop():
         estimators.bootstrap_ratio_db(a, b[:-1], 10, seed=1)
 
 
+@pytest.mark.parametrize("n_runs, chunk", [(50, 7), (2000, 250), (333, 64)])
+def test_paired_ratio_intervals_replicates_are_bootstrap_ratio_db(n_runs, chunk):
+    # the estimator step takes rho_S's crossing replicates from the intervals' resampling (same seed) instead
+    # of redrawing them with bootstrap_ratio_db: the same numbers, bit for bit (tolerance 0)
+    rng = np.random.default_rng(n_runs)
+    vals = {k: rng.exponential(s, n_runs) for k, s in (("a", 2.0), ("b", 1.0), ("c", 1.5))}
+    pairs = [("a", "b"), ("c", "b"), ("a", "c")]
+    out, reps = estimators.paired_ratio_intervals(vals, pairs, 300, 11, replicates=True)
+    assert out == estimators.paired_ratio_intervals(vals, pairs, 300, 11)
+    for (num, den), rep in zip(pairs, reps):
+        assert rep.tobytes() == estimators.bootstrap_ratio_db(vals[num], vals[den], 300, 11, chunk=chunk).tobytes()
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3])
+def test_downward_roots_is_downward_root_row_by_row(degree):
+    # the batched form (one eigvals call on the stacked companion matrices) against the per-row function,
+    # tolerance 0; rows with a zero leading or trailing coefficient take the per-row path
+    rng = np.random.default_rng(degree)
+    c = rng.normal(size=(400, degree + 1))
+    c[:50, -1] = 0.0
+    c[50:60, 0] = 0.0
+    c[61:80] = np.round(c[61:80], 1)
+    got = estimators.downward_roots(c, -1.5, 1.5)
+    want = np.array([estimators.downward_root(row, -1.5, 1.5) for row in c])
+    assert got.tobytes() == want.tobytes()
+    assert np.isfinite(got).sum() > 50 and np.isnan(got).sum() > 50  # both outcomes exercised
+
+
 def test_run_tail_statistics_against_direct_formulas():
     rng = np.random.default_rng(5)
     v = rng.lognormal(0.0, 1.0, 400)

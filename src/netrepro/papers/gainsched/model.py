@@ -845,7 +845,7 @@ def simulate_draws(sys: System, gains: Gains | None, p_seq, x0, draws, nonlinear
     ndarray (runs, K+1, n)
         The estimation errors e(k) = x(k) - x_f(k).
     """
-    from .kernels import KINDS, simulate_kernel
+    from .kernels import KINDS, simulate_kernel, simulate_kernel_2x1
 
     x = np.ascontiguousarray(np.array(x0, dtype=float))
     if x.ndim != 2 or x.shape[1] != sys.n:
@@ -861,10 +861,12 @@ def simulate_draws(sys: System, gains: Gains | None, p_seq, x0, draws, nonlinear
         xf = xf + np.asarray(xf0, dtype=float)
     gg = gains if gains is not None else zero_gains(sys)
     c = np.ascontiguousarray
-    return simulate_kernel(c(sys.A), c(sys.B), c(sys.C), c(sys.D), c(sys.Z), np.diag(sys.F1).copy(),
-                           np.diag(sys.F2).copy(), KINDS[nonlinearity], c(gg.G0, dtype=float), c(gg.Gf, dtype=float),
-                           c(gg.H0, dtype=float), c(gg.Hf, dtype=float), gains is not None, p_seq, x,
-                           np.ascontiguousarray(xf), u, g, float(np.sqrt(sys.sigma2)))
+    # the paper's shapes (2 states, 1 output, 2 channels of f): the same recursion written out, the same numbers
+    kernel = simulate_kernel_2x1 if (sys.n, sys.m, sys.nz) == (2, 1, 2) else simulate_kernel
+    return kernel(c(sys.A), c(sys.B), c(sys.C), c(sys.D), c(sys.Z), np.diag(sys.F1).copy(),
+                  np.diag(sys.F2).copy(), KINDS[nonlinearity], c(gg.G0, dtype=float), c(gg.Gf, dtype=float),
+                  c(gg.H0, dtype=float), c(gg.Hf, dtype=float), gains is not None, p_seq, x,
+                  np.ascontiguousarray(xf), u, g, float(np.sqrt(sys.sigma2)))
 
 
 # ----------------------------------------------------------------------------- helpers of the steps

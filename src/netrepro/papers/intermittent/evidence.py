@@ -146,7 +146,7 @@ def _minimise_rows(ts, a, R1, row):
         def gap(x, lam2=lam2):
             return float(expected_riccati_map([[x]], [[a]], [[R1]], sensors, [lam1, lam2])[0, 0]) - x
 
-        d = np.array([gap(x) for x in xs])
+        d = expected_riccati_map(xs[:, None, None], [[a]], [[R1]], sensors, [lam1, lam2])[:, 0, 0] - xs  # gap(xs)
         sign = np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))
         if sign.size:
             x0 = optimize.brentq(gap, xs[sign[0]], xs[sign[0] + 1], xtol=1e-14, rtol=4 * np.finfo(float).eps)

@@ -11,7 +11,8 @@ import numpy as np
 
 from .model import LinearSystem, riccati_g, riccati_h
 
-__all__ = ["enumerate_norms", "transition_codes", "path_weights", "mean_norm_enumerated", "monotonicity_violation"]
+__all__ = ["enumerate_norms", "transition_codes", "path_weights", "mean_norm_enumerated", "mean_norms_enumerated",
+           "monotonicity_violation"]
 
 
 def enumerate_norms(system: LinearSystem, Sigma0, k_max: int):
@@ -116,6 +117,72 @@ def mean_norm_enumerated(paths, p: float, q: float, start: str = "gamma1", codes
     zero = np.array([w @ n for w, n in ((path_weights(G, p, q, 0, c), n) for (G, n), c in zip(paths, codes))])
     zero[0] = one[0]
     pi1 = q / (p + q)
+    return pi1 * one + (1 - pi1) * zero
+
+
+def _is_enumeration_tree(paths) -> bool:
+    """Whether ``paths`` holds the paths of :func:`enumerate_norms` in its order (level ``i``: the level
+    ``i - 1`` paths with a 0 appended, then with a 1 appended; level 1: ``[[0], [1]]``)."""
+    G = np.zeros((1, 0), dtype=int)
+    for i, (Gi, _) in enumerate(paths):
+        if i:
+            G = np.concatenate([np.c_[G, np.zeros(len(G), int)], np.c_[G, np.ones(len(G), int)]])
+        if np.shape(Gi) != G.shape or not np.array_equal(Gi, G):
+            return False
+    return True
+
+
+def mean_norms_enumerated(paths, ps, q: float, start: str = "gamma1") -> np.ndarray:
+    """:func:`mean_norm_enumerated` for every ``p`` of ``ps`` (one row each), the same numbers bit for bit.
+
+    On the paths of :func:`enumerate_norms` (checked; other ``paths`` go through
+    :func:`mean_norm_enumerated` itself) the weight of eq. (3) of a path of level ``i`` is its parent's
+    product of step probabilities times the probability of the one new step, for all ``p`` at once:
+    the same products in the same order as :func:`path_weights` (``numpy.prod`` multiplies left to
+    right), without gathering every step of every path again at each level; each ``E||P_k||`` is the
+    same dot product of weights and norms.
+
+    Parameters
+    ----------
+    paths : list
+        From :func:`enumerate_norms`.
+    ps : array_like
+        Failure rates.
+    q : float
+        Recovery rate.
+    start : {"gamma1", "stationary"}
+        As :func:`mean_norm_enumerated`.
+
+    Returns
+    -------
+    ndarray
+        ``(len(ps), k_max)``.
+    """
+    ps = np.asarray(ps, dtype=float).ravel()
+    if not _is_enumeration_tree(paths):
+        return np.array([mean_norm_enumerated(paths, p, q, start) for p in ps]).reshape(len(ps), len(paths))
+    # columns: the step probabilities of transition codes 0..3 of transition_codes (1->1, 1->0, 0->1, 0->0)
+    step = np.stack([1 - ps, ps, np.full_like(ps, q), np.full_like(ps, 1 - q)], axis=1)
+    gammas = (1,) if start == "gamma1" else (1, 0)
+    means = {g: np.empty((len(ps), len(paths))) for g in gammas}
+    prod = np.ones((len(ps), 1))     # products of the step probabilities of each path, level by level
+    for i, (G, n) in enumerate(paths):
+        if i >= 2:                   # append 0 (codes 1 from 1, 3 from 0), then 1 (codes 0 from 1, 2 from 0)
+            last = G[: len(G) // 2, -2] == 1
+            prod = np.concatenate([prod * np.where(last, step[:, 1:2], step[:, 3:4]),
+                                   prod * np.where(last, step[:, 0:1], step[:, 2:3])], axis=1)
+        elif i == 1:
+            prod = np.ones((len(ps), 2))
+        for g in gammas:
+            w = prod if i == 0 else np.where(G[:, 0] == g, 1.0, 0.0) * prod
+            for j in range(len(ps)):
+                means[g][j, i] = w[j] @ n
+    one = means[1]
+    if start == "gamma1":
+        return one
+    zero = means[0]
+    zero[:, 0] = one[:, 0]
+    pi1 = (q / (ps + q))[:, None]
     return pi1 * one + (1 - pi1) * zero
 
 

@@ -209,7 +209,12 @@ def rb_mean_trace(system, Sigma0, p, q, arrivals, n_batches: int, z: float):
 def _riccati_step(P, received, A, C, Q, R):
     """One step of eqs. (4)-(5) for a batch of paths: ``g(P)`` (eq. 5) where ``received``, else ``h(P)``
     (eq. 4), each map evaluated only on its own paths (every batched product and solve acts on one
-    matrix at a time, so this equals ``np.where(received, g(P), h(P))`` bit for bit at half the work)."""
+    matrix at a time, so this equals ``np.where(received, g(P), h(P))`` bit for bit at half the work).
+    Two states and one output: the compiled :func:`.kernels.riccati_step_2x1`, the same numbers."""
+    if P.shape[1:] == (2, 2) and np.shape(C) == (1, 2) and np.shape(R) == (1, 1):
+        from .kernels import riccati_step_2x1  # numba: imported by the steps that run the estimator
+
+        return riccati_step_2x1(P, received, A, C, Q, R)
     out = np.empty_like(P)
     out[received] = riccati_g(P[received], A, C, Q, R)
     lost = ~received

@@ -29,6 +29,16 @@ def _branch_channel(state, counts):
     return new_state, counts
 
 
+def _both_maps(P, A, C, Q, R):
+    """``np.concatenate([g(P), h(P)])`` (eqs. 5 and 4: every path's reception, then its loss), for 2 states
+    and 1 output by the compiled :func:`.kernels.riccati_branch_2x1` (the same numbers)."""
+    if P.shape[1:] == (2, 2) and np.shape(C) == (1, 2) and np.shape(R) == (1, 1):
+        from .kernels import riccati_branch_2x1  # numba: imported by the steps that build the tree
+
+        return riccati_branch_2x1(P, A, C, Q, R)
+    return np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
+
+
 def _transition_key(counts, d):
     """One integer per path from its four transition counts (each at most ``d``): equal keys, equal probability."""
     return ((counts[:, 0].astype(np.int64) * (d + 1) + counts[:, 1]) * (d + 1) + counts[:, 2]) * (d + 1) + counts[:, 3]
@@ -144,9 +154,7 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
     for d in range(1, depth + 1):
         if d > 1:
             with np.errstate(over="ignore", invalid="ignore"):
-                P_recv = riccati_g(P, A, C, Q, R)
-                P_loss = riccati_h(P, A, Q)
-            P = np.concatenate([P_recv, P_loss])
+                P = _both_maps(P, A, C, Q, R)
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(group_counts))
@@ -274,8 +282,7 @@ def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSp
     for d in range(1, depth + 1):
         if d > 1:
             with np.errstate(over="ignore", invalid="ignore"):
-                Ps = [np.concatenate([riccati_g(P, A, C, Q, R), riccati_h(P, A, Q)])
-                      for P, (A, C, Q, R, _) in zip(Ps, blocks)]
+                Ps = [_both_maps(P, A, C, Q, R) for P, (A, C, Q, R, _) in zip(Ps, blocks)]
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)

@@ -12,6 +12,12 @@ by path in one compiled loop, with the arithmetic of the numpy form:
 * ``||X||`` by the closed forms of :func:`.model.sym_norm` (``n = 2, 3``), ``inf`` for non-finite;
 * the weighted sum over the last reception time by numpy's pairwise summation (``np.sum``).
 
+:func:`riccati_step_2x1` is the step of eqs. (4)-(5) of :func:`.estimators.rb_trace_grid` for two
+states and one output, with the rounding of numpy's forms (:func:`.model.riccati_g`,
+:func:`.model.riccati_h`) on this platform: ``A X`` and ``X A'`` accumulated left to right by fused
+multiply-adds (OpenBLAS's small ``dgemm``), ``P C'`` from the last coordinate down (its ``dgemv``),
+``C (P C')`` without a fused multiply-add (its ``ddot``); the unit test compares both bit for bit.
+
 Compiled code is cached on disk by numba (next to this file).
 """
 
@@ -20,9 +26,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import intrinsic
 
-__all__ = ["rb_norm_kernel", "pairwise_sum"]
+__all__ = ["rb_norm_kernel", "pairwise_sum", "riccati_step_2x1", "riccati_branch_2x1"]
 
 
 @njit(cache=True, boundscheck=False)
@@ -259,3 +266,144 @@ def _rb_norm_paths(P, arrivals, A, Q, W, which_trace, out, H, tmp, row, frames, 
                     row[c] = 0.0
             out[a, k - 1] = _pairwise_sum_into(row, 0, k - 1, frames, vals)
     return out
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):
+    """Fused multiply-add ``a*b + c`` with one rounding (``llvm.fma``, IEEE on every platform)."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+def riccati_step_2x1(P, received, A, C, Q, R):
+    """One step of eqs. (4)-(5) for a batch of paths of a system with 2 states and 1 output.
+
+    ``g(P)`` (eq. 5, :func:`.model.riccati_g`, symmetrised) where ``received``, else ``h(P)`` (eq. 4,
+    :func:`.model.riccati_h`), matrix by matrix in one compiled loop, with the rounding of those numpy
+    forms (module docstring): the same numbers as ``np.where(received, g(P), h(P))``.
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, 2, 2)
+        Covariances.
+    received : ndarray of bool, shape (N,)
+        ``gamma_k`` per path.
+    A, Q : ndarray, shape (2, 2)
+        System matrix and process noise covariance.
+    C : ndarray, shape (1, 2)
+        Output matrix.
+    R : ndarray, shape (1, 1)
+        Measurement noise variance.
+
+    Returns
+    -------
+    ndarray, shape (N, 2, 2)
+        The covariances one step on.
+
+    Raises
+    ------
+    ValueError
+        If the shapes are not those of a 2-state, 1-output system.
+    """
+    P = np.ascontiguousarray(P, dtype=float)
+    received = np.ascontiguousarray(received, dtype=np.bool_)
+    A, C, Q, R = (np.ascontiguousarray(x, dtype=float) for x in (A, C, Q, R))
+    if (P.ndim != 3 or P.shape[1:] != (2, 2) or received.shape != P.shape[:1] or A.shape != (2, 2)
+            or C.shape != (1, 2) or Q.shape != (2, 2) or R.shape != (1, 1)):
+        raise ValueError("riccati_step_2x1 needs P (N, 2, 2), received (N,), A and Q (2, 2), C (1, 2), R (1, 1)")
+    out = np.empty_like(P)
+    _riccati_step_2x1(P, received, A, C, Q, R, out)
+    return out
+
+
+
+def riccati_branch_2x1(P, A, C, Q, R):
+    """``np.concatenate([g(P), h(P)])`` for 2 states and 1 output: every path's reception, then its loss
+    (the branching of the exact tree of :mod:`.exact`), in one compiled loop with the rounding of
+    :func:`riccati_step_2x1` (the same numbers as numpy's :func:`.model.riccati_g`, :func:`.model.riccati_h`).
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, 2, 2)
+        Covariances.
+    A, Q : ndarray, shape (2, 2)
+        System matrix and process noise covariance.
+    C : ndarray, shape (1, 2)
+        Output matrix.
+    R : ndarray, shape (1, 1)
+        Measurement noise variance.
+
+    Returns
+    -------
+    ndarray, shape (2N, 2, 2)
+        ``g`` of every matrix, then ``h`` of every matrix.
+
+    Raises
+    ------
+    ValueError
+        If the shapes are not those of a 2-state, 1-output system.
+    """
+    P = np.ascontiguousarray(P, dtype=float)
+    A, C, Q, R = (np.ascontiguousarray(x, dtype=float) for x in (A, C, Q, R))
+    if (P.ndim != 3 or P.shape[1:] != (2, 2) or A.shape != (2, 2) or C.shape != (1, 2) or Q.shape != (2, 2)
+            or R.shape != (1, 1)):
+        raise ValueError("riccati_branch_2x1 needs P (N, 2, 2), A and Q (2, 2), C (1, 2), R (1, 1)")
+    out = np.empty((2 * len(P), 2, 2))
+    _riccati_branch_2x1(P, A, C, Q, R, out)
+    return out
+
+@njit(boundscheck=False, inline="always")
+def _riccati_2x1(x00, x01, x10, x11, g, A, C, Q, R):
+    """``g(X)`` (``g`` true) or ``h(X)`` of one 2 x 2 matrix ``X`` (entries in row order), one output:
+    explicit FMAs, no fastmath (module docstring); returns the four entries of the result."""
+    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
+    if g:  # P - P C' (C P C' + R)^{-1} C P: the scalar innovation divides
+        c0, c1 = C[0, 0], C[0, 1]
+        u0 = _fma(x00, c0, x01 * c1)  # P C' (gemv: last coordinate first)
+        u1 = _fma(x10, c0, x11 * c1)
+        s = (c0 * u0 + c1 * u1) + R[0, 0]  # C (P C') (dot: no FMA), + R
+        v0 = u0 / s
+        v1 = u1 / s
+        x00 = x00 - u0 * v0
+        x01 = x01 - u0 * v1
+        x10 = x10 - u1 * v0
+        x11 = x11 - u1 * v1
+    t00 = _fma(a01, x10, a00 * x00)  # A X (left to right by FMA)
+    t01 = _fma(a01, x11, a00 * x01)
+    t10 = _fma(a11, x10, a10 * x00)
+    t11 = _fma(a11, x11, a10 * x01)
+    o00 = _fma(t01, a01, t00 * a00) + Q[0, 0]  # (A X) A' + Q
+    o01 = _fma(t01, a11, t00 * a10) + Q[0, 1]
+    o10 = _fma(t11, a01, t10 * a00) + Q[1, 0]
+    o11 = _fma(t11, a11, t10 * a10) + Q[1, 1]
+    if g:  # riccati_g symmetrises, riccati_h does not
+        return 0.5 * (o00 + o00), 0.5 * (o01 + o10), 0.5 * (o10 + o01), 0.5 * (o11 + o11)
+    return o00, o01, o10, o11
+
+
+@njit(cache=True, boundscheck=False)
+def _riccati_step_2x1(P, received, A, C, Q, R, out):
+    """The loop of :func:`riccati_step_2x1` on checked arguments."""
+    for b in range(P.shape[0]):
+        x00, x01, x10, x11 = P[b, 0, 0], P[b, 0, 1], P[b, 1, 0], P[b, 1, 1]
+        if received[b]:  # a constant flag in each call: two branch-free bodies
+            y = _riccati_2x1(x00, x01, x10, x11, True, A, C, Q, R)
+        else:
+            y = _riccati_2x1(x00, x01, x10, x11, False, A, C, Q, R)
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = y
+
+
+@njit(cache=True, boundscheck=False)
+def _riccati_branch_2x1(P, A, C, Q, R, out):
+    """The loop of :func:`riccati_branch_2x1` on checked arguments."""
+    N = P.shape[0]
+    for b in range(N):
+        x00, x01, x10, x11 = P[b, 0, 0], P[b, 0, 1], P[b, 1, 0], P[b, 1, 1]
+        y = _riccati_2x1(x00, x01, x10, x11, True, A, C, Q, R)
+        out[b, 0, 0], out[b, 0, 1], out[b, 1, 0], out[b, 1, 1] = y
+        y = _riccati_2x1(x00, x01, x10, x11, False, A, C, Q, R)
+        out[N + b, 0, 0], out[N + b, 0, 1], out[N + b, 1, 0], out[N + b, 1, 1] = y

@@ -16,6 +16,7 @@ from ...errors import InputError
 from .model import stationary_variance
 
 __all__ = [
+    "downward_roots",
     "simulate_block",
     "grid_filter_smoother",
     "kalman_rts",
@@ -449,7 +450,7 @@ def _bootstrap_means(arrs, idx, block: int = 64):
     return boot
 
 
-def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float = 0.95):
+def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float = 0.95, replicates: bool = False):
     r""":func:`paired_ratio_interval` for several ``(num, den)`` pairs of the same runs and seed, resampled once.
 
     Every pair gets exactly what ``paired_ratio_interval(values[num], values[den], n_boot, seed, level)``
@@ -468,11 +469,18 @@ def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float =
         Seed of the resampling generator.
     level : float
         Coverage of the percentile interval.
+    replicates : bool
+        Also return each pair's bootstrap replicates in dB, ``10 log10(mean a* / mean b*)``: the same
+        numbers as ``bootstrap_ratio_db(values[num], values[den], n_boot, seed)`` (the same generator and
+        seed draw the same run indices, whatever the chunking: bounded 32-bit integers are drawn one by
+        one; each replicate's means are reduced row by row).
 
     Returns
     -------
     list of tuple of float
         ``(estimate_db, lo_db, hi_db)`` per pair.
+    list of ndarray (n_boot,)
+        With ``replicates``: the replicates in dB, per pair.
 
     Raises
     ------
@@ -488,12 +496,14 @@ def paired_ratio_intervals(values, pairs, n_boot: int, seed: int, level: float =
     idx = rng.integers(0, n, size=(n_boot, n))
     boot = _bootstrap_means(arrs, idx)
     q = 100.0 * (1.0 - level) / 2.0
-    out = []
+    out, reps = [], []
     for num, den in pairs:
         a, b = arrs[num], arrs[den]
-        lo, hi = np.percentile(10.0 * np.log10(boot[num] / boot[den]), [q, 100.0 - q])
+        rep = 10.0 * np.log10(boot[num] / boot[den])
+        lo, hi = np.percentile(rep, [q, 100.0 - q])
         out.append((float(10.0 * np.log10(a.mean() / b.mean())), float(lo), float(hi)))
-    return out
+        reps.append(rep)
+    return (out, reps) if replicates else out
 
 
 def db_zero_crossing(x, y) -> float:
@@ -580,6 +590,53 @@ def downward_root(coefs, lo: float, hi: float) -> float:
     return ok[0] if ok else float("nan")
 
 
+def downward_roots(coefs, lo: float, hi: float) -> np.ndarray:
+    """:func:`downward_root` of each row of ``coefs``, the same numbers, the polynomials' roots in one batch.
+
+    For a row without leading or trailing zero coefficients (all finite) the roots are the eigenvalues of
+    its companion matrix, as :func:`numpy.roots` computes them (``eigvals`` of a stack runs the same LAPACK
+    routine matrix by matrix); the derivative is evaluated by Horner's rule as :func:`numpy.polyval` does.
+    Other rows go through :func:`downward_root` itself.
+
+    Parameters
+    ----------
+    coefs : array_like (n, d + 1)
+        Polynomial coefficients per row, highest power first.
+    lo, hi : float
+        The window.
+
+    Returns
+    -------
+    ndarray (n,)
+        Per row the smallest root in ``[lo, hi]`` where the polynomial decreases, NaN if none.
+    """
+    c = np.atleast_2d(np.asarray(coefs, dtype=float))
+    n, d = c.shape[0], c.shape[1] - 1
+    out = np.full(n, np.nan)
+    plain = np.all(np.isfinite(c), -1) & (c[:, 0] != 0) & (c[:, -1] != 0) if d >= 1 else np.zeros(n, dtype=bool)
+    for i in np.nonzero(~plain)[0]:
+        out[i] = downward_root(c[i], lo, hi)
+    rows = np.nonzero(plain)[0]
+    if len(rows) == 0:
+        return out
+    cp = c[rows]
+    A = np.zeros((len(rows), d, d))
+    if d > 1:
+        A[:, np.arange(1, d), np.arange(d - 1)] = 1.0
+    A[:, 0, :] = -cp[:, 1:] / cp[:, :1]
+    roots = np.linalg.eigvals(A)                           # (m, d)
+    re, im = roots.real, roots.imag
+    real = np.abs(im) <= 1e-12 * np.maximum(1.0, np.abs(re))
+    dcoef = cp[:, :-1] * np.arange(d, 0, -1)               # numpy.polyder
+    y = np.zeros_like(re)
+    for j in range(d):                                     # numpy.polyval: y = y * x + p_j
+        y = y * re + dcoef[:, j:j + 1]
+    ok = real & (lo <= re) & (re <= hi) & (y < 0)
+    best = np.where(ok, re, np.inf).min(-1)
+    out[rows] = np.where(np.isfinite(best), best, np.nan)
+    return out
+
+
 def local_crossing_fit(x, y, y_boot, degree: int = 2, level: float = 0.95) -> dict:
     r"""Where a curve known at a few points crosses 0 downwards: a local polynomial fit with a bootstrap interval.
 
@@ -625,7 +682,7 @@ def local_crossing_fit(x, y, y_boot, degree: int = 2, level: float = 0.95) -> di
     coefs = np.polyfit(x, y, degree)
     est = downward_root(coefs, lo_x, hi_x)
     cb = np.polyfit(x, yb.T, degree).T          # (n_boot, degree + 1)
-    roots = np.array([downward_root(c, lo_x, hi_x) for c in cb])
+    roots = downward_roots(cb, lo_x, hi_x)
     fail = np.isnan(roots)
     if fail.any():
         above = np.array([np.polyval(c, hi_x) > 0 for c in cb[fail]])

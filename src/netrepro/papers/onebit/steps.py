@@ -65,7 +65,6 @@ import pandas as pd
 from scipy.special import ndtri
 
 from .estimators import (
-    bootstrap_ratio_db,
     db_zero_crossing,
     downward_root,
     grid_smoother_at,
@@ -529,15 +528,17 @@ def estimator_step(params, inputs, outputs):
                                  n_runs=len(v), steady_dev=dev[kind], **design_cols, case_set=case.case_set,
                                  **tails))
         bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
-        intervals = paired_ratio_intervals(runs, [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()],
-                                           est["n_boot"], seed)   # one resampling per case, shared by the ratios
+        pairs = [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()]
+        intervals, reps = paired_ratio_intervals(runs, pairs, est["n_boot"], seed,  # one resampling per case,
+                                                 replicates=True)                    # shared by the ratios
         for (qty, (ref, onebit, col)), (e, lo, hi) in zip(RATIO_DEFS.items(), intervals):
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
                                    steady_dev=max(dev[ref], dev[onebit]), **design_cols, case_set=case.case_set,
                                    key=key, half_db=_half_ratios_db(runs[ref], runs[onebit])))
-        # bootstrap replicates of the achievable rho_S for the crossing fit (its own resampling per case)
-        boot[key] = bootstrap_ratio_db(runs[ref_s], runs[onebit_s], est["n_boot"], seed)
+        # bootstrap replicates of the achievable rho_S for the crossing fit: bootstrap_ratio_db(runs[ref_s],
+        # runs[onebit_s], n_boot, seed), the same numbers as the intervals' resampling (same seed), not redrawn
+        boot[key] = reps[pairs.index((ref_s, onebit_s))]
     crossing = _crossing_rows(params, ratio_rows, boot)
     ratios = pd.DataFrame(ratio_rows).drop(columns=["key", "half_db"])
     return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": crossing}
