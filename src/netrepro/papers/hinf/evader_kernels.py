@@ -87,18 +87,7 @@ def pairwise_kernel(Minv, lam, n_iter):
     for r in range(m):
         for _ in range(n_iter):
             # A = sum_n lam_n M_n (sequential, as einsum)
-            A00 = 0.0
-            A01 = 0.0
-            A10 = 0.0
-            A11 = 0.0
-            for q in range(n):
-                A00 += lam[r, q] * Minv[r, q, 0, 0]
-            for q in range(n):
-                A01 += lam[r, q] * Minv[r, q, 0, 1]
-            for q in range(n):
-                A10 += lam[r, q] * Minv[r, q, 1, 0]
-            for q in range(n):
-                A11 += lam[r, q] * Minv[r, q, 1, 1]
+            A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
             c = A00 * A11 - A01 * A10
             i00 = A11 / c
             i11 = A00 / c
