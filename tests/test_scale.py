@@ -141,6 +141,11 @@ def test_scale_step_and_panel(tmp_path, two_runs, monkeypatch):
     assert 'data-claim="flips"' in html and 'data-claim="same"' not in html and 'data-claim="moves"' not in html
     assert "30.0 min" in html
     assert scale_html({}) == ""
+    # a recording whose jobs ran at two commits lists both, not a Python list
+    prov = json.loads((reference / "provenance.json").read_text())
+    (reference / "provenance.json").write_text(json.dumps({**prov, "commit": ["abc", "def"]}))
+    html = scale_html({**paths, "reference": str(reference)})
+    assert "commits <code>abc</code>, <code>def</code>" in html and "[&#39;abc&#39;" not in html
 
 
 def test_findings_comparison_keeps_both_evidence_texts(two_runs):

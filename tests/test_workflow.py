@@ -83,6 +83,18 @@ def test_parameter_change_reruns_exactly_dependents(built):
     assert not planned & untouched
 
 
+def test_a_template_edit_reruns_only_the_report(built):
+    # the report's markup is data (Jinja2 templates, one style sheet), not code: an edit must still show
+    template = built / "src/netrepro/report/templates/scale.html"
+    original, stat = template.read_text(), template.stat()
+    template.write_text(original + "\n")
+    try:
+        assert jobs_planned(built, "report") == {"report"}
+    finally:  # content and time restored: the later tests see the built repository as it was
+        template.write_text(original)
+        os.utime(template, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+
+
 def test_n_chunks_does_not_trigger_rerun(built):
     cfg_path = built / "config/test.yaml"
     original = cfg_path.read_text()

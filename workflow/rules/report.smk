@@ -42,6 +42,8 @@ rule report:
         code=code("netrepro.report.build:build_index"),
         # titles and citations: a title fix reruns the report, and nothing of any paper
         registry="src/netrepro/papers.yaml",
+        # the markup and the style sheet are data, not code: a change of look reruns the report
+        templates=sorted(str(p) for p in Path("src/netrepro/report/templates").glob("*.*")),
         scale=rules.scale_verdicts.output if SCALE_RECORDED else [],
     output:
         html="report/index.html",
