@@ -13,23 +13,13 @@ platform; no fastmath.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
+
+from ...engines.intrinsics import fma
 
 __all__ = ["simulate_kernel", "simulate_kernel_2x1", "KINDS"]
 
 KINDS = {"sine_mid": 0, "lower": 1, "upper": 2}
-
-
-@intrinsic
-def _fma(typingctx, a, b, c):
-    """fused multiply-add a*b + c with one rounding (llvm.fma)."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-
-    return sig, codegen
 
 
 @njit(cache=True)
@@ -98,22 +88,22 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
             for j in range(m):  # y = xi (x @ C.T)
                 acc = x[n - 1] * C[j, n - 1]
                 for q in range(n - 2, -1, -1):
-                    acc = _fma(x[q], C[j, q], acc)
+                    acc = fma(x[q], C[j, q], acc)
                 y[j] = xi * acc
             if has_gains:  # x_f @ G.T + y @ H.T
                 for i in range(n):
                     a1 = xf[0] * G[k, i, 0]
                     for q in range(1, n):
-                        a1 = _fma(xf[q], G[k, i, q], a1)
+                        a1 = fma(xf[q], G[k, i, q], a1)
                     a2 = y[0] * H[k, i, 0]
                     for q in range(1, m):
-                        a2 = _fma(y[q], H[k, i, q], a2)
+                        a2 = fma(y[q], H[k, i, q], a2)
                     xfn[i] = a1 + a2
                 xf, xfn = xfn, xf  # swap the buffers instead of copying (less code to compile)
             for i in range(nz):  # f(x @ Z.T)
                 zi = x[0] * Z[i, 0]
                 for q in range(1, n):
-                    zi = _fma(x[q], Z[i, q], zi)
+                    zi = fma(x[q], Z[i, q], zi)
                 if kind == 0:  # (F1 + F2)/2 z + (F2 - F1)/2 sin z, the numpy reference's rounding order
                     f[i] = (0.5 * (d1[i] + d2[i])) * zi + (0.5 * (d2[i] - d1[i])) * np.sin(zi)
                 elif kind == 1:
@@ -124,11 +114,11 @@ def simulate_kernel(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, p_se
                 xa = x[0] * A[i, 0]
                 xd = x[0] * D[i, 0]
                 for q in range(1, n):
-                    xa = _fma(x[q], A[i, q], xa)
-                    xd = _fma(x[q], D[i, q], xd)
+                    xa = fma(x[q], A[i, q], xa)
+                    xd = fma(x[q], D[i, q], xd)
                 fb = f[0] * B[i, 0]
                 for q in range(1, nz):
-                    fb = _fma(f[q], B[i, q], fb)
+                    fb = fma(f[q], B[i, q], fb)
                 xn[i] = (xa + fb) + w * xd
             x, xn = xn, x
             for i in range(n):
@@ -188,13 +178,13 @@ def simulate_kernel_2x1(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, 
             p = p_seq[k]
             xi = 1.0 if u[k, r] < p else 0.0
             w = sd * g[k, r]
-            y = xi * _fma(x0_, c0, x1_ * c1)  # xi (x @ C.T), gemv order
+            y = xi * fma(x0_, c0, x1_ * c1)  # xi (x @ C.T), gemv order
             if has_gains:  # x_f @ G.T + y @ H.T with G = G0 + p Gf, H = H0 + p Hf
-                n0 = _fma(f1_, G0[0, 1] + p * Gf[0, 1], f0_ * (G0[0, 0] + p * Gf[0, 0])) + y * (H0[0, 0] + p * Hf[0, 0])
-                n1 = _fma(f1_, G0[1, 1] + p * Gf[1, 1], f0_ * (G0[1, 0] + p * Gf[1, 0])) + y * (H0[1, 0] + p * Hf[1, 0])
+                n0 = fma(f1_, G0[0, 1] + p * Gf[0, 1], f0_ * (G0[0, 0] + p * Gf[0, 0])) + y * (H0[0, 0] + p * Hf[0, 0])
+                n1 = fma(f1_, G0[1, 1] + p * Gf[1, 1], f0_ * (G0[1, 0] + p * Gf[1, 0])) + y * (H0[1, 0] + p * Hf[1, 0])
                 f0_, f1_ = n0, n1
-            zz0 = _fma(x1_, z01, x0_ * z00)  # x @ Z.T
-            zz1 = _fma(x1_, z11, x0_ * z10)
+            zz0 = fma(x1_, z01, x0_ * z00)  # x @ Z.T
+            zz1 = fma(x1_, z11, x0_ * z10)
             if kind == 0:
                 q0 = m0 * zz0 + s0 * np.sin(zz0)
                 q1 = m1 * zz1 + s1 * np.sin(zz1)
@@ -203,8 +193,8 @@ def simulate_kernel_2x1(A, B, C, D, Z, d1, d2, kind, G0, Gf, H0, Hf, has_gains, 
             else:
                 q0, q1 = d2[0] * zz0, d2[1] * zz1
             # x @ A.T + f @ B.T + w (x @ D.T)
-            n0 = (_fma(x1_, a01, x0_ * a00) + _fma(q1, b01, q0 * b00)) + w * _fma(x1_, e01, x0_ * e00)
-            n1 = (_fma(x1_, a11, x0_ * a10) + _fma(q1, b11, q0 * b10)) + w * _fma(x1_, e11, x0_ * e10)
+            n0 = (fma(x1_, a01, x0_ * a00) + fma(q1, b01, q0 * b00)) + w * fma(x1_, e01, x0_ * e00)
+            n1 = (fma(x1_, a11, x0_ * a10) + fma(q1, b11, q0 * b10)) + w * fma(x1_, e11, x0_ * e10)
             x0_, x1_ = n0, n1
             errs[r, k + 1, 0] = x0_ - f0_
             errs[r, k + 1, 1] = x1_ - f1_

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .filter_kernels import fma
+from ...engines.intrinsics import fma
 
 __all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel"]
 
@@ -26,7 +26,7 @@ __all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_ke
 # so that its results are bit-identical: ``einsum("...n,...nij->...ij")`` sums the weights sequentially,
 # ``Ai @ Ai`` (numpy's stacked 2x2 matmul through OpenBLAS) rounds ``fma(a_i1, b_1j, a_i0 b_0j)`` and
 # ``einsum("...ij,...nji->...n")`` adds ``(t_00 + t_10) + (t_01 + t_11)``. No fastmath; ``fma`` is
-# :func:`.filter_kernels.fma`, the correctly rounded ``llvm.fma``. Written as one function on scalars (no
+# :func:`netrepro.engines.intrinsics.fma`, the correctly rounded ``llvm.fma``. Written as one function on scalars (no
 # helper functions, no scratch 2x2 arrays): numba then compiles it in about a third less time, which a
 # process that loads it cold pays once.
 @njit(cache=True, error_model="numpy", inline="always")
@@ -63,6 +63,44 @@ def _fused_matrix(Minv, lam, r):
     return A00, A01, A10, A11
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad):
+    """``f = tr A^{-1}`` and its gradient ``-tr(A^{-1} A^{-1} M_q^{-1})`` at the fused matrix ``A`` of instance ``r`` (eq (24)).
+
+    ``A^{-1} @ A^{-1}`` is rounded as numpy's stacked ``matmul`` (:func:`netrepro.engines.intrinsics.fma`).
+
+    Parameters
+    ----------
+    A00, A01, A10, A11 : float
+        The fused matrix ``A`` (:func:`_fused_matrix`).
+    c : float
+        Its determinant ``A00 A11 - A01 A10``.
+    Minv : ndarray, shape (m, n, 2, 2)
+        The agents' inverse informations ``M_q^{-1}`` per instance.
+    r : int
+        The instance.
+    grad : ndarray, shape (n,)
+        Output: the gradient over the agents.
+
+    Returns
+    -------
+    float
+        ``f`` at ``A``.
+    """
+    i00 = A11 / c
+    i11 = A00 / c
+    i01 = -A01 / c
+    i10 = -A10 / c
+    C00 = fma(i01, i10, i00 * i00)
+    C01 = fma(i01, i11, i00 * i01)
+    C10 = fma(i11, i10, i10 * i00)
+    C11 = fma(i11, i11, i10 * i01)
+    for q in range(Minv.shape[1]):
+        grad[q] = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1])
+                    + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+    return i00 + i11
+
+
 @njit(cache=True, error_model="numpy")
 def pairwise_kernel(Minv, lam, n_iter):
     """:func:`min_fused_trace_pairwise` on ``Minv (M, N, 2, 2)`` from ``lam (M, N)`` (updated in place).
@@ -89,17 +127,7 @@ def pairwise_kernel(Minv, lam, n_iter):
             # A = sum_n lam_n M_n (sequential, as einsum)
             A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
             c = A00 * A11 - A01 * A10
-            i00 = A11 / c
-            i11 = A00 / c
-            i01 = -A01 / c
-            i10 = -A10 / c
-            C00 = fma(i01, i10, i00 * i00)
-            C01 = fma(i01, i11, i00 * i01)
-            C10 = fma(i11, i10, i10 * i00)
-            C11 = fma(i11, i11, i10 * i01)
-            for q in range(n):
-                grad[q] = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1])
-                            + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+            _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad)
             # s = argmin(grad), v = argmax over lam > 0 (np.argmin/argmax: first occurrence, a nan wins)
             s = 0
             if not np.isnan(grad[0]):
@@ -344,19 +372,6 @@ def bounds_kernel(Minv, lam, value, grad):
     -------
     None
     """
-    m, n = lam.shape
-    for r in range(m):
+    for r in range(lam.shape[0]):
         A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
-        c = A00 * A11 - A01 * A10
-        i00 = A11 / c
-        i11 = A00 / c
-        i01 = -A01 / c
-        i10 = -A10 / c
-        value[r] = i00 + i11
-        C00 = fma(i01, i10, i00 * i00)
-        C01 = fma(i01, i11, i00 * i01)
-        C10 = fma(i11, i10, i10 * i00)
-        C11 = fma(i11, i11, i10 * i01)
-        for q in range(n):
-            grad[r, q] = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1])
-                           + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+        value[r] = _trace_and_gradient(A00, A01, A10, A11, A00 * A11 - A01 * A10, Minv, r, grad[r])

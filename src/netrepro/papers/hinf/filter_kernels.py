@@ -17,38 +17,12 @@ Imported lazily by :mod:`.filters`, so that steps that run no filter do not impo
 from __future__ import annotations
 
 import numpy as np
-from llvmlite import ir as llvm_ir
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
-__all__ = ["fma", "hinf_update_kernel", "hinf_update_batch_kernel", "congruence_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
+from ...engines.intrinsics import fma
+
+__all__ = ["hinf_update_kernel", "hinf_update_batch_kernel", "congruence_kernel", "exists_kernel", "sigma_gradient_kernel", "noise_information_kernel",
            "rotate_kernel"]
-
-
-@intrinsic
-def fma(typingctx, x, y, z):
-    """Correctly rounded ``x * y + z`` (``llvm.fma.f64``), callable from compiled code only.
-
-    Parameters
-    ----------
-    typingctx : numba typing context
-        Supplied by numba.
-    x, y, z : float64
-        The operands (inside a compiled function: ``fma(x, y, z)``).
-
-    Returns
-    -------
-    tuple
-        The signature and the code generator numba's ``@intrinsic`` expects.
-    """
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        dbl = llvm_ir.DoubleType()
-        fn = builder.module.declare_intrinsic("llvm.fma", [dbl], llvm_ir.FunctionType(dbl, [dbl, dbl, dbl]))
-        return builder.call(fn, args)
-
-    return sig, codegen
 
 
 @njit(cache=True, error_model="numpy")

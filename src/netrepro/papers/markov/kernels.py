@@ -26,8 +26,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
+
+from ...engines.intrinsics import fma
 
 __all__ = ["rb_norm_kernel", "pairwise_sum", "riccati_step_2x1", "riccati_branch_2x1"]
 
@@ -268,17 +269,6 @@ def _rb_norm_paths(P, arrivals, A, Q, W, which_trace, out, H, tmp, row, frames, 
     return out
 
 
-@intrinsic
-def _fma(typingctx, a, b, c):
-    """Fused multiply-add ``a*b + c`` with one rounding (``llvm.fma``, IEEE on every platform)."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-
-    return sig, codegen
-
-
 def riccati_step_2x1(P, received, A, C, Q, R):
     """One step of eqs. (4)-(5) for a batch of paths of a system with 2 states and 1 output.
 
@@ -363,8 +353,8 @@ def _riccati_2x1(x00, x01, x10, x11, g, A, C, Q, R):
     a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
     if g:  # P - P C' (C P C' + R)^{-1} C P: the scalar innovation divides
         c0, c1 = C[0, 0], C[0, 1]
-        u0 = _fma(x00, c0, x01 * c1)  # P C' (gemv: last coordinate first)
-        u1 = _fma(x10, c0, x11 * c1)
+        u0 = fma(x00, c0, x01 * c1)  # P C' (gemv: last coordinate first)
+        u1 = fma(x10, c0, x11 * c1)
         s = (c0 * u0 + c1 * u1) + R[0, 0]  # C (P C') (dot: no FMA), + R
         v0 = u0 / s
         v1 = u1 / s
@@ -372,14 +362,14 @@ def _riccati_2x1(x00, x01, x10, x11, g, A, C, Q, R):
         x01 = x01 - u0 * v1
         x10 = x10 - u1 * v0
         x11 = x11 - u1 * v1
-    t00 = _fma(a01, x10, a00 * x00)  # A X (left to right by FMA)
-    t01 = _fma(a01, x11, a00 * x01)
-    t10 = _fma(a11, x10, a10 * x00)
-    t11 = _fma(a11, x11, a10 * x01)
-    o00 = _fma(t01, a01, t00 * a00) + Q[0, 0]  # (A X) A' + Q
-    o01 = _fma(t01, a11, t00 * a10) + Q[0, 1]
-    o10 = _fma(t11, a01, t10 * a00) + Q[1, 0]
-    o11 = _fma(t11, a11, t10 * a10) + Q[1, 1]
+    t00 = fma(a01, x10, a00 * x00)  # A X (left to right by FMA)
+    t01 = fma(a01, x11, a00 * x01)
+    t10 = fma(a11, x10, a10 * x00)
+    t11 = fma(a11, x11, a10 * x01)
+    o00 = fma(t01, a01, t00 * a00) + Q[0, 0]  # (A X) A' + Q
+    o01 = fma(t01, a11, t00 * a10) + Q[0, 1]
+    o10 = fma(t11, a01, t10 * a00) + Q[1, 0]
+    o11 = fma(t11, a11, t10 * a10) + Q[1, 1]
     if g:  # riccati_g symmetrises, riccati_h does not
         return 0.5 * (o00 + o00), 0.5 * (o01 + o10), 0.5 * (o10 + o01), 0.5 * (o11 + o11)
     return o00, o01, o10, o11
