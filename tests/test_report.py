@@ -95,3 +95,27 @@ def test_reconstruction_value_of_an_integer_setting_shows_as_an_integer():
     config = {"paths": {"seed": 20150101}, "scalar": {"Ep0": 10.0}}
     rows = table_view(frame, "reconstructions", config)["rows"]
     assert [r[1] for r in rows] == ["20150101", "10.0", "[C; CA]"]  # a float setting keeps its form
+
+
+def test_blank_and_num_treat_missing_numbers_as_empty():
+    import numpy as np
+
+    from netrepro.report.markup import blank, num
+
+    for missing in (None, float("nan"), np.float64("nan")):
+        assert blank(missing) == "" and str(num(missing)) == ""
+    assert blank(0.0) == 0.0 and blank("x") == "x"
+    assert str(num(3.0)) == "3.0" and str(num(True)) == "True" and str(num("n/a")) == "n/a"
+    assert str(num(0.123456789)) == '<span title="0.123456789">0.1234568</span>'
+    assert str(num(float("inf"))) == "inf" and str(num(-np.inf)) == "-inf"  # raised OverflowError before
+
+
+def test_notebook_driver_and_relocate_do_not_import_pandas():
+    """The notebook jobs and `relocate` (the last, serial step of `make report`) never read a table:
+    pandas (~0.3 s of start-up per process) is imported only where one is read."""
+    import subprocess
+    import sys
+
+    code = "import sys, netrepro.report.cli; print('pandas' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"

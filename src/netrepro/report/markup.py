@@ -10,13 +10,17 @@ from __future__ import annotations
 import base64
 import functools
 import json
+import math
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
 from jinja2 import Environment, FileSystemBytecodeCache, PackageLoader
 from jinja2.ext import Extension
 from markupsafe import Markup, escape
+
+if TYPE_CHECKING:  # pandas is imported where a table is read: the notebook driver and relocate never need it
+    import pandas as pd
 
 __all__ = ["NO_FAVICON", "strip_external_scripts", "relocate", "relocate_json", "render", "read_csv",
            "rst_html", "img", "num", "fmt_value", "short", "blank"]
@@ -130,7 +134,7 @@ def blank(value):
     object
         ``""`` for a missing value, else ``value``.
     """
-    if value is None or (isinstance(value, float) and pd.isna(value)):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
         return ""
     return value
 
@@ -153,7 +157,7 @@ def num(value) -> Markup:
         number = float(value)
     except (TypeError, ValueError):
         return text
-    if isinstance(value, bool) or not pd.notna(number) or number == int(number) and abs(number) < 1e15:
+    if isinstance(value, bool) or not math.isfinite(number) or number == int(number) and abs(number) < 1e15:
         return text
     shown = f"{number:.7g}"
     return text if shown == str(value) else Markup('<span title="{}">{}</span>').format(text, shown)
@@ -264,6 +268,8 @@ def read_csv(path) -> pd.DataFrame | None:
 
 @functools.lru_cache(maxsize=256)
 def _read_csv(path: str, mtime_ns: int, size: int) -> pd.DataFrame:
+    import pandas as pd
+
     try:
         return pd.read_csv(path)
     except pd.errors.EmptyDataError:

@@ -15,8 +15,6 @@ import shlex
 import sys
 from pathlib import Path
 
-import pandas as pd
-
 from ..errors import NetreproError
 from ..io import atomic_path
 from .markup import relocate, strip_external_scripts
@@ -155,6 +153,7 @@ def show_table(path, max_rows=None):
     max_rows : int, optional
         Show only the first rows.
     """
+    import pandas as pd  # here, not at the top: the driver that executes the notebook never reads a table
     from IPython.display import HTML, display
 
     path = Path(path)
