@@ -592,8 +592,140 @@ def evader_decisions(x_t, agents, model: NoiseModel, step: float, n_headings: in
             "gap": (upper - lower).max(axis=1), "margin": upper[idx, choice] - second}
 
 
+CERTIFY_MARGIN = 1e-9
+"""Relative margin by which :func:`evader_move` (``solver="exact"``) must separate a candidate's bracket from the
+best lower bound to skip its exact solve (see :func:`_certified_exact_values`)."""
+
+CERTIFY_SCALE_MAX = 1e4
+"""Largest rounding scale (``tr(A)^2 / det A`` and ``max_j |grad_j| / f``) of a bracket that
+:func:`_certified_exact_values` trusts; a run with a larger one has every candidate solved exactly."""
+
+
+def _support_bracket_numpy(Mf, lam0):
+    """Bracket ``[lower, value]`` of ``min_lambda tr (sum_j lam_j M_j^{-1})^{-1}`` from a guessed support (eq (24)).
+
+    Per instance, the stationary point of ``f = tr A / det A`` on the face of the simplex spanned by the
+    support of ``lam0`` (the closed form of ``_face_stationary``), if its weights are finite and non-negative,
+    else ``lam0`` itself: a point ``w`` of the simplex, so ``value = f(w)`` is an upper bound of the minimum and
+    ``lower = f(w) - g(w)`` (the Frank-Wolfe gap, as :func:`fused_trace_bounds`) a lower bound. When the
+    support is the optimum's (the usual case for candidates a step apart) the bracket is as tight as the
+    exact solver's certificate. Also returned: the rounding scale ``max(tr(A)^2 / det A, max_j |grad_j| / f)``
+    of the bracket (see :func:`_certified_exact_values`).
+
+    Parameters
+    ----------
+    Mf : ndarray, shape ``(M, N, 2, 2)``
+        The informations ``M_j^{-1}`` (symmetric positive definite) of ``M`` instances.
+    lam0 : ndarray, shape ``(M, N)``
+        Weights on the simplex whose support (at most 3 agents) is tried.
+
+    Returns
+    -------
+    value, lower, scale : ndarray, shape ``(M,)``
+    """
+    Mf = np.asarray(Mf, dtype=float)
+    lam0 = np.asarray(lam0, dtype=float)
+    m, n = lam0.shape
+    s = _sym_coords(Mf)
+    l = s[..., 0] + s[..., 2]
+    w = lam0.copy()
+    k_of = (lam0 > 0).sum(-1)
+    for k in (1, 2, 3):
+        rows = np.nonzero(k_of == k)[0]
+        if len(rows) == 0:
+            continue
+        J = np.argsort(-lam0[rows], -1, kind="stable")[:, :k]          # the support
+        sJ = np.take_along_axis(s[rows], J[..., None], 1)               # (r, k, 3)
+        lJ = np.take_along_axis(l[rows], J, 1)
+        lam, _, _ = _face_stationary(_polarised_det(sJ), lJ, np.arange(k)[None, :])
+        lam = lam[:, 0]                                                 # (r, k)
+        ok = np.all(np.isfinite(lam) & (lam >= 0), -1)
+        full = np.zeros((len(rows), n))
+        np.put_along_axis(full, J, lam, 1)
+        w[rows[ok]] = full[ok]
+    A = np.einsum("...n,...nij->...ij", w, Mf)
+    tr, det = _trace_det(A)
+    Ai = inv2(A)
+    value = Ai[..., 0, 0] + Ai[..., 1, 1]
+    grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Mf)
+    gap = np.einsum("...n,...n->...", grad, w) - grad.min(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where((det > 0) & (value > 0), np.maximum(tr * tr / det, np.abs(grad).max(-1) / value), np.inf)
+    return value, value - gap, scale
+
+
+def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN, kernel: str = "auto"):
+    """The evader's candidate values ``min_lambda tr Q_fused`` (eq (24)) where they can decide its move (eq (19)).
+
+    Returns :func:`min_fused_trace_exact`'s value for every candidate that could be the (first) largest, and
+    ``-inf`` for the candidates proved smaller than it, so that ``argmax`` over the result and the value there
+    are those of the exact solver on every candidate (the reference), bit for bit.
+
+    The method: each candidate is bracketed, ``lower_c <= min f_c <= value_c``, by
+    :func:`_support_bracket_numpy` on the support of ``lam_hint`` (the optimal weights of the run's previous
+    move: the optimum's support rarely changes over a step); with ``L = max_c lower_c``, a candidate with
+    ``value_c (1 + margin) < L (1 - margin)`` is excluded, the others (the contenders, always including the
+    candidate attaining ``L``) are solved exactly. Why the exclusion is safe: let ``v_c`` be the exact solver's
+    value of candidate ``c`` and ``b`` a candidate with ``lower_b = L``. The exact solver's ``v`` is ``f`` at a
+    point of the simplex with relative Frank-Wolfe gap at most :data:`EXACT_TOLERANCE` (1e-12), so
+    ``min f_c <= v_c <= min f_c (1 + 1e-12)`` up to rounding. The bracket's own rounding is relative and of
+    order ``N eps s`` with ``eps = 2.2e-16``, ``N`` the agents and ``s`` the bracket's scale
+    (``tr(A)^2 / det A`` bounds the amplification of the determinant's cancellation, ``max_j |grad_j| / f``
+    that of the gap's), at most ``10 * 2.2e-16 * 1e4 ~ 2e-11`` when ``s <= CERTIFY_SCALE_MAX`` (a candidate
+    whose bracket has a larger scale or is not finite is neither excluded nor used for ``L``). Hence
+    ``v_c <= value_c (1 + 1e-12 + 2e-11) < value_c (1 + margin)`` and ``v_b >= lower_b (1 - 2e-11) >
+    L (1 - margin)`` for ``margin = 1e-9``: an excluded ``c`` has ``v_c < v_b``, it is neither the argmax
+    nor tied with it. The exact solver's result for an instance does not depend on the other instances of
+    its call (per-instance arithmetic; compiled and numpy forms bit-identical), so solving only the
+    contenders gives the same bits (tested). Where the exact solver would fail (``ArithmeticError``) on an
+    excluded candidate, the reference raises and this does not.
+
+    Parameters
+    ----------
+    Minv : ndarray, shape ``(R, C, N, 2, 2)``
+        The informations ``M_j^{-1}`` at the ``C`` candidate positions of ``R`` runs.
+    lam_hint : ndarray, shape ``(R, N)``, optional
+        Weights on the simplex whose support is tried for each run's bracket; ``None``: every candidate is
+        solved exactly.
+    margin : float
+        Relative separation required to exclude a candidate (:data:`CERTIFY_MARGIN`); ``inf`` excludes none.
+    kernel : {"auto", "compiled", "numpy"}
+        Form of the exact solver and the bracket (``"auto"``: compiled where numba is loaded, whatever the
+        batch size: the forms are bit-identical).
+
+    Returns
+    -------
+    value : ndarray, shape ``(R, C)``
+        The exact value of each contender, ``-inf`` elsewhere.
+    lam : ndarray, shape ``(R, C, N)``
+        The exact solver's weights of each contender, 0 elsewhere.
+    """
+    R, C, n = Minv.shape[:3]
+    if kernel == "auto":
+        kernel = "compiled" if use_compiled("auto", Minv.size // 4) else "numpy"
+    if lam_hint is None:
+        return min_fused_trace_exact(Minv, kernel=kernel)
+    Mf = np.ascontiguousarray(Minv.reshape(R * C, n, 2, 2))
+    lam_rep = np.repeat(np.asarray(lam_hint, dtype=float), C, axis=0)
+    if kernel == "compiled":
+        from .evader_kernels import support_bracket_kernel
+        value, lower, scale = np.empty(R * C), np.empty(R * C), np.empty(R * C)
+        support_bracket_kernel(Mf, lam_rep, value, lower, scale)
+    else:
+        value, lower, scale = _support_bracket_numpy(Mf, lam_rep)
+    value, lower, scale = value.reshape(R, C), lower.reshape(R, C), scale.reshape(R, C)
+    ok = np.isfinite(value) & np.isfinite(lower) & (scale <= CERTIFY_SCALE_MAX)  # nan scale: not ok
+    L = np.where(ok, np.minimum(lower, value), -np.inf).max(axis=1)
+    excluded = ok & (value * (1.0 + margin) < (L * (1.0 - margin))[:, None]) & (L > 0)[:, None]
+    ri, ci = np.nonzero(~excluded)
+    out = np.full((R, C), -np.inf)
+    lam = np.zeros((R, C, n))
+    out[ri, ci], lam[ri, ci] = min_fused_trace_exact(Minv[ri, ci], kernel=kernel)
+    return out, lam
+
+
 def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_iter: int = 60,
-                solver: str = "mirror"):
+                solver: str = "mirror", state: dict | None = None):
     """Greedy evasive move, eqs (19) and (21): maximise ``tr Q_fused`` over the next position.
 
     Candidates are ``x_t`` itself and ``x_t + step (cos phi, sin phi)`` for ``n_headings``
@@ -617,6 +749,12 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     solver : {"mirror", "pairwise", "exact"}
         :func:`min_fused_trace`, :func:`min_fused_trace_pairwise` or :func:`min_fused_trace_exact`
         (``exact`` ignores ``n_iter``).
+    state : dict, optional
+        ``exact`` only: a dict the caller keeps over the moves of one simulation (start with ``{}``). With it,
+        the optimal weights of each run's chosen candidate are kept in ``state["lam"]`` and, at the next move,
+        only the candidates that can be the largest are solved exactly (:func:`_certified_exact_values`: the
+        same move and value, bit for bit, at a fraction of the cost). ``None``: every candidate (the
+        reference).
 
     Returns
     -------
@@ -630,8 +768,17 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     cand = x_t[:, None, :] + offs[None]  # (R, H+1, 2)
     r, th = geometry(cand, agents[:, None, :, :])  # (R, H+1, N)
     Minv = noise_information(r, th, model)
-    tr, _ = _inner(solver)(Minv, n_iter)
+    certify = solver == "exact" and state is not None
+    if certify:
+        hint = state.get("lam")
+        if hint is not None and np.shape(hint) != (Minv.shape[0], Minv.shape[2]):
+            hint = None  # another simulation's weights: solve every candidate
+        tr, lam = _certified_exact_values(Minv, hint)
+    else:
+        tr, lam = _inner(solver)(Minv, n_iter)
     best = np.argmax(tr, axis=1)
     idx = np.arange(len(x_t))
+    if certify:
+        state["lam"] = lam[idx, best]
     return cand[idx, best], tr[idx, best]
 

@@ -18,7 +18,7 @@ from numba import njit
 
 from ...engines.intrinsics import fma
 
-__all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel"]
+__all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel", "support_bracket_kernel"]
 
 
 # --------------------------------------------------------------------------- compiled kernel (numba)
@@ -375,3 +375,114 @@ def bounds_kernel(Minv, lam, value, grad):
     for r in range(lam.shape[0]):
         A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
         value[r] = _trace_and_gradient(A00, A01, A10, A11, A00 * A11 - A01 * A10, Minv, r, grad[r])
+
+
+@njit(cache=True, error_model="numpy")
+def support_bracket_kernel(Minv, lam0, value, lower, scale):
+    """:func:`.evader._support_bracket_numpy` per instance: a bracket of the fused trace's minimum (eq (24)).
+
+    Per instance, the stationary point of ``f = tr A / det A`` on the face spanned by the support of ``lam0``
+    (at most 3 agents; the closed form of :func:`.evader._face_stationary`), or ``lam0`` where that point is not
+    finite and non-negative; then ``f``, its Frank-Wolfe lower bound and the rounding scale at that point. The
+    same mathematics as the numpy form, not the same rounding (a bracket, not a result: its use in
+    :func:`.evader._certified_exact_values` allows for rounding).
+
+    Parameters
+    ----------
+    Minv : ndarray ``(M, N, 2, 2)``
+        The informations ``M_j^{-1}``.
+    lam0 : ndarray ``(M, N)``
+        Weights on the simplex whose support is tried.
+    value, lower, scale : ndarray ``(M,)``
+        Outputs: ``f(w)``, ``f(w) - gap(w)`` and ``max(tr(A)^2 / det A, max_j |grad_j| / f)``.
+
+    Returns
+    -------
+    None
+    """
+    m, n = lam0.shape
+    w = np.empty(n)
+    grad = np.empty(n)
+    J = np.empty(3, dtype=np.int64)
+    a = np.empty(3)
+    b = np.empty(3)
+    d = np.empty(3)
+    lv = np.empty(3)
+    h = np.empty((3, 3))
+    adj = np.empty((3, 3))
+    P = np.empty(3)
+    Rr = np.empty(3)
+    for r in range(m):
+        k = 0
+        for q in range(n):
+            w[q] = lam0[r, q]
+            if lam0[r, q] > 0:
+                if k < 3:
+                    J[k] = q
+                k += 1
+        if 0 < k <= 3:
+            for i in range(k):
+                a[i] = Minv[r, J[i], 0, 0]
+                b[i] = 0.5 * (Minv[r, J[i], 0, 1] + Minv[r, J[i], 1, 0])
+                d[i] = Minv[r, J[i], 1, 1]
+                lv[i] = a[i] + d[i]
+            for i in range(k):
+                for j in range(k):
+                    h[i, j] = 0.5 * (a[i] * d[j] + d[i] * a[j]) - b[i] * b[j]
+            adj[:, :] = 0.0
+            if k == 1:
+                adj[0, 0] = 1.0
+            elif k == 2:
+                adj[0, 0], adj[1, 1], adj[0, 1], adj[1, 0] = h[1, 1], h[0, 0], -h[0, 1], -h[0, 1]
+            else:
+                adj[0, 0] = h[1, 1] * h[2, 2] - h[1, 2] ** 2
+                adj[1, 1] = h[0, 0] * h[2, 2] - h[0, 2] ** 2
+                adj[2, 2] = h[0, 0] * h[1, 1] - h[0, 1] ** 2
+                adj[0, 1] = adj[1, 0] = h[0, 2] * h[1, 2] - h[0, 1] * h[2, 2]
+                adj[0, 2] = adj[2, 0] = h[0, 1] * h[1, 2] - h[0, 2] * h[1, 1]
+                adj[1, 2] = adj[2, 1] = h[0, 1] * h[0, 2] - h[0, 0] * h[1, 2]
+            lP = 0.0
+            sR = 0.0
+            P[:] = 0.0
+            Rr[:] = 0.0
+            for i in range(k):
+                for j in range(k):
+                    P[i] += adj[i, j] * lv[j]
+                    Rr[i] += adj[i, j]
+                lP += lv[i] * P[i]
+                sR += Rr[i]
+            L = np.sqrt(lP / sR)
+            tot = 0.0
+            for i in range(k):
+                tot += P[i] + L * Rr[i]
+            ok = True
+            for i in range(k):
+                x = (P[i] + L * Rr[i]) / tot
+                if not (np.isfinite(x) and x >= 0.0):
+                    ok = False
+            if ok:
+                for q in range(n):
+                    w[q] = 0.0
+                for i in range(k):
+                    w[J[i]] = (P[i] + L * Rr[i]) / tot
+        A00 = 0.0
+        A01 = 0.0
+        A10 = 0.0
+        A11 = 0.0
+        for q in range(n):
+            A00 += w[q] * Minv[r, q, 0, 0]
+            A01 += w[q] * Minv[r, q, 0, 1]
+            A10 += w[q] * Minv[r, q, 1, 0]
+            A11 += w[q] * Minv[r, q, 1, 1]
+        c = A00 * A11 - A01 * A10
+        f = _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad)
+        gl = 0.0
+        gmin = np.inf
+        gabs = 0.0
+        for q in range(n):
+            gl += grad[q] * w[q]
+            gmin = min(gmin, grad[q])
+            gabs = max(gabs, abs(grad[q]))
+        value[r] = f
+        lower[r] = f - (gl - gmin)
+        scale[r] = max((A00 + A11) * (A00 + A11) / c, gabs / f) if c > 0 and f > 0 else np.inf

@@ -285,17 +285,18 @@ def simulate(sc: dict) -> dict:
     v, w, Ct, yt = {}, {}, {}, {}
     dsig = np.zeros((2, R, N, 2, 2))  # local copies of Sigma^r_i, Sigma^theta_i (eq (14))
     n_psd_fix = 0
+    ev_state = {}  # the evader's weights from move to move: it then solves only the candidates that can win (bit-identical)
     for k in range(1, K + 1):
         # 1. target motion
         if sc["target"] == "random":
             x = x @ A.T + gaussian_draws(rng_t, Wt_factor, R) if np.any(Wt) else x @ A.T
         elif sc["target"] == "evasive":
             x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
-                                ev.get("solver", "mirror"))
+                                ev.get("solver", "mirror"), state=ev_state)
             fused[:, k] = fz
         elif sc["target"] == "evasive_noise":
             x, fz = evader_move(x, P, model, float(ev["step"]), int(ev["n_headings"]), int(ev["n_iter"]),
-                                ev.get("solver", "mirror"))
+                                ev.get("solver", "mirror"), state=ev_state)
             fused[:, k] = fz
             x = x + gaussian_draws(rng_t, Wt_factor, R)
         elif sc["target"] == "drift":
