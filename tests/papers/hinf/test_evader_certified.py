@@ -101,9 +101,10 @@ def test_support_bracket_contains_the_minimum_and_is_tight_on_the_right_support(
         true = np.array([_slsqp_min(S) for S in Mf])
         for hint in _hints(M, rng):
             rep = np.repeat(hint, C, 0)
-            value, lower, scale = E._support_bracket_numpy(Mf, rep)
-            assert np.all(lower <= true * (1 + 1e-12)) and np.all(true <= value * (1 + 1e-12))
-            assert np.all(scale >= 1.0)
+            for rounds in (0, 1, 3):
+                value, lower, scale = E._support_bracket_numpy(Mf, rep, rounds)
+                assert np.all(lower <= true * (1 + 1e-12)) and np.all(true <= value * (1 + 1e-12))
+                assert np.all(scale >= 1.0)
         # the optimum's own support: the bracket is as tight as the exact solver's certificate
         _, lam = E.min_fused_trace_exact(Mf)
         value, lower, _ = E._support_bracket_numpy(Mf, lam)
@@ -128,17 +129,18 @@ def test_support_bracket_on_a_dense_grid_of_three_agents():
         assert np.all(value >= brute - 1e-3 * brute)  # an upper bound of the minimum (grid spacing 1/300)
 
 
+@pytest.mark.parametrize("rounds", [0, 1, 3])
 @pytest.mark.parametrize("case", range(5))
-def test_support_bracket_kernel_matches_numpy_form(case):
+def test_support_bracket_kernel_matches_numpy_form(case, rounds):
     """Same mathematics (not necessarily the same rounding): equal to 1e-12 relative, same fallbacks."""
     M = _hard_instances(5)[case]
     R, C, n = M.shape[:3]
     Mf = np.ascontiguousarray(M.reshape(-1, n, 2, 2))
     for hint in _hints(M, np.random.default_rng(case)):
         rep = np.ascontiguousarray(np.repeat(hint, C, 0))
-        a = E._support_bracket_numpy(Mf, rep)
+        a = E._support_bracket_numpy(Mf, rep, rounds)
         b = tuple(np.empty(len(Mf)) for _ in range(3))
-        support_bracket_kernel(Mf, rep, *b)
+        support_bracket_kernel(Mf, rep, rounds, *b)
         for u, v in zip(a, b):
             np.testing.assert_allclose(v, u, rtol=1e-12 * max(1.0, float(np.max(a[2]))), atol=0)
 
@@ -222,3 +224,18 @@ def test_simulate_evasive_matches_the_reference_evader(monkeypatch):
         ref = Mo.simulate(sc)
         for key in ("target", "agents", "fused_trace"):
             assert ref[key].tobytes() == fast[key].tobytes(), (target, key)
+
+
+def test_support_corrections_tighten_brackets_from_a_wrong_support():
+    """Hints from another candidate or a random support: the active-set corrections make more brackets tight."""
+    M = _hard_instances(10)[1]
+    R, C, n = M.shape[:3]
+    Mf = M.reshape(-1, n, 2, 2)
+    tight = {}
+    for rounds in (0, 3):
+        count = 0
+        for hint in _hints(M, np.random.default_rng(3))[1:]:
+            value, lower, _ = E._support_bracket_numpy(Mf, np.repeat(hint, C, 0), rounds)
+            count += np.sum(value - lower <= 1e-12 * value)
+        tight[rounds] = count
+    assert tight[3] > tight[0]

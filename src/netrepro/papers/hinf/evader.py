@@ -601,23 +601,45 @@ CERTIFY_SCALE_MAX = 1e4
 :func:`_certified_exact_values` trusts; a run with a larger one has every candidate solved exactly."""
 
 
-def _support_bracket_numpy(Mf, lam0):
+SUPPORT_ROUNDS = 3
+"""Active-set corrections of the guessed support in :func:`_support_bracket_numpy` (after the first face)."""
+
+
+def _bracket_at(Mf, w):
+    """``f(w)``, its Frank-Wolfe lower bound, the rounding scale and the gradient at weights ``w`` (eq (24))."""
+    A = np.einsum("...n,...nij->...ij", w, Mf)
+    tr, det = _trace_det(A)
+    Ai = inv2(A)
+    value = Ai[..., 0, 0] + Ai[..., 1, 1]
+    grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Mf)
+    gap = np.einsum("...n,...n->...", grad, w) - grad.min(-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where((det > 0) & (value > 0), np.maximum(tr * tr / det, np.abs(grad).max(-1) / value), np.inf)
+    return value, value - gap, scale, grad
+
+
+def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
     """Bracket ``[lower, value]`` of ``min_lambda tr (sum_j lam_j M_j^{-1})^{-1}`` from a guessed support (eq (24)).
 
-    Per instance, the stationary point of ``f = tr A / det A`` on the face of the simplex spanned by the
-    support of ``lam0`` (the closed form of ``_face_stationary``), if its weights are finite and non-negative,
-    else ``lam0`` itself: a point ``w`` of the simplex, so ``value = f(w)`` is an upper bound of the minimum and
-    ``lower = f(w) - g(w)`` (the Frank-Wolfe gap, as :func:`fused_trace_bounds`) a lower bound. When the
-    support is the optimum's (the usual case for candidates a step apart) the bracket is as tight as the
-    exact solver's certificate. Also returned: the rounding scale ``max(tr(A)^2 / det A, max_j |grad_j| / f)``
-    of the bracket (see :func:`_certified_exact_values`).
+    Every point ``w`` of the simplex gives ``lower(w) = f(w) - g(w) <= min f <= f(w) = value(w)`` (``g`` the
+    Frank-Wolfe gap, as :func:`fused_trace_bounds`); the bracket is the smallest ``value`` and the largest
+    ``lower`` over the points tried: ``lam0`` itself, then the stationary point of ``f = tr A / det A`` on the
+    face spanned by the support of ``lam0`` (at most 3 agents; the closed form of ``_face_stationary``), and
+    up to ``rounds`` active-set corrections of that support: a vertex with a negative (infeasible) weight is
+    dropped; where the point is feasible but its gap is above ``1e-12 f``, the vertex of smallest gradient
+    is added (or, on a triangle, replaces the vertex of smallest weight). When the support is the
+    optimum's, or a correction away (the usual case for candidates a step apart), the bracket is as tight as
+    the exact solver's certificate. Also returned: the largest rounding scale
+    ``max(tr(A)^2 / det A, max_j |grad_j| / f)`` over the points (see :func:`_certified_exact_values`).
 
     Parameters
     ----------
     Mf : ndarray, shape ``(M, N, 2, 2)``
         The informations ``M_j^{-1}`` (symmetric positive definite) of ``M`` instances.
     lam0 : ndarray, shape ``(M, N)``
-        Weights on the simplex whose support (at most 3 agents) is tried.
+        Weights on the simplex whose support is tried first.
+    rounds : int
+        Corrections of the support (:data:`SUPPORT_ROUNDS`).
 
     Returns
     -------
@@ -628,30 +650,47 @@ def _support_bracket_numpy(Mf, lam0):
     m, n = lam0.shape
     s = _sym_coords(Mf)
     l = s[..., 0] + s[..., 2]
-    w = lam0.copy()
-    k_of = (lam0 > 0).sum(-1)
-    for k in (1, 2, 3):
-        rows = np.nonzero(k_of == k)[0]
+    value, lower, scale, _ = _bracket_at(Mf, lam0)
+    sup = lam0 > 0
+    active = (sup.sum(-1) >= 1) & (sup.sum(-1) <= 3)
+    for _ in range(rounds + 1):
+        rows = np.nonzero(active)[0]
         if len(rows) == 0:
-            continue
-        J = np.argsort(-lam0[rows], -1, kind="stable")[:, :k]          # the support
-        sJ = np.take_along_axis(s[rows], J[..., None], 1)               # (r, k, 3)
-        lJ = np.take_along_axis(l[rows], J, 1)
-        lam, _, _ = _face_stationary(_polarised_det(sJ), lJ, np.arange(k)[None, :])
-        lam = lam[:, 0]                                                 # (r, k)
-        ok = np.all(np.isfinite(lam) & (lam >= 0), -1)
-        full = np.zeros((len(rows), n))
-        np.put_along_axis(full, J, lam, 1)
-        w[rows[ok]] = full[ok]
-    A = np.einsum("...n,...nij->...ij", w, Mf)
-    tr, det = _trace_det(A)
-    Ai = inv2(A)
-    value = Ai[..., 0, 0] + Ai[..., 1, 1]
-    grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Mf)
-    gap = np.einsum("...n,...n->...", grad, w) - grad.min(-1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.where((det > 0) & (value > 0), np.maximum(tr * tr / det, np.abs(grad).max(-1) / value), np.inf)
-    return value, value - gap, scale
+            break
+        k_of = sup[rows].sum(-1)
+        raw = np.zeros((len(rows), n))
+        for k in (1, 2, 3):
+            sub = np.nonzero(k_of == k)[0]
+            if len(sub) == 0:
+                continue
+            J = np.sort(np.argsort(~sup[rows[sub]], -1, kind="stable")[:, :k], -1)  # the support, ascending
+            sJ = np.take_along_axis(s[rows[sub]], J[..., None], 1)
+            lJ = np.take_along_axis(l[rows[sub]], J, 1)
+            lam, _, _ = _face_stationary(_polarised_det(sJ), lJ, np.arange(k)[None, :])
+            part = np.zeros((len(sub), n))
+            np.put_along_axis(part, J, lam[:, 0], 1)
+            raw[sub] = part
+        feas = np.all(np.isfinite(raw) & (raw >= 0), -1)
+        nxt = sup[rows].copy()
+        if feas.any():
+            fr = rows[feas]
+            v, lo, sc, g = _bracket_at(Mf[fr], raw[feas])
+            value[fr], lower[fr], scale[fr] = np.minimum(value[fr], v), np.maximum(lower[fr], lo), np.maximum(scale[fr], sc)
+            loose = ~(v - lo <= 1e-12 * v)
+            add = g.argmin(-1)
+            i = np.nonzero(feas)[0][loose]
+            full = k_of[i] == 3
+            drop = np.where(raw[i] > 0, raw[i], np.inf).argmin(-1)
+            nxt[i[full], drop[full]] = False
+            nxt[i, add[loose]] = True
+        bad = np.nonzero(~feas & np.all(~np.isnan(raw), -1))[0]
+        if len(bad):
+            nxt[bad, np.where(sup[rows[bad]], raw[bad], np.inf).argmin(-1)] = False
+        changed = np.any(nxt != sup[rows], -1) & (nxt.sum(-1) >= 1) & (nxt.sum(-1) <= 3)
+        sup[rows] = nxt
+        active[:] = False
+        active[rows[changed]] = True
+    return value, lower, scale
 
 
 def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN, kernel: str = "auto"):
@@ -662,8 +701,8 @@ def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN,
     are those of the exact solver on every candidate (the reference), bit for bit.
 
     The method: each candidate is bracketed, ``lower_c <= min f_c <= value_c``, by
-    :func:`_support_bracket_numpy` on the support of ``lam_hint`` (the optimal weights of the run's previous
-    move: the optimum's support rarely changes over a step); with ``L = max_c lower_c``, a candidate with
+    :func:`_support_bracket_numpy` from the support of ``lam_hint`` (the optimal weights of the run's previous
+    move: the optimum's support rarely changes much over a step); with ``L = max_c lower_c``, a candidate with
     ``value_c (1 + margin) < L (1 - margin)`` is excluded, the others (the contenders, always including the
     candidate attaining ``L``) are solved exactly. Why the exclusion is safe: let ``v_c`` be the exact solver's
     value of candidate ``c`` and ``b`` a candidate with ``lower_b = L``. The exact solver's ``v`` is ``f`` at a
@@ -710,7 +749,7 @@ def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN,
     if kernel == "compiled":
         from .evader_kernels import support_bracket_kernel
         value, lower, scale = np.empty(R * C), np.empty(R * C), np.empty(R * C)
-        support_bracket_kernel(Mf, lam_rep, value, lower, scale)
+        support_bracket_kernel(Mf, lam_rep, SUPPORT_ROUNDS, value, lower, scale)
     else:
         value, lower, scale = _support_bracket_numpy(Mf, lam_rep)
     value, lower, scale = value.reshape(R, C), lower.reshape(R, C), scale.reshape(R, C)
@@ -753,8 +792,8 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
         ``exact`` only: a dict the caller keeps over the moves of one simulation (start with ``{}``). With it,
         the optimal weights of each run's chosen candidate are kept in ``state["lam"]`` and, at the next move,
         only the candidates that can be the largest are solved exactly (:func:`_certified_exact_values`: the
-        same move and value, bit for bit, at a fraction of the cost). ``None``: every candidate (the
-        reference).
+        same move and value, bit for bit, at a fraction of the cost), where the compiled kernels are used
+        (:func:`.algebra.use_compiled`). ``None``: every candidate (the reference).
 
     Returns
     -------
@@ -768,7 +807,9 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     cand = x_t[:, None, :] + offs[None]  # (R, H+1, 2)
     r, th = geometry(cand, agents[:, None, :, :])  # (R, H+1, N)
     Minv = noise_information(r, th, model)
-    certify = solver == "exact" and state is not None
+    # certified only in compiled form: in numpy the bracket's per-call overhead exceeds its saving on the small
+    # batches of the steps that do not load numba (fig6_paths: 2.98 s with it, 2.11 s without)
+    certify = solver == "exact" and state is not None and use_compiled("auto", Minv.size // 4)
     if certify:
         hint = state.get("lam")
         if hint is not None and np.shape(hint) != (Minv.shape[0], Minv.shape[2]):

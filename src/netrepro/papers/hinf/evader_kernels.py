@@ -377,14 +377,52 @@ def bounds_kernel(Minv, lam, value, grad):
         value[r] = _trace_and_gradient(A00, A01, A10, A11, A00 * A11 - A01 * A10, Minv, r, grad[r])
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _nmin(a, b):
+    """``np.minimum(a, b)`` on scalars (a nan wins)."""
+    return a if (np.isnan(a) or a <= b) else b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _nmax(a, b):
+    """``np.maximum(a, b)`` on scalars (a nan wins)."""
+    return a if (np.isnan(a) or a >= b) else b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bracket_point(Minv, r, w, grad):
+    """``(f(w), f(w) - gap(w), scale)`` of :func:`.evader._bracket_at` for instance ``r``; ``grad`` filled."""
+    n = w.shape[0]
+    A00 = 0.0
+    A01 = 0.0
+    A10 = 0.0
+    A11 = 0.0
+    for q in range(n):
+        A00 += w[q] * Minv[r, q, 0, 0]
+        A01 += w[q] * Minv[r, q, 0, 1]
+        A10 += w[q] * Minv[r, q, 1, 0]
+        A11 += w[q] * Minv[r, q, 1, 1]
+    c = A00 * A11 - A01 * A10
+    f = _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad)
+    gl = 0.0
+    gmin = grad[0]
+    gabs = 0.0
+    for q in range(n):
+        gl += grad[q] * w[q]
+        gmin = _nmin(gmin, grad[q])
+        gabs = _nmax(gabs, abs(grad[q]))
+    scale = _nmax((A00 + A11) * (A00 + A11) / c, gabs / f) if (c > 0 and f > 0) else np.inf
+    return f, f - (gl - gmin), scale
+
+
 @njit(cache=True, error_model="numpy")
-def support_bracket_kernel(Minv, lam0, value, lower, scale):
+def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
     """:func:`.evader._support_bracket_numpy` per instance: a bracket of the fused trace's minimum (eq (24)).
 
-    Per instance, the stationary point of ``f = tr A / det A`` on the face spanned by the support of ``lam0``
-    (at most 3 agents; the closed form of :func:`.evader._face_stationary`), or ``lam0`` where that point is not
-    finite and non-negative; then ``f``, its Frank-Wolfe lower bound and the rounding scale at that point. The
-    same mathematics as the numpy form, not the same rounding (a bracket, not a result: its use in
+    The same algorithm as the numpy form: the hint ``lam0``, the stationary point of ``f = tr A / det A`` on
+    the face spanned by its support (the closed form of :func:`.evader._face_stationary`) and up to
+    ``rounds`` active-set corrections of the support; the smallest ``f``, the largest Frank-Wolfe lower bound
+    and the largest rounding scale over the points. Not necessarily the same rounding (a bracket, not a result:
     :func:`.evader._certified_exact_values` allows for rounding).
 
     Parameters
@@ -392,9 +430,11 @@ def support_bracket_kernel(Minv, lam0, value, lower, scale):
     Minv : ndarray ``(M, N, 2, 2)``
         The informations ``M_j^{-1}``.
     lam0 : ndarray ``(M, N)``
-        Weights on the simplex whose support is tried.
+        Weights on the simplex whose support is tried first.
+    rounds : int
+        Corrections of the support.
     value, lower, scale : ndarray ``(M,)``
-        Outputs: ``f(w)``, ``f(w) - gap(w)`` and ``max(tr(A)^2 / det A, max_j |grad_j| / f)``.
+        Outputs: the bracket ``[lower, value]`` and the scale ``max(tr(A)^2 / det A, max_j |grad_j| / f)``.
 
     Returns
     -------
@@ -402,7 +442,9 @@ def support_bracket_kernel(Minv, lam0, value, lower, scale):
     """
     m, n = lam0.shape
     w = np.empty(n)
+    raw = np.empty(n)
     grad = np.empty(n)
+    sup = np.empty(n, dtype=np.bool_)
     J = np.empty(3, dtype=np.int64)
     a = np.empty(3)
     b = np.empty(3)
@@ -416,11 +458,20 @@ def support_bracket_kernel(Minv, lam0, value, lower, scale):
         k = 0
         for q in range(n):
             w[q] = lam0[r, q]
-            if lam0[r, q] > 0:
-                if k < 3:
-                    J[k] = q
+            sup[q] = lam0[r, q] > 0
+            if sup[q]:
                 k += 1
-        if 0 < k <= 3:
+        bv, bl, bs = _bracket_point(Minv, r, w, grad)
+        active = 1 <= k <= 3
+        for _ in range(rounds + 1):
+            if not active:
+                break
+            k = 0
+            for q in range(n):
+                raw[q] = 0.0
+                if sup[q]:
+                    J[k] = q
+                    k += 1
             for i in range(k):
                 a[i] = Minv[r, J[i], 0, 0]
                 b[i] = 0.5 * (Minv[r, J[i], 0, 1] + Minv[r, J[i], 1, 0])
@@ -443,9 +494,9 @@ def support_bracket_kernel(Minv, lam0, value, lower, scale):
                 adj[1, 2] = adj[2, 1] = h[0, 1] * h[0, 2] - h[0, 0] * h[1, 2]
             lP = 0.0
             sR = 0.0
-            P[:] = 0.0
-            Rr[:] = 0.0
             for i in range(k):
+                P[i] = 0.0
+                Rr[i] = 0.0
                 for j in range(k):
                     P[i] += adj[i, j] * lv[j]
                     Rr[i] += adj[i, j]
@@ -455,34 +506,54 @@ def support_bracket_kernel(Minv, lam0, value, lower, scale):
             tot = 0.0
             for i in range(k):
                 tot += P[i] + L * Rr[i]
-            ok = True
+            feasible = True
+            has_nan = False
             for i in range(k):
                 x = (P[i] + L * Rr[i]) / tot
+                raw[J[i]] = x
+                if np.isnan(x):
+                    has_nan = True
                 if not (np.isfinite(x) and x >= 0.0):
-                    ok = False
-            if ok:
+                    feasible = False
+            changed = False
+            if feasible:
                 for q in range(n):
-                    w[q] = 0.0
-                for i in range(k):
-                    w[J[i]] = (P[i] + L * Rr[i]) / tot
-        A00 = 0.0
-        A01 = 0.0
-        A10 = 0.0
-        A11 = 0.0
-        for q in range(n):
-            A00 += w[q] * Minv[r, q, 0, 0]
-            A01 += w[q] * Minv[r, q, 0, 1]
-            A10 += w[q] * Minv[r, q, 1, 0]
-            A11 += w[q] * Minv[r, q, 1, 1]
-        c = A00 * A11 - A01 * A10
-        f = _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad)
-        gl = 0.0
-        gmin = np.inf
-        gabs = 0.0
-        for q in range(n):
-            gl += grad[q] * w[q]
-            gmin = min(gmin, grad[q])
-            gabs = max(gabs, abs(grad[q]))
-        value[r] = f
-        lower[r] = f - (gl - gmin)
-        scale[r] = max((A00 + A11) * (A00 + A11) / c, gabs / f) if c > 0 and f > 0 else np.inf
+                    w[q] = raw[q]
+                v, lo, sc = _bracket_point(Minv, r, w, grad)
+                bv, bl, bs = _nmin(bv, v), _nmax(bl, lo), _nmax(bs, sc)
+                if not (v - lo <= 1e-12 * v):
+                    add = 0  # np.argmin: first occurrence, a nan wins
+                    for q in range(1, n):
+                        if np.isnan(grad[add]):
+                            break
+                        if np.isnan(grad[q]) or grad[q] < grad[add]:
+                            add = q
+                    if k == 3:  # np.where(raw > 0, raw, inf).argmin()
+                        drop = 0
+                        best = np.inf
+                        for q in range(n):
+                            x = raw[q] if raw[q] > 0 else np.inf
+                            if x < best:
+                                best = x
+                                drop = q
+                        if sup[drop]:
+                            sup[drop] = False
+                            changed = True
+                    if not sup[add]:
+                        sup[add] = True
+                        changed = True
+            elif not has_nan:  # drop the support's vertex of most negative weight
+                drop = -1
+                for q in range(n):
+                    if sup[q] and (drop == -1 or raw[q] < raw[drop]):
+                        drop = q
+                sup[drop] = False
+                changed = True
+            k = 0
+            for q in range(n):
+                if sup[q]:
+                    k += 1
+            active = changed and 1 <= k <= 3
+        value[r] = bv
+        lower[r] = bl
+        scale[r] = bs

@@ -146,6 +146,26 @@ def gaussian_draws(rng: np.random.Generator, factor, size: int):
     return np.zeros(factor.shape[0]) + x @ factor.T
 
 
+def _error_norm(d):
+    """``np.linalg.norm(d, axis=-1)`` of vectors in the plane, bit for bit, without its generic reduction.
+
+    numpy computes it as ``sqrt(add.reduce(d * d, axis=-1))``; a reduction over two elements is the one sum
+    ``d_0^2 + d_1^2``, written here directly (several times faster on the filters' ``(labels, R, N, 2)`` errors).
+
+    Parameters
+    ----------
+    d : ndarray, shape ``(..., 2)``
+        Real vectors (position errors).
+
+    Returns
+    -------
+    ndarray, shape ``(...)``
+        Their Euclidean norms.
+    """
+    s = d * d
+    return np.sqrt(s[..., 0] + s[..., 1])
+
+
 def _connected(adj):
     # agent 0 reaches every agent (boolean squaring; the same answer as lambda_2(laplacian) > 1e-9, ~4x faster)
     return component_membership(adj)[..., 0, :].min(-1) > 0
@@ -259,7 +279,7 @@ def simulate(sc: dict) -> dict:
         tr_g[kind] = np.empty((len(labs), R, K + 1))
         bwb_g[kind] = np.stack([bwb_of[n] for n in labs])
         gi_g[kind] = np.array([gi_of[n] for n in labs])
-        e = np.linalg.norm(est[kind] - (x if g_kind[kind] == "centralized" else x[:, None, :]), axis=-1)
+        e = _error_norm(est[kind] - (x if g_kind[kind] == "centralized" else x[:, None, :]))
         err_g[kind][..., 0] = e if e.ndim == 3 else e[..., None]
         tr_g[kind][:, :, 0] = 2 * float(sc["P0"])
     errors = {n: err_g[slot[n][0]][slot[n][1]] for n in names}
@@ -346,10 +366,10 @@ def simulate(sc: dict) -> dict:
             est[kind], cov[kind], delta[kind], _ = hinf_update_batch(est[kind], cov[kind], y_k, S_k, A, bwb_g[kind],
                                                                      gi_g[kind], Lbar)
             if g_kind[kind] == "centralized":
-                err_g[kind][:, :, 0, k] = np.linalg.norm(est[kind] - x, axis=-1)
+                err_g[kind][:, :, 0, k] = _error_norm(est[kind] - x)
                 tr_g[kind][:, :, k] = cov[kind][..., 0, 0] + cov[kind][..., 1, 1]
             else:
-                err_g[kind][:, :, :, k] = np.linalg.norm(est[kind] - x[:, None, :], axis=-1)
+                err_g[kind][:, :, :, k] = _error_norm(est[kind] - x[:, None, :])
                 tr_g[kind][:, :, k] = (cov[kind][..., 0, 0] + cov[kind][..., 1, 1]).mean(2)
         # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
         if mobile:
