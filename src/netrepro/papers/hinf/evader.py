@@ -623,11 +623,12 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
 
     Every point ``w`` of the simplex gives ``lower(w) = f(w) - g(w) <= min f <= f(w) = value(w)`` (``g`` the
     Frank-Wolfe gap, as :func:`fused_trace_bounds`); the bracket is the smallest ``value`` and the largest
-    ``lower`` over the points tried: ``lam0`` itself, then the stationary point of ``f = tr A / det A`` on the
-    face spanned by the support of ``lam0`` (at most 3 agents; the closed form of ``_face_stationary``), and
-    up to ``rounds`` active-set corrections of that support: a vertex with a negative (infeasible) weight is
-    dropped; where the point is feasible but its gap is above ``1e-12 f``, the vertex of smallest gradient
-    is added (or, on a triangle, replaces the vertex of smallest weight). When the support is the
+    ``lower`` over the points tried: the stationary point of ``f = tr A / det A`` on the face spanned by the
+    support of ``lam0`` (at most 3 agents; the closed form of ``_face_stationary``) and up to ``rounds``
+    active-set corrections of that support (a vertex with a negative, infeasible weight is dropped; where
+    the point is feasible but its gap is above ``1e-12 f``, the vertex of smallest gradient is added or, on a
+    triangle, replaces the vertex of smallest weight), or ``lam0`` itself where none of these points is
+    feasible. When the support is the
     optimum's, or a correction away (the usual case for candidates a step apart), the bracket is as tight as
     the exact solver's certificate. Also returned: the largest rounding scale
     ``max(tr(A)^2 / det A, max_j |grad_j| / f)`` over the points (see :func:`_certified_exact_values`).
@@ -650,7 +651,8 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
     m, n = lam0.shape
     s = _sym_coords(Mf)
     l = s[..., 0] + s[..., 2]
-    value, lower, scale, _ = _bracket_at(Mf, lam0)
+    value, lower, scale = np.full(m, np.inf), np.full(m, -np.inf), np.zeros(m)
+    found = np.zeros(m, dtype=bool)
     sup = lam0 > 0
     active = (sup.sum(-1) >= 1) & (sup.sum(-1) <= 3)
     for _ in range(rounds + 1):
@@ -676,6 +678,7 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
             fr = rows[feas]
             v, lo, sc, g = _bracket_at(Mf[fr], raw[feas])
             value[fr], lower[fr], scale[fr] = np.minimum(value[fr], v), np.maximum(lower[fr], lo), np.maximum(scale[fr], sc)
+            found[fr] = True
             loose = ~(v - lo <= 1e-12 * v)
             add = g.argmin(-1)
             i = np.nonzero(feas)[0][loose]
@@ -690,6 +693,9 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
         sup[rows] = nxt
         active[:] = False
         active[rows[changed]] = True
+    if not found.all():  # no feasible face point: the hint itself (a point of the simplex)
+        nf = np.nonzero(~found)[0]
+        value[nf], lower[nf], scale[nf], _ = _bracket_at(Mf[nf], lam0[nf])
     return value, lower, scale
 
 

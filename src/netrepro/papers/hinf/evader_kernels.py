@@ -391,7 +391,10 @@ def _nmax(a, b):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _bracket_point(Minv, r, w, grad):
-    """``(f(w), f(w) - gap(w), scale)`` of :func:`.evader._bracket_at` for instance ``r``; ``grad`` filled."""
+    """``(f(w), f(w) - gap(w), scale)`` of :func:`.evader._bracket_at` for instance ``r``; ``grad`` filled.
+
+    Not the rounding of the numpy form (one reciprocal of the determinant, plain products): a bracket.
+    """
     n = w.shape[0]
     A00 = 0.0
     A01 = 0.0
@@ -403,15 +406,30 @@ def _bracket_point(Minv, r, w, grad):
         A10 += w[q] * Minv[r, q, 1, 0]
         A11 += w[q] * Minv[r, q, 1, 1]
     c = A00 * A11 - A01 * A10
-    f = _trace_and_gradient(A00, A01, A10, A11, c, Minv, r, grad)
+    ic = 1.0 / c
+    i00 = A11 * ic
+    i11 = A00 * ic
+    i01 = -A01 * ic
+    i10 = -A10 * ic
+    C00 = i00 * i00 + i01 * i10
+    C01 = i00 * i01 + i01 * i11
+    C10 = i10 * i00 + i11 * i10
+    C11 = i10 * i01 + i11 * i11
+    f = i00 + i11
     gl = 0.0
-    gmin = grad[0]
+    gmin = np.inf
     gabs = 0.0
+    nan = False
     for q in range(n):
-        gl += grad[q] * w[q]
-        gmin = _nmin(gmin, grad[q])
-        gabs = _nmax(gabs, abs(grad[q]))
-    scale = _nmax((A00 + A11) * (A00 + A11) / c, gabs / f) if (c > 0 and f > 0) else np.inf
+        g = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1]) + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+        grad[q] = g
+        nan = nan or np.isnan(g)
+        gl += g * w[q]
+        gmin = min(gmin, g)
+        gabs = max(gabs, abs(g))
+    if nan:
+        return f, np.nan, np.nan
+    scale = max((A00 + A11) * (A00 + A11) * ic, gabs / f) if (c > 0 and f > 0) else np.inf
     return f, f - (gl - gmin), scale
 
 
@@ -419,10 +437,10 @@ def _bracket_point(Minv, r, w, grad):
 def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
     """:func:`.evader._support_bracket_numpy` per instance: a bracket of the fused trace's minimum (eq (24)).
 
-    The same algorithm as the numpy form: the hint ``lam0``, the stationary point of ``f = tr A / det A`` on
-    the face spanned by its support (the closed form of :func:`.evader._face_stationary`) and up to
-    ``rounds`` active-set corrections of the support; the smallest ``f``, the largest Frank-Wolfe lower bound
-    and the largest rounding scale over the points. Not necessarily the same rounding (a bracket, not a result:
+    The same algorithm as the numpy form: the stationary point of ``f = tr A / det A`` on the face spanned by
+    the support of ``lam0`` (the closed form of :func:`.evader._face_stationary`) and up to ``rounds``
+    active-set corrections of the support, or the hint ``lam0`` where no such point is feasible; the smallest
+    ``f``, the largest Frank-Wolfe lower bound and the largest rounding scale over the points. Not necessarily the same rounding (a bracket, not a result:
     :func:`.evader._certified_exact_values` allows for rounding).
 
     Parameters
@@ -457,11 +475,11 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
     for r in range(m):
         k = 0
         for q in range(n):
-            w[q] = lam0[r, q]
             sup[q] = lam0[r, q] > 0
             if sup[q]:
                 k += 1
-        bv, bl, bs = _bracket_point(Minv, r, w, grad)
+        bv, bl, bs = np.inf, -np.inf, 0.0
+        found = False
         active = 1 <= k <= 3
         for _ in range(rounds + 1):
             if not active:
@@ -521,6 +539,7 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
                     w[q] = raw[q]
                 v, lo, sc = _bracket_point(Minv, r, w, grad)
                 bv, bl, bs = _nmin(bv, v), _nmax(bl, lo), _nmax(bs, sc)
+                found = True
                 if not (v - lo <= 1e-12 * v):
                     add = 0  # np.argmin: first occurrence, a nan wins
                     for q in range(1, n):
@@ -554,6 +573,10 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
                 if sup[q]:
                     k += 1
             active = changed and 1 <= k <= 3
+        if not found:  # no feasible face point: the hint itself (a point of the simplex)
+            for q in range(n):
+                w[q] = lam0[r, q]
+            bv, bl, bs = _bracket_point(Minv, r, w, grad)
         value[r] = bv
         lower[r] = bl
         scale[r] = bs
