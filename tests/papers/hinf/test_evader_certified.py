@@ -20,29 +20,41 @@ from netrepro.papers.hinf.noise import NoiseModel, geometry, noise_information
 MODEL = NoiseModel(0.3528, 15.625, 0.0008, 5.0)
 
 
-def _candidates(x, agents, step=0.14, H=16):
+def _positions(x, step=0.14, H=16):
     phi = 2 * np.pi * np.arange(H) / H
     offs = np.concatenate([np.zeros((1, 2)), step * np.stack([np.cos(phi), np.sin(phi)], -1)])
-    cand = x[:, None, :] + offs[None]
-    r, th = geometry(cand, agents[:, None, :, :])
+    return x[:, None, :] + offs[None]
+
+
+def _candidates(x, agents, step=0.14, H=16):
+    r, th = geometry(_positions(x, step, H), agents[:, None, :, :])
     return noise_information(r, th, MODEL, kernel="numpy")
 
 
-def _hard_instances(seed=0):
-    """``(R, C, N, 2, 2)`` candidate informations: model geometry, near-duplicate and identical agents, mirror ties."""
+def _hard_cases(seed=0):
+    """``(x, agents)`` of hard cases: model geometry, near-duplicate and identical agents, mirror ties, a
+    candidate on an agent."""
     rng = np.random.default_rng(seed)
     out = []
     for N in (3, 4, 10):
-        out.append(_candidates(rng.normal(scale=3, size=(25, 2)), rng.normal(scale=20, size=(25, N, 2))))
+        out.append((rng.normal(scale=3, size=(25, 2)), rng.normal(scale=20, size=(25, N, 2))))
     ag = rng.normal(scale=20, size=(25, 4, 2))
     ag[:, 2] = ag[:, 0] + 1e-7 * rng.standard_normal((25, 2))   # nearly coincident agents (Newton polish)
     ag[:, 3] = ag[:, 1]                                          # identical agents (singular faces)
-    out.append(_candidates(rng.normal(scale=3, size=(25, 2)), ag))
+    x = rng.normal(scale=3, size=(25, 2))
+    ag[:4, 1] = x[:4]                                            # an agent on the target (range 0)
+    ag[4:8, 1] = _positions(x)[4:8, 5]                           # an agent on a candidate
+    out.append((x, ag))
     # mirror-symmetric agents about the x axis, target on the axis: headings phi and -phi tie (up to rounding)
     a = rng.normal(scale=20, size=(25, 2, 2))
     sym = np.concatenate([a, a * [1.0, -1.0]], 1)
-    out.append(_candidates(np.stack([rng.normal(scale=3, size=25), np.zeros(25)], -1), sym))
+    out.append((np.stack([rng.normal(scale=3, size=25), np.zeros(25)], -1), sym))
     return out
+
+
+def _hard_instances(seed=0):
+    """``(R, C, N, 2, 2)`` candidate informations of :func:`_hard_cases`."""
+    return [_candidates(x, ag) for x, ag in _hard_cases(seed)]
 
 
 def _slsqp_min(S):
@@ -98,7 +110,9 @@ def test_support_bracket_contains_the_minimum_and_is_tight_on_the_right_support(
         M = M[:4, ::4]                                   # (4, 5, N, 2, 2): 20 instances per hint
         R, C, n = M.shape[:3]
         Mf = M.reshape(-1, n, 2, 2)
-        true = np.array([_slsqp_min(S) for S in Mf])
+        # the best of SLSQP (independent) and the exact solver (SLSQP can stall on singular faces): an upper bound
+        # of the minimum within 1e-12 of it
+        true = np.minimum([_slsqp_min(S) for S in Mf], E.min_fused_trace_exact(Mf)[0])
         for hint in _hints(M, rng):
             rep = np.repeat(hint, C, 0)
             for rounds in (0, 1, 3):
@@ -151,33 +165,83 @@ def _reference_choice(M):
     return best, v[np.arange(len(v)), best]
 
 
+def test_approximate_information_is_the_model_information_to_a_few_ulps():
+    rng = np.random.default_rng(12)
+    x, ag = rng.normal(scale=3, size=(30, 2)), rng.normal(scale=20, size=(30, 4, 2))
+    approx = E._approx_information(_positions(x), ag, MODEL)
+    np.testing.assert_allclose(approx, _candidates(x, ag), rtol=1e-13, atol=1e-15)
+    # by hand: an agent due west of the target at range r sees diag(1/f_r, 1/(alpha f_r))
+    fr = MODEL.a2 * (7.0 - MODEL.a1) ** 2 + MODEL.a0
+    S = E._approx_information(np.array([[[7.0, 0.0]]]), np.zeros((1, 1, 2)), MODEL)[0, 0, 0]
+    np.testing.assert_allclose(S, np.diag([1 / fr, 1 / (MODEL.alpha * fr)]), rtol=1e-15)
+
+
+@pytest.mark.parametrize("case", range(5))
+def test_candidate_bracket_compiled_matches_numpy_form_and_contains_the_exact_value(case):
+    x, ag = _hard_cases(13)[case]
+    cand = _positions(x)
+    M = _candidates(x, ag)
+    exact, _ = E.min_fused_trace_exact(M)
+    for hint in _hints(M, np.random.default_rng(case)):
+        a = E._candidate_bracket(cand, ag, MODEL, hint, compiled=False)
+        b = E._candidate_bracket(cand, ag, MODEL, hint, compiled=True)
+        fin = np.isfinite(a[2]) & (a[2] < 1e8)
+        for u, v in zip(a, b):
+            assert np.array_equal(np.isfinite(u), np.isfinite(v))
+            np.testing.assert_allclose(v[fin], u[fin], rtol=1e-12 * max(1.0, float(np.max(a[2][fin]))), atol=0)
+        ok = np.isfinite(a[0]) & np.isfinite(a[1])
+        assert np.all(a[1][ok] <= exact[ok] * (1 + 1e-11)) and np.all(exact[ok] <= a[0][ok] * (1 + 1e-11))
+        assert np.all(a[2] >= MODEL.alpha)
+        # a candidate on an agent (range 0): no bracket, so never excluded
+        if case == 3:
+            assert not np.isfinite(a[0][4:8, 5]).any()
+
+
 @pytest.mark.parametrize("kernel", ["numpy", "compiled"])
 @pytest.mark.parametrize("case", range(5))
 def test_certified_values_give_the_reference_choice_bitwise(case, kernel):
-    M = _hard_instances(6)[case]
+    x, ag = _hard_cases(6)[case]
+    M = _candidates(x, ag)
     ref_best, ref_val = _reference_choice(M)
     R = len(M)
     _, lam = E.min_fused_trace_exact(M)
     excluded = 0
     for hint in (lam[:, 0], lam[:, 5], np.full((R, M.shape[2]), 1.0 / M.shape[2])):
-        tr, lam_c = E._certified_exact_values(M, hint, kernel=kernel)
+        tr, lam_c = E._certified_exact_values(_positions(x), ag, MODEL, hint, kernel=kernel)
         best = tr.argmax(1)
         assert np.array_equal(best, ref_best)
         assert tr[np.arange(R), best].tobytes() == ref_val.tobytes()
+        assert lam_c[np.arange(R), best].tobytes() == lam[np.arange(R), best].tobytes()
         excluded += np.isneginf(tr).sum()
     assert excluded > 0  # the fast path is taken
 
 
 def test_certified_fallbacks_solve_every_candidate(monkeypatch):
-    M = _hard_instances(7)[1]
+    x, ag = _hard_cases(7)[1]
+    M = _candidates(x, ag)
     ref_v, ref_l = E.min_fused_trace_exact(M)
-    _, lam = E.min_fused_trace_exact(M)
+    cand = _positions(x)
     # no hint, an infinite margin, or no trusted bracket (scale limit 0): every candidate solved, as the reference
-    for tr, lam_c in (E._certified_exact_values(M, None), E._certified_exact_values(M, lam[:, 0], margin=np.inf)):
+    for tr, lam_c in (E._certified_exact_values(cand, ag, MODEL, None),
+                      E._certified_exact_values(cand, ag, MODEL, ref_l[:, 0], margin=np.inf)):
         assert tr.tobytes() == ref_v.tobytes() and lam_c.tobytes() == ref_l.tobytes()
     monkeypatch.setattr(E, "CERTIFY_SCALE_MAX", 0.0)
-    tr, _ = E._certified_exact_values(M, lam[:, 0])
+    tr, _ = E._certified_exact_values(cand, ag, MODEL, ref_l[:, 0])
     assert tr.tobytes() == ref_v.tobytes()
+
+
+def test_candidate_informations_of_a_subset_are_those_of_the_whole_batch():
+    """The contenders' informations are recomputed on their own: element-wise, so the same bits (either form)."""
+    for x, ag in _hard_cases(14):
+        cand = _positions(x)
+        r, th = geometry(cand, ag[:, None, :, :])
+        full = noise_information(r, th, MODEL)
+        rng = np.random.default_rng(0)
+        for size in (1, 5, 60, 300):
+            ri, ci = rng.integers(0, len(x), size), rng.integers(0, cand.shape[1], size)
+            r2, th2 = geometry(cand[ri, ci], ag[ri])
+            for kernel in ("numpy", "compiled", "auto"):
+                assert noise_information(r2, th2, MODEL, kernel=kernel).tobytes() == full[ri, ci].tobytes()
 
 
 def test_evader_move_with_state_follows_the_reference_path_bitwise():
@@ -190,6 +254,7 @@ def test_evader_move_with_state_follows_the_reference_path_bitwise():
         if N == 4:
             agents[:, 3] = agents[:, 1]
         state, xs = {}, x.copy()
+        agents[:3, 0] = x[:3]  # an agent on the target
         for _ in range(15):
             a = E.evader_move(x, agents, MODEL, 0.14, 16, 0, "exact")
             b = E.evader_move(xs, agents, MODEL, 0.14, 16, 0, "exact", state=state)

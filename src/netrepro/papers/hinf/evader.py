@@ -699,7 +699,85 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
     return value, lower, scale
 
 
-def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN, kernel: str = "auto"):
+def _approx_information(cand, agents, model: NoiseModel):
+    """``M_j^{-1}`` of eq (3) at candidate positions, without transcendental functions (for brackets only).
+
+    ``M^{-1} = T diag(1/f_r, 1/f_b) T^T`` with ``T`` the rotation by the bearing, whose cosine and sine are
+    taken as ``dx / r`` and ``dy / r`` (``r = sqrt(dx^2 + dy^2)``) instead of ``cos(arctan2(dy, dx))``: the
+    same matrices up to a few ulps (:func:`.noise.noise_information` is the exact form the solver uses).
+
+    Parameters
+    ----------
+    cand : ndarray, shape ``(R, C, 2)``
+        Candidate target positions.
+    agents : ndarray, shape ``(R, N, 2)``
+        Agent positions.
+    model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4).
+
+    Returns
+    -------
+    ndarray, shape ``(R, C, N, 2, 2)``
+        Not finite where a candidate is on an agent (range 0).
+    """
+    d = np.asarray(cand, dtype=float)[:, :, None, :] - np.asarray(agents, dtype=float)[:, None, :, :]
+    dx, dy = d[..., 0], d[..., 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.sqrt(dx * dx + dy * dy)
+        co, si = dx / r, dy / r
+        fr = model.a2 * (r - model.a1) ** 2 + model.a0
+        ir = 1.0 / fr
+        ib = ir / model.alpha
+        S = np.empty(r.shape + (2, 2))
+        S[..., 0, 0] = co * co * ir + si * si * ib
+        S[..., 0, 1] = S[..., 1, 0] = co * si * (ir - ib)
+        S[..., 1, 1] = si * si * ir + co * co * ib
+    return S
+
+
+def _candidate_bracket(cand, agents, model: NoiseModel, lam0, compiled: bool, rounds: int = SUPPORT_ROUNDS):
+    """Brackets of every candidate's ``min_lambda tr Q_fused`` (eq (24)) from positions and each run's hint.
+
+    :func:`_support_bracket_numpy` (``compiled``: its kernel ``support_bracket_kernel``) on
+    :func:`_approx_information`, from the hint ``lam0[i]`` for every candidate of run ``i``; the scale is at
+    least ``max(alpha, 1/alpha)``, the condition number of each ``M_j^{-1}`` (the amplification of the few
+    ulps by which these informations may differ from the solver's).
+
+    Parameters
+    ----------
+    cand : ndarray, shape ``(R, C, 2)``
+        Candidate target positions.
+    agents : ndarray, shape ``(R, N, 2)``
+        Agent positions.
+    model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4).
+    lam0 : ndarray, shape ``(R, N)``
+        Each run's hint.
+    compiled : bool
+        Use the compiled kernel.
+    rounds : int
+        Corrections of the support (:data:`SUPPORT_ROUNDS`).
+
+    Returns
+    -------
+    value, lower, scale : ndarray, shape ``(R, C)``
+    """
+    R, C, n = cand.shape[0], cand.shape[1], agents.shape[1]
+    S = _approx_information(cand, agents, model).reshape(R * C, n, 2, 2)
+    hint = np.repeat(np.asarray(lam0, dtype=float), C, 0)
+    if compiled:
+        from .evader_kernels import support_bracket_kernel
+        value, lower, scale = np.empty(R * C), np.empty(R * C), np.empty(R * C)
+        support_bracket_kernel(S, hint, int(rounds), value, lower, scale)
+    else:
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            value, lower, scale = _support_bracket_numpy(S, hint, rounds)
+    scale = np.maximum(scale, max(model.alpha, 1.0 / model.alpha))
+    return value.reshape(R, C), lower.reshape(R, C), scale.reshape(R, C)
+
+
+def _certified_exact_values(cand, agents, model: NoiseModel, lam_hint=None, margin: float = CERTIFY_MARGIN,
+                            kernel: str = "auto"):
     """The evader's candidate values ``min_lambda tr Q_fused`` (eq (24)) where they can decide its move (eq (19)).
 
     Returns :func:`min_fused_trace_exact`'s value for every candidate that could be the (first) largest, and
@@ -707,28 +785,36 @@ def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN,
     are those of the exact solver on every candidate (the reference), bit for bit.
 
     The method: each candidate is bracketed, ``lower_c <= min f_c <= value_c``, by
-    :func:`_support_bracket_numpy` from the support of ``lam_hint`` (the optimal weights of the run's previous
+    :func:`_candidate_bracket` (:func:`_support_bracket_numpy` on informations formed without transcendental
+    functions, within a few ulps of the solver's) from the support of ``lam_hint`` (the optimal weights of the run's previous
     move: the optimum's support rarely changes much over a step); with ``L = max_c lower_c``, a candidate with
     ``value_c (1 + margin) < L (1 - margin)`` is excluded, the others (the contenders, always including the
-    candidate attaining ``L``) are solved exactly. Why the exclusion is safe: let ``v_c`` be the exact solver's
+    candidate attaining ``L``) are solved exactly, on their informations from :func:`.noise.geometry` and
+    :func:`.noise.noise_information` as the reference computes them. Why the exclusion is safe: let ``v_c`` be the exact solver's
     value of candidate ``c`` and ``b`` a candidate with ``lower_b = L``. The exact solver's ``v`` is ``f`` at a
     point of the simplex with relative Frank-Wolfe gap at most :data:`EXACT_TOLERANCE` (1e-12), so
-    ``min f_c <= v_c <= min f_c (1 + 1e-12)`` up to rounding. The bracket's own rounding is relative and of
-    order ``N eps s`` with ``eps = 2.2e-16``, ``N`` the agents and ``s`` the bracket's scale
-    (``tr(A)^2 / det A`` bounds the amplification of the determinant's cancellation, ``max_j |grad_j| / f``
-    that of the gap's), at most ``10 * 2.2e-16 * 1e4 ~ 2e-11`` when ``s <= CERTIFY_SCALE_MAX`` (a candidate
+    ``min f_c <= v_c <= min f_c (1 + 1e-12)`` up to rounding. The bracket's own rounding, including the few
+    ulps by which its informations differ from the solver's, is relative and of order ``N eps s`` with
+    ``eps = 2.2e-16``, ``N`` the agents and ``s`` the bracket's scale (``tr(A)^2 / det A`` bounds the
+    amplification of the determinant's cancellation, ``max_j |grad_j| / f`` that of the gap's, ``alpha``
+    that of the informations' perturbation), at most ``10 * 2.2e-16 * 1e4 ~ 2e-11`` when ``s <= CERTIFY_SCALE_MAX`` (a candidate
     whose bracket has a larger scale or is not finite is neither excluded nor used for ``L``). Hence
     ``v_c <= value_c (1 + 1e-12 + 2e-11) < value_c (1 + margin)`` and ``v_b >= lower_b (1 - 2e-11) >
     L (1 - margin)`` for ``margin = 1e-9``: an excluded ``c`` has ``v_c < v_b``, it is neither the argmax
     nor tied with it. The exact solver's result for an instance does not depend on the other instances of
-    its call (per-instance arithmetic; compiled and numpy forms bit-identical), so solving only the
-    contenders gives the same bits (tested). Where the exact solver would fail (``ArithmeticError``) on an
+    its call (per-instance arithmetic; compiled and numpy forms bit-identical), and neither do the
+    informations of a candidate (element-wise functions), so solving only the contenders gives the same bits
+    (tested). Where the exact solver would fail (``ArithmeticError``) on an
     excluded candidate, the reference raises and this does not.
 
     Parameters
     ----------
-    Minv : ndarray, shape ``(R, C, N, 2, 2)``
-        The informations ``M_j^{-1}`` at the ``C`` candidate positions of ``R`` runs.
+    cand : ndarray, shape ``(R, C, 2)``
+        The ``C`` candidate positions of ``R`` runs.
+    agents : ndarray, shape ``(R, N, 2)``
+        The agents' positions.
+    model : NoiseModel
+        The range-bearing noise model of eqs (3)-(4).
     lam_hint : ndarray, shape ``(R, N)``, optional
         Weights on the simplex whose support is tried for each run's bracket; ``None``: every candidate is
         solved exactly.
@@ -745,27 +831,21 @@ def _certified_exact_values(Minv, lam_hint=None, margin: float = CERTIFY_MARGIN,
     lam : ndarray, shape ``(R, C, N)``
         The exact solver's weights of each contender, 0 elsewhere.
     """
-    R, C, n = Minv.shape[:3]
+    R, C, n = cand.shape[0], cand.shape[1], agents.shape[1]
     if kernel == "auto":
-        kernel = "compiled" if use_compiled("auto", Minv.size // 4) else "numpy"
+        kernel = "compiled" if use_compiled("auto", R * C * n) else "numpy"
     if lam_hint is None:
-        return min_fused_trace_exact(Minv, kernel=kernel)
-    Mf = np.ascontiguousarray(Minv.reshape(R * C, n, 2, 2))
-    lam_rep = np.repeat(np.asarray(lam_hint, dtype=float), C, axis=0)
-    if kernel == "compiled":
-        from .evader_kernels import support_bracket_kernel
-        value, lower, scale = np.empty(R * C), np.empty(R * C), np.empty(R * C)
-        support_bracket_kernel(Mf, lam_rep, SUPPORT_ROUNDS, value, lower, scale)
-    else:
-        value, lower, scale = _support_bracket_numpy(Mf, lam_rep)
-    value, lower, scale = value.reshape(R, C), lower.reshape(R, C), scale.reshape(R, C)
+        r, th = geometry(cand, agents[:, None, :, :])
+        return min_fused_trace_exact(noise_information(r, th, model), kernel=kernel)
+    value, lower, scale = _candidate_bracket(cand, agents, model, lam_hint, kernel == "compiled")
     ok = np.isfinite(value) & np.isfinite(lower) & (scale <= CERTIFY_SCALE_MAX)  # nan scale: not ok
     L = np.where(ok, np.minimum(lower, value), -np.inf).max(axis=1)
     excluded = ok & (value * (1.0 + margin) < (L * (1.0 - margin))[:, None]) & (L > 0)[:, None]
     ri, ci = np.nonzero(~excluded)
     out = np.full((R, C), -np.inf)
     lam = np.zeros((R, C, n))
-    out[ri, ci], lam[ri, ci] = min_fused_trace_exact(Minv[ri, ci], kernel=kernel)
+    r, th = geometry(cand[ri, ci], agents[ri])
+    out[ri, ci], lam[ri, ci] = min_fused_trace_exact(noise_information(r, th, model), kernel=kernel)
     return out, lam
 
 
@@ -811,18 +891,18 @@ def evader_move(x_t, agents, model: NoiseModel, step: float, n_headings: int, n_
     phi = 2 * np.pi * np.arange(n_headings) / n_headings
     offs = np.concatenate([np.zeros((1, 2)), step * np.stack([np.cos(phi), np.sin(phi)], -1)])
     cand = x_t[:, None, :] + offs[None]  # (R, H+1, 2)
-    r, th = geometry(cand, agents[:, None, :, :])  # (R, H+1, N)
-    Minv = noise_information(r, th, model)
     # certified only in compiled form: in numpy the bracket's per-call overhead exceeds its saving on the small
     # batches of the steps that do not load numba (fig6_paths: 2.98 s with it, 2.11 s without)
-    certify = solver == "exact" and state is not None and use_compiled("auto", Minv.size // 4)
+    certify = solver == "exact" and state is not None and use_compiled("auto", cand.shape[0] * cand.shape[1]
+                                                                        * agents.shape[1])
     if certify:
         hint = state.get("lam")
-        if hint is not None and np.shape(hint) != (Minv.shape[0], Minv.shape[2]):
+        if hint is not None and np.shape(hint) != (agents.shape[0], agents.shape[1]):
             hint = None  # another simulation's weights: solve every candidate
-        tr, lam = _certified_exact_values(Minv, hint)
+        tr, lam = _certified_exact_values(cand, agents, model, hint)
     else:
-        tr, lam = _inner(solver)(Minv, n_iter)
+        r, th = geometry(cand, agents[:, None, :, :])  # (R, H+1, N)
+        tr, lam = _inner(solver)(noise_information(r, th, model), n_iter)
     best = np.argmax(tr, axis=1)
     idx = np.arange(len(x_t))
     if certify:
