@@ -464,14 +464,6 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
     grad = np.empty(n)
     sup = np.empty(n, dtype=np.bool_)
     J = np.empty(3, dtype=np.int64)
-    a = np.empty(3)
-    b = np.empty(3)
-    d = np.empty(3)
-    lv = np.empty(3)
-    h = np.empty((3, 3))
-    adj = np.empty((3, 3))
-    P = np.empty(3)
-    Rr = np.empty(3)
     for r in range(m):
         k = 0
         for q in range(n):
@@ -490,49 +482,68 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
                 if sup[q]:
                     J[k] = q
                     k += 1
-            for i in range(k):
-                a[i] = Minv[r, J[i], 0, 0]
-                b[i] = 0.5 * (Minv[r, J[i], 0, 1] + Minv[r, J[i], 1, 0])
-                d[i] = Minv[r, J[i], 1, 1]
-                lv[i] = a[i] + d[i]
-            for i in range(k):
-                for j in range(k):
-                    h[i, j] = 0.5 * (a[i] * d[j] + d[i] * a[j]) - b[i] * b[j]
-            adj[:, :] = 0.0
+            # the face's stationary point in closed form (as faces_kernel, on scalars)
+            j0 = J[0]
+            j1 = J[1] if k > 1 else j0
+            j2 = J[2] if k > 2 else j0
+            a0, d0 = Minv[r, j0, 0, 0], Minv[r, j0, 1, 1]
+            a1, d1 = Minv[r, j1, 0, 0], Minv[r, j1, 1, 1]
+            a2, d2 = Minv[r, j2, 0, 0], Minv[r, j2, 1, 1]
+            b0 = 0.5 * (Minv[r, j0, 0, 1] + Minv[r, j0, 1, 0])
+            b1 = 0.5 * (Minv[r, j1, 0, 1] + Minv[r, j1, 1, 0])
+            b2 = 0.5 * (Minv[r, j2, 0, 1] + Minv[r, j2, 1, 0])
+            l0, l1, l2 = a0 + d0, a1 + d1, a2 + d2
+            x1 = x2 = 0.0
             if k == 1:
-                adj[0, 0] = 1.0
-            elif k == 2:
-                adj[0, 0], adj[1, 1], adj[0, 1], adj[1, 0] = h[1, 1], h[0, 0], -h[0, 1], -h[0, 1]
+                n0 = l0 + np.sqrt(l0 * l0)
+                x0 = n0 / n0
             else:
-                adj[0, 0] = h[1, 1] * h[2, 2] - h[1, 2] ** 2
-                adj[1, 1] = h[0, 0] * h[2, 2] - h[0, 2] ** 2
-                adj[2, 2] = h[0, 0] * h[1, 1] - h[0, 1] ** 2
-                adj[0, 1] = adj[1, 0] = h[0, 2] * h[1, 2] - h[0, 1] * h[2, 2]
-                adj[0, 2] = adj[2, 0] = h[0, 1] * h[1, 2] - h[0, 2] * h[1, 1]
-                adj[1, 2] = adj[2, 1] = h[0, 1] * h[0, 2] - h[0, 0] * h[1, 2]
-            lP = 0.0
-            sR = 0.0
-            for i in range(k):
-                P[i] = 0.0
-                Rr[i] = 0.0
-                for j in range(k):
-                    P[i] += adj[i, j] * lv[j]
-                    Rr[i] += adj[i, j]
-                lP += lv[i] * P[i]
-                sR += Rr[i]
-            L = np.sqrt(lP / sR)
-            tot = 0.0
-            for i in range(k):
-                tot += P[i] + L * Rr[i]
-            feasible = True
-            has_nan = False
-            for i in range(k):
-                x = (P[i] + L * Rr[i]) / tot
-                raw[J[i]] = x
-                if np.isnan(x):
-                    has_nan = True
-                if not (np.isfinite(x) and x >= 0.0):
-                    feasible = False
+                h00 = a0 * d0 - b0 * b0
+                h11 = a1 * d1 - b1 * b1
+                h01 = 0.5 * (a0 * d1 + d0 * a1) - b0 * b1
+                if k == 2:
+                    P0 = h11 * l0 - h01 * l1
+                    P1 = h00 * l1 - h01 * l0
+                    R0 = h11 - h01
+                    R1 = h00 - h01
+                    L = np.sqrt((l0 * P0 + l1 * P1) / (R0 + R1))
+                    n0 = P0 + L * R0
+                    n1 = P1 + L * R1
+                    tot = n0 + n1
+                    x0 = n0 / tot
+                    x1 = n1 / tot
+                else:
+                    h22 = a2 * d2 - b2 * b2
+                    h02 = 0.5 * (a0 * d2 + d0 * a2) - b0 * b2
+                    h12 = 0.5 * (a1 * d2 + d1 * a2) - b1 * b2
+                    c00 = h11 * h22 - h12 * h12
+                    c11 = h00 * h22 - h02 * h02
+                    c22 = h00 * h11 - h01 * h01
+                    c01 = h02 * h12 - h01 * h22
+                    c02 = h01 * h12 - h02 * h11
+                    c12 = h01 * h02 - h00 * h12
+                    P0 = c00 * l0 + c01 * l1 + c02 * l2
+                    P1 = c01 * l0 + c11 * l1 + c12 * l2
+                    P2 = c02 * l0 + c12 * l1 + c22 * l2
+                    R0 = c00 + c01 + c02
+                    R1 = c01 + c11 + c12
+                    R2 = c02 + c12 + c22
+                    L = np.sqrt((l0 * P0 + l1 * P1 + l2 * P2) / (R0 + R1 + R2))
+                    n0 = P0 + L * R0
+                    n1 = P1 + L * R1
+                    n2 = P2 + L * R2
+                    tot = n0 + n1 + n2
+                    x0 = n0 / tot
+                    x1 = n1 / tot
+                    x2 = n2 / tot
+            raw[j0] = x0
+            if k > 1:
+                raw[j1] = x1
+            if k > 2:
+                raw[j2] = x2
+            has_nan = np.isnan(x0) or np.isnan(x1) or np.isnan(x2)
+            feasible = (np.isfinite(x0) and x0 >= 0.0 and np.isfinite(x1) and x1 >= 0.0
+                        and np.isfinite(x2) and x2 >= 0.0)
             changed = False
             if feasible:
                 for q in range(n):
