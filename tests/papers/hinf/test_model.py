@@ -466,9 +466,9 @@ def test_consensus_variants_equal_their_own_simulations(mobile):
             assert not np.array_equal(out["errors"][lab], alone["errors"]["decentralized"]), lab
 
 
-def test_error_norm_is_numpy_norm_bitwise():
-    """The simulation's position-error norms equal np.linalg.norm(axis=-1) bit for bit, with extreme values."""
-    from netrepro.papers.hinf.model import _error_norm
+def test_plane_norm_is_numpy_norm_bitwise():
+    """The simulations' plane norms (errors, separations, velocities) equal np.linalg.norm(axis=-1) bit for bit."""
+    from netrepro.papers.hinf.noise import plane_norm as _error_norm
 
     rng = np.random.default_rng(31)
     d = rng.standard_normal((3, 50, 4, 2)) * 10.0 ** rng.integers(-200, 200, size=(3, 50, 4, 2))

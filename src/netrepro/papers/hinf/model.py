@@ -24,7 +24,7 @@ from .consensus import (CONSENSUS_DESIGNS, adjacency, complete_laplacian, compon
 from .evader import SOLVERS, evader_move
 from .filters import FilterDoesNotExist, congruence, hinf_update_batch, minimum_attenuation
 from .motion import control_law, sigma_gradient
-from .noise import NoiseModel, geometry, noise_information, sample_noise
+from .noise import NoiseModel, geometry, noise_information, plane_norm, sample_noise
 
 __all__ = ["FILTER_KINDS", "SCENARIOS", "KINDS", "layout_positions", "resolve_scenario", "simulate",
            "FilterDoesNotExist", "attenuation_levels", "window_means", "paired_z", "run_paired", "bonferroni_z", "tag_z",
@@ -146,26 +146,6 @@ def gaussian_draws(rng: np.random.Generator, factor, size: int):
     return np.zeros(factor.shape[0]) + x @ factor.T
 
 
-def _error_norm(d):
-    """``np.linalg.norm(d, axis=-1)`` of vectors in the plane, bit for bit, without its generic reduction.
-
-    numpy computes it as ``sqrt(add.reduce(d * d, axis=-1))``; a reduction over two elements is the one sum
-    ``d_0^2 + d_1^2``, written here directly (several times faster on the filters' ``(labels, R, N, 2)`` errors).
-
-    Parameters
-    ----------
-    d : ndarray, shape ``(..., 2)``
-        Real vectors (position errors).
-
-    Returns
-    -------
-    ndarray, shape ``(...)``
-        Their Euclidean norms.
-    """
-    s = d * d
-    return np.sqrt(s[..., 0] + s[..., 1])
-
-
 def _connected(adj):
     # agent 0 reaches every agent (boolean squaring; the same answer as lambda_2(laplacian) > 1e-9, ~4x faster)
     return component_membership(adj)[..., 0, :].min(-1) > 0
@@ -279,7 +259,7 @@ def simulate(sc: dict) -> dict:
         tr_g[kind] = np.empty((len(labs), R, K + 1))
         bwb_g[kind] = np.stack([bwb_of[n] for n in labs])
         gi_g[kind] = np.array([gi_of[n] for n in labs])
-        e = _error_norm(est[kind] - (x if g_kind[kind] == "centralized" else x[:, None, :]))
+        e = plane_norm(est[kind] - (x if g_kind[kind] == "centralized" else x[:, None, :]))
         err_g[kind][..., 0] = e if e.ndim == 3 else e[..., None]
         tr_g[kind][:, :, 0] = 2 * float(sc["P0"])
     errors = {n: err_g[slot[n][0]][slot[n][1]] for n in names}
@@ -366,10 +346,10 @@ def simulate(sc: dict) -> dict:
             est[kind], cov[kind], delta[kind], _ = hinf_update_batch(est[kind], cov[kind], y_k, S_k, A, bwb_g[kind],
                                                                      gi_g[kind], Lbar)
             if g_kind[kind] == "centralized":
-                err_g[kind][:, :, 0, k] = _error_norm(est[kind] - x)
+                err_g[kind][:, :, 0, k] = plane_norm(est[kind] - x)
                 tr_g[kind][:, :, k] = cov[kind][..., 0, 0] + cov[kind][..., 1, 1]
             else:
-                err_g[kind][:, :, :, k] = _error_norm(est[kind] - x[:, None, :])
+                err_g[kind][:, :, :, k] = plane_norm(est[kind] - x[:, None, :])
                 tr_g[kind][:, :, k] = (cov[kind][..., 0, 0] + cov[kind][..., 1, 1]).mean(2)
         # 5. decentralized gradient motion control (12)-(18), each agent with its own estimate
         if mobile:
