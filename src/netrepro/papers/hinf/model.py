@@ -285,7 +285,7 @@ def simulate(sc: dict) -> dict:
     v, w, Ct, yt = {}, {}, {}, {}
     dsig = np.zeros((2, R, N, 2, 2))  # local copies of Sigma^r_i, Sigma^theta_i (eq (14))
     n_psd_fix = 0
-    ev_state = {}  # the evader's weights from move to move: it then solves only the candidates that can win (bit-identical)
+    ev_state = {}  # the evader's weights from move to move: it solves only the candidates that can win
     for k in range(1, K + 1):
         # 1. target motion
         if sc["target"] == "random":
