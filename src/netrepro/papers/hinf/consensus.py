@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .noise import plane_norm
+
 __all__ = [
     "adjacency", "laplacian", "pi_consensus_step", "pi_consensus_modes", "pi_consensus_spectral_radius",
     "consensus_h_max", "run_pi_consensus", "pi_consensus_time_constants", "CONSENSUS_DESIGNS",
@@ -36,7 +38,7 @@ def adjacency(positions, radius: float):
         0/1 floats, zero diagonal.
     """
     p = np.asarray(positions, dtype=float)
-    d = np.linalg.norm(p[..., :, None, :] - p[..., None, :, :], axis=-1)
+    d = plane_norm(p[..., :, None, :] - p[..., None, :, :])  # np.linalg.norm(axis=-1), bit for bit
     adj = (d <= radius).astype(float)
     n = p.shape[-2]
     adj[..., np.arange(n), np.arange(n)] = 0.0

@@ -18,7 +18,7 @@ from numba import njit
 
 from ...engines.intrinsics import fma
 
-__all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel"]
+__all__ = ["pairwise_kernel", "faces_kernel", "polarised_det_kernel", "bounds_kernel", "support_bracket_kernel"]
 
 
 # --------------------------------------------------------------------------- compiled kernel (numba)
@@ -375,3 +375,219 @@ def bounds_kernel(Minv, lam, value, grad):
     for r in range(lam.shape[0]):
         A00, A01, A10, A11 = _fused_matrix(Minv, lam, r)
         value[r] = _trace_and_gradient(A00, A01, A10, A11, A00 * A11 - A01 * A10, Minv, r, grad[r])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _nmin(a, b):
+    """``np.minimum(a, b)`` on scalars (a nan wins)."""
+    return a if (np.isnan(a) or a <= b) else b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _nmax(a, b):
+    """``np.maximum(a, b)`` on scalars (a nan wins)."""
+    return a if (np.isnan(a) or a >= b) else b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bracket_point(Minv, r, w, grad):
+    """``(f(w), f(w) - gap(w), scale)`` of :func:`.evader._bracket_at` for instance ``r``; ``grad`` filled.
+
+    Not the rounding of the numpy form (one reciprocal of the determinant, plain products): a bracket.
+    """
+    n = w.shape[0]
+    A00 = 0.0
+    A01 = 0.0
+    A10 = 0.0
+    A11 = 0.0
+    for q in range(n):
+        A00 += w[q] * Minv[r, q, 0, 0]
+        A01 += w[q] * Minv[r, q, 0, 1]
+        A10 += w[q] * Minv[r, q, 1, 0]
+        A11 += w[q] * Minv[r, q, 1, 1]
+    c = A00 * A11 - A01 * A10
+    ic = 1.0 / c
+    i00 = A11 * ic
+    i11 = A00 * ic
+    i01 = -A01 * ic
+    i10 = -A10 * ic
+    C00 = i00 * i00 + i01 * i10
+    C01 = i00 * i01 + i01 * i11
+    C10 = i10 * i00 + i11 * i10
+    C11 = i10 * i01 + i11 * i11
+    f = i00 + i11
+    gl = 0.0
+    gmin = np.inf
+    gabs = 0.0
+    nan = False
+    for q in range(n):
+        g = -((C00 * Minv[r, q, 0, 0] + C10 * Minv[r, q, 0, 1]) + (C01 * Minv[r, q, 1, 0] + C11 * Minv[r, q, 1, 1]))
+        grad[q] = g
+        nan = nan or np.isnan(g)
+        gl += g * w[q]
+        gmin = min(gmin, g)
+        gabs = max(gabs, abs(g))
+    if nan:
+        return f, np.nan, np.nan
+    scale = max((A00 + A11) * (A00 + A11) * ic, gabs / f) if (c > 0 and f > 0) else np.inf
+    return f, f - (gl - gmin), scale
+
+
+@njit(cache=True, error_model="numpy")
+def support_bracket_kernel(Minv, lam0, rounds, value, lower, scale):
+    """:func:`.evader._support_bracket_numpy` per instance: a bracket of the fused trace's minimum (eq (24)).
+
+    The same algorithm as the numpy form: the stationary point of ``f = tr A / det A`` on the face spanned by
+    the support of ``lam0`` (the closed form of :func:`.evader._face_stationary`) and up to ``rounds``
+    active-set corrections of the support, or the hint ``lam0`` where no such point is feasible; the smallest
+    ``f``, the largest Frank-Wolfe lower bound and the largest rounding scale over the points. Not necessarily
+    the same rounding (a bracket, not a result: :func:`.evader._certified_exact_values` allows for rounding).
+
+    Parameters
+    ----------
+    Minv : ndarray ``(M, N, 2, 2)``
+        The informations ``M_j^{-1}``.
+    lam0 : ndarray ``(M, N)``
+        Weights on the simplex whose support is tried first.
+    rounds : int
+        Corrections of the support.
+    value, lower, scale : ndarray ``(M,)``
+        Outputs: the bracket ``[lower, value]`` and the scale ``max(tr(A)^2 / det A, max_j |grad_j| / f)``.
+
+    Returns
+    -------
+    None
+    """
+    m, n = lam0.shape
+    w = np.empty(n)
+    raw = np.empty(n)
+    grad = np.empty(n)
+    sup = np.empty(n, dtype=np.bool_)
+    J = np.empty(3, dtype=np.int64)
+    for r in range(m):
+        k = 0
+        for q in range(n):
+            sup[q] = lam0[r, q] > 0
+            if sup[q]:
+                k += 1
+        bv, bl, bs = np.inf, -np.inf, 0.0
+        found = False
+        active = 1 <= k <= 3
+        for _ in range(rounds + 1):
+            if not active:
+                break
+            k = 0
+            for q in range(n):
+                raw[q] = 0.0
+                if sup[q]:
+                    J[k] = q
+                    k += 1
+            # the face's stationary point in closed form (as faces_kernel, on scalars)
+            j0 = J[0]
+            j1 = J[1] if k > 1 else j0
+            j2 = J[2] if k > 2 else j0
+            a0, d0 = Minv[r, j0, 0, 0], Minv[r, j0, 1, 1]
+            a1, d1 = Minv[r, j1, 0, 0], Minv[r, j1, 1, 1]
+            a2, d2 = Minv[r, j2, 0, 0], Minv[r, j2, 1, 1]
+            b0 = 0.5 * (Minv[r, j0, 0, 1] + Minv[r, j0, 1, 0])
+            b1 = 0.5 * (Minv[r, j1, 0, 1] + Minv[r, j1, 1, 0])
+            b2 = 0.5 * (Minv[r, j2, 0, 1] + Minv[r, j2, 1, 0])
+            l0, l1, l2 = a0 + d0, a1 + d1, a2 + d2
+            x1 = x2 = 0.0
+            if k == 1:
+                n0 = l0 + np.sqrt(l0 * l0)
+                x0 = n0 / n0
+            else:
+                h00 = a0 * d0 - b0 * b0
+                h11 = a1 * d1 - b1 * b1
+                h01 = 0.5 * (a0 * d1 + d0 * a1) - b0 * b1
+                if k == 2:
+                    P0 = h11 * l0 - h01 * l1
+                    P1 = h00 * l1 - h01 * l0
+                    R0 = h11 - h01
+                    R1 = h00 - h01
+                    L = np.sqrt((l0 * P0 + l1 * P1) / (R0 + R1))
+                    n0 = P0 + L * R0
+                    n1 = P1 + L * R1
+                    tot = n0 + n1
+                    x0 = n0 / tot
+                    x1 = n1 / tot
+                else:
+                    h22 = a2 * d2 - b2 * b2
+                    h02 = 0.5 * (a0 * d2 + d0 * a2) - b0 * b2
+                    h12 = 0.5 * (a1 * d2 + d1 * a2) - b1 * b2
+                    c00 = h11 * h22 - h12 * h12
+                    c11 = h00 * h22 - h02 * h02
+                    c22 = h00 * h11 - h01 * h01
+                    c01 = h02 * h12 - h01 * h22
+                    c02 = h01 * h12 - h02 * h11
+                    c12 = h01 * h02 - h00 * h12
+                    P0 = c00 * l0 + c01 * l1 + c02 * l2
+                    P1 = c01 * l0 + c11 * l1 + c12 * l2
+                    P2 = c02 * l0 + c12 * l1 + c22 * l2
+                    R0 = c00 + c01 + c02
+                    R1 = c01 + c11 + c12
+                    R2 = c02 + c12 + c22
+                    L = np.sqrt((l0 * P0 + l1 * P1 + l2 * P2) / (R0 + R1 + R2))
+                    n0 = P0 + L * R0
+                    n1 = P1 + L * R1
+                    n2 = P2 + L * R2
+                    tot = n0 + n1 + n2
+                    x0 = n0 / tot
+                    x1 = n1 / tot
+                    x2 = n2 / tot
+            raw[j0] = x0
+            if k > 1:
+                raw[j1] = x1
+            if k > 2:
+                raw[j2] = x2
+            has_nan = np.isnan(x0) or np.isnan(x1) or np.isnan(x2)
+            feasible = (np.isfinite(x0) and x0 >= 0.0 and np.isfinite(x1) and x1 >= 0.0
+                        and np.isfinite(x2) and x2 >= 0.0)
+            changed = False
+            if feasible:
+                for q in range(n):
+                    w[q] = raw[q]
+                v, lo, sc = _bracket_point(Minv, r, w, grad)
+                bv, bl, bs = _nmin(bv, v), _nmax(bl, lo), _nmax(bs, sc)
+                found = True
+                if not (v - lo <= 1e-12 * v):
+                    add = 0  # np.argmin: first occurrence, a nan wins
+                    for q in range(1, n):
+                        if np.isnan(grad[add]):
+                            break
+                        if np.isnan(grad[q]) or grad[q] < grad[add]:
+                            add = q
+                    if k == 3:  # np.where(raw > 0, raw, inf).argmin()
+                        drop = 0
+                        best = np.inf
+                        for q in range(n):
+                            x = raw[q] if raw[q] > 0 else np.inf
+                            if x < best:
+                                best = x
+                                drop = q
+                        if sup[drop]:
+                            sup[drop] = False
+                            changed = True
+                    if not sup[add]:
+                        sup[add] = True
+                        changed = True
+            elif not has_nan:  # drop the support's vertex of most negative weight
+                drop = -1
+                for q in range(n):
+                    if sup[q] and (drop == -1 or raw[q] < raw[drop]):
+                        drop = q
+                sup[drop] = False
+                changed = True
+            k = 0
+            for q in range(n):
+                if sup[q]:
+                    k += 1
+            active = changed and 1 <= k <= 3
+        if not found:  # no feasible face point: the hint itself (a point of the simplex)
+            for q in range(n):
+                w[q] = lam0[r, q]
+            bv, bl, bs = _bracket_point(Minv, r, w, grad)
+        value[r] = bv
+        lower[r] = bl
+        scale[r] = bs

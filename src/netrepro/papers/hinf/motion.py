@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .algebra import I2, inv2, kernel_operand, rotation, use_compiled
+from .noise import plane_norm
 
 __all__ = ["sigma_gradient", "printed_sigma_gradient", "control_law", "printed_control_law", "path_statistics"]
 
@@ -133,7 +134,7 @@ def control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float, v_max: float = np.inf,
     else:
         local = np.stack([dJ_dr, dJ_dtheta / r], -1)
         u = Gamma * (rotation(theta) @ local[..., None])[..., 0]
-    norm = np.linalg.norm(u, axis=-1, keepdims=True)
+    norm = plane_norm(u)[..., None]  # np.linalg.norm(axis=-1, keepdims=True), bit for bit
     scale = np.where(norm > v_max, v_max / np.maximum(norm, 1e-300), 1.0)
     return u * scale
 

@@ -16,7 +16,7 @@ from ...errors import InputError
 from .algebra import kernel_operand, rotation, use_compiled
 
 __all__ = [
-    "NoiseModel", "geometry", "noise_variances", "noise_covariance", "noise_information",
+    "NoiseModel", "geometry", "plane_norm", "noise_variances", "noise_covariance", "noise_information",
     "printed_dinfo_dtheta", "dinfo_dr_reading", "sample_noise", "fit_noise_model",
 ]
 
@@ -40,6 +40,26 @@ def geometry(target, agents):
     """
     d = np.asarray(target, dtype=float)[..., None, :] - np.asarray(agents, dtype=float)
     return np.hypot(d[..., 0], d[..., 1]), np.arctan2(d[..., 1], d[..., 0])
+
+
+def plane_norm(d):
+    """``np.linalg.norm(d, axis=-1)`` of vectors in the plane, bit for bit, without its generic reduction.
+
+    numpy computes it as ``sqrt(add.reduce(d * d, axis=-1))``; a reduction over two elements is the one sum
+    ``d_0^2 + d_1^2``, written here directly (several times faster on the simulations' small stacked arrays).
+
+    Parameters
+    ----------
+    d : ndarray, shape ``(..., 2)``
+        Real vectors (position errors, separations, velocities).
+
+    Returns
+    -------
+    ndarray, shape ``(...)``
+        Their Euclidean norms.
+    """
+    s = d * d
+    return np.sqrt(s[..., 0] + s[..., 1])
 
 
 class NoiseModel:
