@@ -154,6 +154,26 @@ def test_sym_norm_2x2_only_masks_rows_with_a_non_finite_entry():
     assert np.isnan(model.sym_norm(np.array([[[-1.7e308, 1e308], [1e308, -1.7e308]]]))[0])  # finite entries: kept
 
 
+def test_batched_trace_is_np_trace_bit_for_bit():
+    rng = np.random.default_rng(13)
+    for n in (1, 2, 3):
+        P = rng.standard_normal((4000, n, n)) * 10.0 ** rng.uniform(-300, 300, size=(4000, 1, 1))
+        P[::7] = -0.0  # np.trace sums from 0.0: a diagonal of -0.0 gives 0.0
+        P[::11, 0, 0] = np.inf
+        P[::13, -1, -1] = -np.inf  # with ::11: inf - inf
+        P[::17, 0, 0] = np.nan
+        P[::19, 0, 0], P[::19, -1, -1] = 1e308, 1e308  # overflow
+        with np.errstate(over="ignore", invalid="ignore"):
+            want = np.trace(P, axis1=-2, axis2=-1)
+            got = model.batched_trace(P)
+            assert got.dtype == want.dtype and got.tobytes() == want.tobytes()
+            grid = P[:3990].reshape(10, 399, n, n)
+            assert model.batched_trace(grid).tobytes() == np.trace(grid, axis1=-2, axis2=-1).tobytes()
+        assert float(model.batched_trace(P[1])) == float(sum(P[1][i, i] for i in range(n)))  # one matrix
+    ints = np.arange(8).reshape(2, 2, 2)  # another dtype: np.trace itself (an integer result)
+    assert model.batched_trace(ints).dtype == ints.dtype and list(model.batched_trace(ints)) == [3, 11]
+
+
 def test_stationary_loss_rates():
     assert model.gilbert_elliott_stationary_loss(0.04, 0.65) == pytest.approx(0.0580, abs=5e-5)
     assert model.gilbert_elliott_stationary_loss(0.22004, 0.65) == pytest.approx(0.2529, abs=5e-5)

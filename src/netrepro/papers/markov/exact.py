@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .model import LinearSystem, riccati_g, riccati_h, sym_norm
+from .model import LinearSystem, batched_trace, riccati_g, riccati_h, sym_norm
 
 __all__ = ["ExactMoments", "exact_moments", "BlockSplit", "example2_split", "exact_moments_split", "find_split", "exact_moments_auto"]
 
@@ -158,7 +158,7 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(group_counts))
-        s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(group_counts))
+        s_tr = np.bincount(inv, weights=batched_trace(P), minlength=len(group_counts))
         coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))
     return ExactMoments(coef, float(sym_norm(P1[None])[0]), float(np.trace(P1)))
 
@@ -286,7 +286,7 @@ def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSp
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)
-        tr = sum(np.trace(P, axis1=-2, axis2=-1) for P in Ps)
+        tr = sum(batched_trace(P) for P in Ps)
         s_norm = np.bincount(inv, weights=norm, minlength=len(group_counts))
         s_tr = np.bincount(inv, weights=tr, minlength=len(group_counts))
         coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))

@@ -19,7 +19,7 @@ from ...errors import InputError
 
 __all__ = [
     "LinearSystem", "spectral_abs", "observability_index", "stacked_output", "prop1_bound", "loss_factor",
-    "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm",
+    "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm", "batched_trace",
     "gilbert_elliott_stationary_loss", "parity_bound_example2", "parity_ceiling", "norm_relaxation_bound",
     "prop1_closed_form",
 ]
@@ -403,6 +403,32 @@ def sym_norm(P) -> np.ndarray:
     else:
         val = np.linalg.eigvalsh(Pf)[..., -1]
     return np.where(bad, np.inf, val)
+
+
+def batched_trace(P) -> np.ndarray:
+    """Traces of a stack of square matrices: ``np.trace(P, axis1=-2, axis2=-1)``, bit for bit.
+
+    ``np.trace`` sums the diagonal from ``0.0`` (so a diagonal of ``-0.0`` gives ``0.0``); for 1 x 1 and
+    2 x 2 matrices that is written out, ``(0.0 + P_00) + P_11``, the same additions in the same order
+    without numpy's reduction over a short axis (~4x faster on the 2^22 paths of the exact moments).
+    Larger matrices and other dtypes: ``np.trace``.
+
+    Parameters
+    ----------
+    P : array_like
+        ``(..., n, n)``.
+
+    Returns
+    -------
+    ndarray
+        ``(...)`` the traces.
+    """
+    P = np.asarray(P)
+    if P.dtype == np.float64 and P.shape[-1] == 1:
+        return 0.0 + P[..., 0, 0]
+    if P.dtype == np.float64 and P.shape[-1] == 2:
+        return (0.0 + P[..., 0, 0]) + P[..., 1, 1]
+    return np.trace(P, axis1=-2, axis2=-1)
 
 
 def _sym_norm_2x2(P) -> np.ndarray:
