@@ -22,10 +22,14 @@ def _branch_channel(state, counts):
     """
     n_par = len(state)
     new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
-    old = np.concatenate([state, state])
     counts = np.concatenate([counts, counts])
-    idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
-    counts[np.arange(len(idx)), idx] += 1
+    # reception half: 1 -> 1 (column 0) or 0 -> 1 (column 2); loss half: 1 -> 0 (column 1) or 0 -> 0 (column 3).
+    # Column slices with boolean increments (integers: exact), not a fancy-indexed scatter (~15x faster)
+    lost = ~state
+    counts[:n_par, 0] += state
+    counts[:n_par, 2] += lost
+    counts[n_par:, 1] += state
+    counts[n_par:, 3] += lost
     return new_state, counts
 
 
