@@ -123,6 +123,7 @@ class LMICoefficients:
 
 def _affine_tensor(blocks, variables, parameters):
     """cvxpy's sparse tensor mapping (parameters, 1) to the stacked coefficients of ``blocks``."""
+    from .cvx import cp  # noqa: F401  (imports cvxpy without scipy.stats before its submodules)
     from cvxpy.cvxcore.python import canonInterface
     from cvxpy.lin_ops import lin_op
 
@@ -602,8 +603,9 @@ def _as_block(expr):
     A cvxpy constraint stands for its expression: ``PSD`` (``A >> B``) for ``A - B``,
     ``Inequality`` (``a <= b``) for ``b - a``.
     """
-    import cvxpy as cp
-    from cvxpy.constraints import PSD, Inequality
+    from .cvx import cp
+
+    PSD, Inequality = cp.constraints.PSD, cp.constraints.Inequality
 
     if isinstance(expr, PSD):
         expr = expr.args[0]
@@ -869,7 +871,7 @@ class CertifiedLMI:
         LMIError
             If the certifier was built without a problem.
         """
-        import cvxpy as cp
+        from .cvx import cp
 
         if self.problem is None:
             raise LMIError("CertifiedLMI.solve needs the problem= it was built with")

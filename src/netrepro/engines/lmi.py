@@ -12,8 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import cvxpy as cp
 import numpy as np
+
+from .cvx import cp
 
 __all__ = [
     "LMIOutcome",

@@ -104,3 +104,24 @@ def test_e19_gap_grid_batched_equals_the_scalar_calls():
         ref = a * a * ((1 - l1) * (1 - l2) * xs + l1 * (1 - l2) * post(xs, 1.0) + (1 - l1) * l2 * post(xs, 4.0)
                        + l1 * l2 * both) + 1.0 - xs
         assert np.allclose(batched, ref, rtol=1e-9, atol=1e-9 * xs)
+
+
+def test_exact_is_exact_mean_computed_once_per_argument_set():
+    """The evidence step's kept E(p_k): bit for bit a fresh exact_mean call (np.float64 and float arguments
+    alike), the same object on a repeat, read-only so that no reader can change what the next one gets."""
+    from netrepro.papers.intermittent.exact import exact_mean
+
+    sc = {"a": 1.5, "R1": 0.1, "R2": 0.5}
+    lam = float(np.float64(1.0 - 1.0 / 1.5**2) + 0.1)
+    evidence._exact_once.cache_clear()
+    for p0, horizon in ((10.0, 60), (0.0, 60), (15.0, 30)):
+        fresh = exact_mean(p0, sc["a"], sc["R1"], [sc["R2"]], [lam], horizon)
+        kept = evidence._exact(np.float64(p0), sc, np.float64(lam), horizon)
+        assert kept is evidence._exact(p0, sc, lam, np.int64(horizon))
+        for name in ("mean", "rel_error_bound", "mu", "mu_error_bound"):
+            assert np.array_equal(getattr(kept, name), getattr(fresh, name))
+            assert getattr(kept, name).tobytes() == getattr(fresh, name).tobytes()
+            with pytest.raises(ValueError, match="read-only"):
+                getattr(kept, name)[0] = 1.0
+        assert (kept.rho, kept.degree) == (fresh.rho, fresh.degree)
+    assert evidence._exact_once.cache_info().misses == 3

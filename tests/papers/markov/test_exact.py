@@ -82,3 +82,22 @@ def test_transition_groups_equal_np_unique():
         uniq, first, inv = np.unique(_transition_key(counts, d), return_index=True, return_inverse=True)
         group_counts, got_inv = _transition_groups(counts, d)
         assert np.array_equal(group_counts, counts[first]) and np.array_equal(got_inv, inv.ravel())
+
+
+def test_branch_channel_counts_every_paths_transitions():
+    """_branch_channel against the paths themselves: after d - 1 branchings (reception half first), path j's
+    channel states are gamma_1 = 1 and the bits of j from the least significant (the latest branching is the most
+    significant bit; 1 = lost), and its counts
+    are the transitions 11, 10, 01, 00 along them, counted here one path at a time."""
+    from netrepro.papers.markov.exact import _branch_channel
+
+    state, counts = np.ones(1, dtype=bool), np.zeros((1, 4), dtype=np.int16)
+    for d in range(2, 11):
+        state, counts = _branch_channel(state, counts)
+        assert counts.dtype == np.int16 and state.dtype == bool
+        for j in range(len(state)):
+            gammas = [1] + [1 - int(b) for b in reversed(format(j, f"0{d - 1}b"))]
+            want = np.zeros(4, dtype=int)
+            for a, b in zip(gammas[:-1], gammas[1:]):
+                want[{(1, 1): 0, (1, 0): 1, (0, 1): 2, (0, 0): 3}[(a, b)]] += 1
+            assert np.array_equal(counts[j], want) and state[j] == bool(gammas[-1])

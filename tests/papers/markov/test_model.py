@@ -89,6 +89,91 @@ def test_sym_norm_3x3_closed_form_matches_lapack():
     assert np.isinf(model.sym_norm(np.full((1, 3, 3), np.inf))).all()
 
 
+def _sym_norm_2x2_masked(P):
+    """The masked form the 2 x 2 path of sym_norm replaced (reference path): zero the matrices with a
+    non-finite entry, evaluate, then put inf there."""
+    P = np.asarray(P, dtype=float)
+    bad = ~np.isfinite(P).all(axis=(-1, -2))
+    Pf = np.where(bad[..., None, None], 0.0, P)
+    with np.errstate(over="ignore", invalid="ignore"):
+        a, b, d = Pf[..., 0, 0], 0.5 * (Pf[..., 0, 1] + Pf[..., 1, 0]), Pf[..., 1, 1]
+        val = 0.5 * (a + d) + np.sqrt(0.25 * (a - d) ** 2 + b * b)
+    return np.where(bad, np.inf, val)
+
+
+def _hard_2x2_cases():
+    rng = np.random.default_rng(12)
+    G = rng.standard_normal((3000, 2, 2)) * 10.0 ** rng.uniform(-150, 150, size=(3000, 1, 1))
+    P = [G @ np.swapaxes(G, 1, 2), rng.standard_normal((500, 2, 2))]  # PSD over 300 decades; non-symmetric
+    ties = np.array([[[1.0, 0.0], [0.0, 1.0]], [[2.5, 1e-300], [0.0, 2.5]], [[0.0, 0.0], [0.0, 0.0]],
+                     [[1.0, 1e-17], [1e-17, 1.0 + 2e-16]], [[5e-324, 0.0], [0.0, 5e-324]]])
+    big = np.array([[[1e308, 0.0], [0.0, 1e308]], [[1.7e308, 1e300], [1e300, 1.7e308]],  # a + d overflows
+                    [[1e308, 0.0], [0.0, -1e308]],                                      # a - d overflows
+                    [[-1.7e308, 1e308], [1e308, -1.7e308]],                             # -inf + inf: nan
+                    [[1.0, 1e200], [1e200, 1.0]]])                                      # b^2 overflows
+    nonfinite = []
+    for i in range(2):
+        for j in range(2):
+            for x in (np.inf, -np.inf, np.nan):
+                M = np.array([[3.0, 0.5], [0.5, 2.0]])
+                M[i, j] = x
+                nonfinite.append(M)
+    nonfinite += [np.array([[1.0, np.inf], [-np.inf, 1.0]]), np.full((2, 2), np.inf), np.full((2, 2), -np.inf),
+                  np.array([[np.inf, 0.0], [0.0, -np.inf]]), np.array([[1e308, np.inf], [np.inf, 1e308]])]
+    return np.concatenate(P + [ties, big, np.array(nonfinite)])
+
+
+def test_sym_norm_2x2_is_the_masked_form_bit_for_bit():
+    P = _hard_2x2_cases()
+    want = _sym_norm_2x2_masked(P)
+    with np.errstate(over="ignore"):
+        got = model.sym_norm(P)
+        assert got.tobytes() == want.tobytes()  # nan, inf and -0.0 included
+        # batch shapes: a leading grid, one matrix (0-d result), an empty batch, integer entries
+        m = len(P) // 5 * 5
+        assert model.sym_norm(P[:m].reshape(-1, 5, 2, 2)).tobytes() == want[:m].tobytes()
+        one = model.sym_norm(P[-1])
+        assert isinstance(one, np.ndarray) and one.shape == () and one.tobytes() == want[-1].tobytes()
+        assert model.sym_norm(P[:0]).shape == (0,)
+    assert model.sym_norm(np.array([[[2, 1], [1, 2]]])).tobytes() == np.array([3.0]).tobytes()
+    assert np.isnan(want).any() and np.isinf(want).any()  # the cases reach both non-finite outcomes
+    # and against LAPACK where the entries are finite and moderate (independent of both forms; the closed form
+    # loses b^2 to underflow below ~1e-154 and overflows above ~1e154, in both forms alike)
+    mag = np.abs(P).max(axis=(1, 2))
+    ok = np.isfinite(P).all(axis=(1, 2)) & (mag < 1e100) & (mag > 1e-100)
+    S = 0.5 * (P[ok] + np.swapaxes(P[ok], 1, 2))
+    assert np.allclose(got[ok], np.linalg.eigvalsh(S)[:, -1], rtol=1e-12, atol=1e-300)
+
+
+def test_sym_norm_2x2_only_masks_rows_with_a_non_finite_entry():
+    # the masking branch (a non-finite value) taken with and without a non-finite entry in the same batch
+    P = np.array([[[np.nan, 0.0], [0.0, 1.0]], [[1e308, 0.0], [0.0, 1e308]], [[2.0, 0.0], [0.0, 1.0]]])
+    with np.errstate(over="ignore"):
+        got = model.sym_norm(P)
+    assert got[0] == np.inf and got[1] == np.inf and got[2] == 2.0
+    assert np.isnan(model.sym_norm(np.array([[[-1.7e308, 1e308], [1e308, -1.7e308]]]))[0])  # finite entries: kept
+
+
+def test_batched_trace_is_np_trace_bit_for_bit():
+    rng = np.random.default_rng(13)
+    for n in (1, 2, 3):
+        P = rng.standard_normal((4000, n, n)) * 10.0 ** rng.uniform(-300, 300, size=(4000, 1, 1))
+        P[::7] = -0.0  # np.trace sums from 0.0: a diagonal of -0.0 gives 0.0
+        P[::11, 0, 0] = np.inf
+        P[::13, -1, -1] = -np.inf  # with ::11: inf - inf
+        P[::17, 0, 0] = np.nan
+        P[::19, 0, 0], P[::19, -1, -1] = 1e308, 1e308  # overflow
+        with np.errstate(over="ignore", invalid="ignore"):
+            want = np.trace(P, axis1=-2, axis2=-1)
+            got = model.batched_trace(P)
+            assert got.dtype == want.dtype and got.tobytes() == want.tobytes()
+            grid = P[:3990].reshape(10, 399, n, n)
+            assert model.batched_trace(grid).tobytes() == np.trace(grid, axis1=-2, axis2=-1).tobytes()
+        assert float(model.batched_trace(P[1])) == float(sum(P[1][i, i] for i in range(n)))  # one matrix
+    ints = np.arange(8).reshape(2, 2, 2)  # another dtype: np.trace itself (an integer result)
+    assert model.batched_trace(ints).dtype == ints.dtype and list(model.batched_trace(ints)) == [3, 11]
+
+
 def test_stationary_loss_rates():
     assert model.gilbert_elliott_stationary_loss(0.04, 0.65) == pytest.approx(0.0580, abs=5e-5)
     assert model.gilbert_elliott_stationary_loss(0.22004, 0.65) == pytest.approx(0.2529, abs=5e-5)

@@ -42,9 +42,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-import cvxpy as cp
 import numpy as np
 
+from ...engines.cvx import cp
 from ...engines.lmi import SOLVER
 from .model import Gains, GainschedError, System
 

@@ -384,9 +384,8 @@ class PlantLMI:
     """
 
     def __init__(self, sys: System, margin_cap: float = 0.1, bound: float = 100.0, multiplier: str = "scalar"):
-        import cvxpy as cp
-
         from ...engines.certify import CertifiedLMI
+        from ...engines.cvx import cp
         from .model import GainschedError
 
         if multiplier not in ("scalar", "diagonal"):
@@ -421,7 +420,7 @@ class PlantLMI:
         -------
         ndarray or cvxpy expression (n + nz, n + nz)
         """
-        import cvxpy as cp
+        from ...engines.cvx import cp
 
         s = self.sys
         A1 = s.A + s.B @ s.F1 @ s.Z

@@ -473,7 +473,7 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
         [SD, O((nn, nz)), O((nn, nn)), O((nn, nn)), -s2 * Lam],
     ]
     if use_cp:
-        import cvxpy as cp
+        from ...engines.cvx import cp
 
         return cp.bmat(rows)
     return np.block(rows)
@@ -549,9 +549,8 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
         ``verdict`` is the shared engine's certified decision on the gridded system
         (:mod:`netrepro.engines.certify`); ``solver_feasible`` is the solver's opinion (information).
     """
-    import cvxpy as cp
-
     from ...engines.certify import CertifiedLMI
+    from ...engines.cvx import cp
     from ...engines.lmi import SOLVER
 
     nn = 2 * sys.n

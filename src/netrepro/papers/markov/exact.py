@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from .model import LinearSystem, riccati_g, riccati_h, sym_norm
+from .model import LinearSystem, batched_trace, riccati_g, riccati_h, sym_norm
 
 __all__ = ["ExactMoments", "exact_moments", "BlockSplit", "example2_split", "exact_moments_split", "find_split", "exact_moments_auto"]
 
@@ -22,10 +22,14 @@ def _branch_channel(state, counts):
     """
     n_par = len(state)
     new_state = np.concatenate([np.ones(n_par, bool), np.zeros(n_par, bool)])
-    old = np.concatenate([state, state])
     counts = np.concatenate([counts, counts])
-    idx = np.where(old, np.where(new_state, 0, 1), np.where(new_state, 2, 3))
-    counts[np.arange(len(idx)), idx] += 1
+    # reception half: 1 -> 1 (column 0) or 0 -> 1 (column 2); loss half: 1 -> 0 (column 1) or 0 -> 0 (column 3).
+    # Column slices with boolean increments (integers: exact), not a fancy-indexed scatter (~15x faster)
+    lost = ~state
+    counts[:n_par, 0] += state
+    counts[:n_par, 2] += lost
+    counts[n_par:, 1] += state
+    counts[n_par:, 3] += lost
     return new_state, counts
 
 
@@ -158,7 +162,7 @@ def exact_moments(system: LinearSystem, Sigma0, depth: int) -> ExactMoments:
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         s_norm = np.bincount(inv, weights=sym_norm(P), minlength=len(group_counts))
-        s_tr = np.bincount(inv, weights=np.trace(P, axis1=-2, axis2=-1), minlength=len(group_counts))
+        s_tr = np.bincount(inv, weights=batched_trace(P), minlength=len(group_counts))
         coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))
     return ExactMoments(coef, float(sym_norm(P1[None])[0]), float(np.trace(P1)))
 
@@ -286,7 +290,7 @@ def exact_moments_split(system: LinearSystem, Sigma0, depth: int, split: BlockSp
             state, counts = _branch_channel(state, counts)
         group_counts, inv = _transition_groups(counts, d)
         norm = np.max(np.stack([sym_norm(P) if P.shape[-1] > 1 else P[:, 0, 0] for P in Ps]), axis=0)
-        tr = sum(np.trace(P, axis1=-2, axis2=-1) for P in Ps)
+        tr = sum(batched_trace(P) for P in Ps)
         s_norm = np.bincount(inv, weights=norm, minlength=len(group_counts))
         s_tr = np.bincount(inv, weights=tr, minlength=len(group_counts))
         coef.append(np.column_stack([group_counts.astype(float), s_norm, s_tr]))

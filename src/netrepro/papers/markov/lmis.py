@@ -26,9 +26,9 @@ CANDIDATE_STATUSES = ("optimal", "optimal_inaccurate")
 
 
 def _cp():
-    import cvxpy
+    from ...engines.cvx import cp
 
-    return cvxpy
+    return cp
 
 
 def _solver() -> str:
