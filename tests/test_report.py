@@ -119,3 +119,32 @@ def test_notebook_driver_and_relocate_do_not_import_pandas():
     code = "import sys, netrepro.report.cli; print('pandas' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "False"
+
+
+def test_source_pages_made_ahead_are_linked_not_remade(tmp_path, monkeypatch):
+    """report_sources writes the pages; the report links a page it finds and the checkout's file otherwise."""
+    from netrepro.report.site import Site, source_page, source_pages_step
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg/a.py").write_text("x = 1\n")
+    (tmp_path / "pkg/b.py").write_text("def f():\n    return 2\n")
+    (tmp_path / "pkg/c.py").write_text("y = 3\n")
+    pages = tmp_path / "files/source"
+    source_pages_step({}, {"sources": ["pkg/b.py", "pkg/a.py", "pkg/a.py"]}, {"pages": pages})
+    assert sorted(p.relative_to(pages).as_posix() for p in pages.rglob("*.html")) == ["pkg/a.py.html", "pkg/b.py.html"]
+    assert (pages / "pkg/a.py.html").read_text() == source_page("pkg/a.py", "x = 1\n")
+
+    (pages / "pkg/a.py.html").write_text("MADE AHEAD")
+    site = Site(tmp_path, tmp_path / "files", pages_made=True)
+    assert site.source_link("pkg/a.py", 3) == "files/source/pkg/a.py.html#L-3"
+    assert site.source_link("pkg/c.py") == "../pkg/c.py"  # no page made: the checkout's file
+    site.write()
+    assert (pages / "pkg/a.py.html").read_text() == "MADE AHEAD"  # not remade
+    assert not (pages / "pkg/c.py.html").exists()
+    assert (tmp_path / "files/data").is_dir() and (tmp_path / "files/workflow").is_dir()
+
+    fresh = Site(tmp_path, tmp_path / "other")  # without report_sources: the linked pages are made here
+    fresh.source_link("pkg/c.py")
+    fresh.write()
+    assert (tmp_path / "other/source/pkg/c.py.html").read_text() == source_page("pkg/c.py", "y = 3\n")

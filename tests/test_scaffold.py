@@ -358,7 +358,7 @@ def test_adding_a_paper_reruns_nothing_of_the_others(sixth):
     _, planned = sixth
     assert planned, "the new paper planned no jobs"
     # the report and the comparison with the recorded paper-scale run read every paper's claims
-    cross_paper = {"report", "scale_verdicts"}
+    cross_paper = {"report", "scale_verdicts", "report_sources"}  # report_sources: the new code's pages
     others = {rule for rule in planned if rule not in cross_paper and not rule.startswith(f"{SLUG}_")}
     assert not others, f"adding {SLUG} reruns rules of other papers: {sorted(others)}"
     assert {f"{SLUG}_fixed_point_curve", f"{SLUG}_evidence", f"{SLUG}_claims", f"{SLUG}_fig1",
@@ -415,7 +415,8 @@ def test_a_figure_edit_reruns_only_its_figure_notebook_and_report(sixth):
     work, _ = sixth
     path = work / "src/netrepro/papers" / SLUG / "figures.py"
     path.write_text(path.read_text().replace('lw=2', 'lw=2.5'))
-    assert set(_planned(work)) == {f"{SLUG}_fig1", f"{SLUG}_notebook", "report"}
+    # report_sources: the edited code's page in the report
+    assert set(_planned(work)) == {f"{SLUG}_fig1", f"{SLUG}_notebook", "report_sources", "report"}
 
 
 def test_a_title_fix_reruns_only_the_report(sixth):

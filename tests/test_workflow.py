@@ -95,6 +95,22 @@ def test_a_template_edit_reruns_only_the_report(built):
         os.utime(template, ns=(stat.st_atime_ns, stat.st_mtime_ns))
 
 
+def test_source_pages_are_made_ahead_of_the_report(built):
+    # the report's source pages come from report_sources (it highlights once per change of the code or of
+    # the source-page template, in parallel with the other jobs), not from the report itself
+    assert (built / "report/files/source/src/netrepro/runner.py.html").is_file()
+    template = built / "src/netrepro/report/templates/source.html"
+    original, stat = template.read_text(), template.stat()
+    template.write_text(original + "\n")
+    try:
+        assert jobs_planned(built, "report") == {"report_sources", "report"}
+    finally:
+        template.write_text(original)
+        os.utime(template, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+    forced = jobs_planned(built, "report", "--forcerun", "intermittent_fig1")
+    assert "report_sources" not in forced and {"intermittent_fig1", "report"} <= forced
+
+
 def test_n_chunks_does_not_trigger_rerun(built):
     cfg_path = built / "config/test.yaml"
     original = cfg_path.read_text()

@@ -72,9 +72,15 @@ def io_json(wildcards, input, output):
     return as_json({"inputs": dict(input.items()), "outputs": dict(output.items())})
 
 
+# Every source file a step runs (filled by code() as the rules are read): the report's source pages
+CODE_FILES = set()
+
+
 def code(func):
     """Source files the step ``func`` runs: its module's import closure in the package (derived)."""
-    return code_inputs(func, root="src")
+    files = code_inputs(func, root="src")
+    CODE_FILES.update(files)
+    return files
 
 
 def step(func="{params.func}"):

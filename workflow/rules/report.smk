@@ -36,6 +36,30 @@ rule scale_verdicts:
         step("netrepro.scale:scale_step")
 
 
+# The report's source pages (report/files/source/), highlighted ahead of the report, which did this last
+# (~2-3 CPU s in every build and figure rerun): every file of the steps' code (CODE_FILES, read when the
+# DAG is built, after all rules are defined); rerun when that code or the page template changes.
+rule report_sources:
+    input:
+        code=code("netrepro.report.site:source_pages_step"),
+        sources=lambda wildcards: sorted(CODE_FILES),
+        templates=[
+            f"src/netrepro/report/templates/{t}" for t in ("source.html", "source_lines.html")
+        ],
+    output:
+        pages=directory("report/files/source"),
+    log:
+        "logs/report_sources.log",
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json({}),
+        rule="report_sources",
+        io=io_json,
+    shell:
+        step("netrepro.report.site:source_pages_step")
+
+
 rule report:
     input:
         unpack(report_inputs),
@@ -45,16 +69,17 @@ rule report:
         # the markup and the style sheet are data, not code: a change of look reruns the report
         templates=sorted(str(p) for p in Path("src/netrepro/report/templates").glob("*.*")),
         scale=rules.scale_verdicts.output if SCALE_RECORDED else [],
+        source_pages=rules.report_sources.output.pages,
     output:
         html="report/index.html",
-        files=directory("report/files"),
+        files_data=directory("report/files/data"),
+        files_workflow=directory("report/files/workflow"),
         crate="report/ro-crate-metadata.json",
     log:
         "logs/report.log",
     conda:
         CONDA_ENV
-    # the report runs last: a second process highlights half of the source pages
-    threads: 2
+    threads: 1
     params:
         cfg=as_json(
             {

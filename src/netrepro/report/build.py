@@ -41,10 +41,13 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         ``machine``, ``benchmarks`` (path of an optional benchmark table), ``scale`` (the paths of
         the verdicts-by-scale tables and of the recorded paper-scale run, when one is recorded).
     inputs : dict
-        The rule's inputs (read through ``params``; listed so that Snakemake orders the jobs).
+        The rule's inputs (read through ``params``; listed so that Snakemake orders the jobs), and
+        ``source_pages``, the folder ``report/files/source`` of pages highlighted ahead by ``report_sources``
+        (optional: without it, the linked source files are highlighted here).
     outputs : dict
-        ``html``, and optionally ``files``, a folder receiving the linked source pages and
-        tables so that the report is self-contained, and ``crate``.
+        ``html``, and optionally ``files_data`` and ``files_workflow`` (``report/files/data`` and
+        ``report/files/workflow``: the copies of the tables and of the workflow files, so that the report is
+        self-contained), and ``crate``.
 
     Returns
     -------
@@ -54,9 +57,12 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     root = Path(".").resolve()
     order = [s for s in params.get("order", []) if s in params["papers"]]
     papers = {s: params["papers"][s] for s in order + sorted(set(params["papers"]) - set(order))}
-    files_dir = Path(outputs["files"]) if outputs.get("files") else None
+    # report/files/: the copies of tables and workflow files (files_data, files_workflow); report_sources
+    # writes the source pages beside them (files/source/, the input source_pages)
+    files_dir = Path(outputs["files_data"]).parent if outputs.get("files_data") else None
     # the rule's threads (exported by its shell command as OMP_NUM_THREADS) highlight the source pages
-    site = Site(root, files_dir, workers=int(os.environ.get("OMP_NUM_THREADS") or 1))
+    site = Site(root, files_dir, workers=int(os.environ.get("OMP_NUM_THREADS") or 1),
+                pages_made=bool(inputs.get("source_pages")))
     claims = {slug: read_csv(spec["claims"]) for slug, spec in papers.items()}
     score = scorecard({s: (f if f is not None else pd.DataFrame({"verdict": []})) for s, f in claims.items()},
                       errata={s: read_csv(spec["errata"]) for s, spec in papers.items() if spec.get("errata")},

@@ -5,6 +5,7 @@ of the workflow and configuration files, and one highlighted page per source fil
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -14,7 +15,7 @@ from ..provenance import sidecar_path
 from .markup import relocate_json, render
 from .panel import repo_relative
 
-__all__ = ["Site", "source_page", "source_pages"]
+__all__ = ["Site", "source_page", "source_pages", "source_pages_step"]
 
 
 class Site:
@@ -28,11 +29,16 @@ class Site:
         ``report/files``; ``None`` links to the checkout's own files instead.
     workers : int, default 1
         Processes that highlight the source pages.
+    pages_made : bool, default False
+        The source pages are already under ``out_dir/source/`` (rule ``report_sources``,
+        :func:`source_pages_step`): link those, and a file without a page to the checkout's copy; else
+        the pages of the linked files are highlighted by :meth:`write`.
     """
 
-    def __init__(self, root: Path, out_dir: Path | None, workers: int = 1):
+    def __init__(self, root: Path, out_dir: Path | None, workers: int = 1, pages_made: bool = False):
         self.root = root
         self.workers = workers
+        self.pages_made = pages_made
         self.out_dir = out_dir
         self.sources: set[str] = set()
         self.tables: set[str] = set()
@@ -42,6 +48,8 @@ class Site:
         """Link to the page of a source file (at line ``line``), registering the page."""
         rel = repo_relative(source_file)
         if self.out_dir is None or not (self.root / rel).is_file():
+            return f"../{rel}"
+        if self.pages_made and not (self.out_dir / "source" / f"{rel}.html").is_file():
             return f"../{rel}"
         self.sources.add(rel)
         return f"files/source/{rel}.html" + (f"#L-{int(line)}" if line else "")
@@ -57,7 +65,8 @@ class Site:
         """Copy the registered tables, workflow files and source pages under ``out_dir``."""
         if self.out_dir is None:
             return
-        self.out_dir.mkdir(parents=True, exist_ok=True)
+        for sub in ("data", "workflow"):  # the report rule's two folder outputs, even if empty
+            (self.out_dir / sub).mkdir(parents=True, exist_ok=True)
         for rel in sorted(self.tables):
             target = self.out_dir / "data" / rel
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -70,11 +79,46 @@ class Site:
             target = self.out_dir / rel
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copyfile(self.root / source, target)
+        if self.pages_made:
+            return
         rels = sorted(self.sources)
         for rel, page in zip(rels, source_pages(self.root, rels, self.workers)):
             target = self.out_dir / "source" / f"{rel}.html"
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(page)
+
+
+def source_pages_step(params: dict, inputs: dict, outputs: dict) -> dict:
+    """Pipeline step: the report's source pages, highlighted ahead of the report (rule ``report_sources``).
+
+    Highlighting the source files the report links takes ~2-3 CPU s; done by the report rule, it was part of
+    the last job of every build and of every rerun of a figure. This step writes the page of every file of the
+    workflow's code inputs (a superset of the linked ones) into ``report/files/source/``, once per change of
+    the code, in parallel with the other jobs; the report links the pages it finds there.
+
+    Parameters
+    ----------
+    params : dict
+        Unused (the files are the inputs).
+    inputs : dict
+        ``sources``: the source files (repository-relative), besides the step's own ``code``.
+    outputs : dict
+        ``pages``: the folder of pages, ``<pages>/<file>.html``.
+
+    Returns
+    -------
+    dict
+        The number of pages, for the provenance.
+    """
+    root = Path(".").resolve()
+    rels = sorted({str(p) for p in inputs["sources"]})
+    out = Path(outputs["pages"])
+    workers = int(os.environ.get("OMP_NUM_THREADS") or 1)
+    for rel, page in zip(rels, source_pages(root, rels, workers)):
+        target = out / f"{rel}.html"
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(page)
+    return {"provenance": {"pages": len(rels)}}
 
 
 def _source_pages_of(root: Path, rels: list[str]) -> list[str]:
