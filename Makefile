@@ -41,7 +41,10 @@ SHARDS ?=
 SMK = $(BIN)/snakemake report --profile workflow/profiles/$(PROFILE) $(if $(filter default,$(PROFILE)),-j$(JOBS)) \
 	$(if $(SHARDS),--config 'shards=$(SHARDS)') $(if $(CONFIG),--configfile config/config.yaml config/$(CONFIG).yaml)
 
+# Bytecode of the package compiled once: where PYTHONDONTWRITEBYTECODE is set (containers, CI), every job
+# would otherwise compile the modules it imports again (~0.05-0.1 CPU s per job); elsewhere a no-op.
 report: $(STAMP)
+	$(BIN)/python -m compileall -q src
 	$(SMK)
 	$(SMK) --report report/snakemake_report.html
 	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
