@@ -515,12 +515,19 @@ def fused_trace_bounds(Minv, lam):
     value, lower : ndarray, shape ``(...)``
         ``f(lam)`` and ``f(lam) - g``.
     """
+    _, value, grad, gap = _value_gradient_gap(Minv, lam)
+    return value, value - gap
+
+
+def _value_gradient_gap(Minv, lam):
+    """``A = sum_j lam_j M_j^{-1}``, ``f = tr A^{-1}``, its gradient and Frank-Wolfe gap at ``lam`` (eq (24));
+    shared by the certificate :func:`fused_trace_bounds` and the evader's brackets (:func:`_bracket_at`)."""
     A = np.einsum("...n,...nij->...ij", lam, Minv)
     Ai = inv2(A)
     value = Ai[..., 0, 0] + Ai[..., 1, 1]
     grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Minv)
     gap = np.einsum("...n,...n->...", grad, lam) - grad.min(-1)
-    return value, value - gap
+    return A, value, grad, gap
 
 
 SOLVERS = {"mirror": min_fused_trace, "pairwise": min_fused_trace_pairwise,
@@ -607,12 +614,8 @@ SUPPORT_ROUNDS = 3
 
 def _bracket_at(Mf, w):
     """``f(w)``, its Frank-Wolfe lower bound, the rounding scale and the gradient at weights ``w`` (eq (24))."""
-    A = np.einsum("...n,...nij->...ij", w, Mf)
+    A, value, grad, gap = _value_gradient_gap(Mf, w)
     tr, det = _trace_det(A)
-    Ai = inv2(A)
-    value = Ai[..., 0, 0] + Ai[..., 1, 1]
-    grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Mf)
-    gap = np.einsum("...n,...n->...", grad, w) - grad.min(-1)
     with np.errstate(divide="ignore", invalid="ignore"):
         scale = np.where((det > 0) & (value > 0), np.maximum(tr * tr / det, np.abs(grad).max(-1) / value), np.inf)
     return value, value - gap, scale, grad
