@@ -1,6 +1,7 @@
 """Shared fixtures. Tests never write into the repository's results/ or figures/."""
 
 import os
+import re
 
 # one BLAS thread per test worker: pytest -n 2 on 2 cores, small matrices (threads only add contention)
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -80,8 +81,19 @@ def run_snakemake(workdir, *args, config="config/test.yaml", check=True, timeout
     env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
     if check and proc.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+        raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"
+                             f"{failed_job_logs(workdir, proc.stdout + proc.stderr)}")
     return proc
+
+
+def failed_job_logs(workdir, console: str, tail: int = 3000) -> str:
+    """The end of every log file snakemake names for a failed job, so a CI failure shows its cause."""
+    names = []
+    for line in console.splitlines():
+        match = re.match(r"\s*log: (.+?) \(check log file", line)
+        names.extend(n for n in (match.group(1).split(", ") if match else []) if n not in names)
+    return "".join(f"\n--- end of {name} ---\n{(Path(workdir) / name).read_text(errors='replace')[-tail:]}"
+                   for name in names if (Path(workdir) / name).is_file())
 
 
 @pytest.fixture(scope="session")

@@ -1,6 +1,7 @@
 """A paper's notebook that fails or hangs stops its rule with the notebook's error (papermill's
 execution timeout): the build never hangs on a notebook."""
 
+import os
 import subprocess
 import sys
 import time
@@ -45,3 +46,29 @@ def test_the_default_notebook_imports_the_report_helpers(tmp_path):
     sources = [c.source for c in nbformat.read(str(path), as_version=4).cells]
     assert sources[0] == 'slug = "p"\nroot = "."'
     assert "from netrepro.report.notebooks import figure_captions, show_figures, show_table" in sources[1]
+
+
+def test_the_kernel_talks_over_private_unix_sockets_and_is_shut_down(tmp_path):
+    # TCP ports are picked by binding port 0 and releasing it, so two kernels started at once by
+    # different processes can take the same port and one dies ("Address already in use", seen in
+    # CI). The kernel must use IPC sockets in a folder of its own, removed afterwards.
+    notebook = _notebook(tmp_path / "transport.ipynb",
+                         "import os\nfrom ipykernel.kernelapp import IPKernelApp\n"
+                         "app = IPKernelApp.instance()\nprint(app.transport, app.ip, os.getpid())")
+    execute_notebook("x", notebook, tmp_path / "x.html", root=tmp_path, timeout=60)
+    printed = nbformat.read(str(tmp_path / "x.ipynb"), as_version=4).cells[-1].outputs[0]["text"].split()
+    transport, ip, pid = printed[0], printed[1], int(printed[2])
+    assert transport == "ipc"
+    assert "netrepro-kernel-" in ip and not os.path.exists(os.path.dirname(ip))
+    deadline = time.monotonic() + 10
+    while _alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _alive(pid)  # shut down by nbclient, not left to notice its parent's exit
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True

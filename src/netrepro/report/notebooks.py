@@ -13,6 +13,7 @@ import os
 import re
 import shlex
 import sys
+import tempfile
 from pathlib import Path
 
 from ..errors import NetreproError
@@ -191,23 +192,47 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
     Raises
     ------
     NotebookError
-        A cell raised, or ran longer than ``timeout``; no page is written.
+        A cell raised, or ran longer than ``timeout``, or the kernel did not start; no page is written.
     """
     import nbformat
-    import papermill
-    from nbclient.exceptions import CellTimeoutError, DeadKernelError
     from nbconvert import HTMLExporter
 
-    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
-    # path of the machine that built it (and any path a warning prints is made relative too).
     print("command:", shlex.join(getattr(sys, "orig_argv", sys.argv)), flush=True)
     root = Path(root).resolve()
     html_out = Path(html_out)
     executed = html_out.with_suffix(".ipynb")
+    with tempfile.TemporaryDirectory(prefix="netrepro-kernel-") as sockets:
+        _run_papermill(slug, notebook, executed, root, timeout, sockets)
+    exporter = HTMLExporter()
+    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
+    with atomic_path(html_out) as tmp:
+        tmp.write_text(relocate(strip_external_scripts(body), root))
+    os.chmod(html_out, 0o644)
+    return html_out
+
+
+def _run_papermill(slug: str, notebook, executed: Path, root: Path, timeout: float, sockets: str) -> None:
+    """Execute ``notebook`` into ``executed`` on a kernel whose channels are Unix sockets in ``sockets``.
+
+    Why not TCP: Jupyter picks a kernel's five TCP ports by binding port 0 and releasing it, so
+    kernels started at the same moment by other processes (the other notebook job, a test) can
+    take the same port. The kernel then dies at its bind and the client waits out its 60-s
+    start-up timeout ("Address already in use", seen in CI). Socket files in a private folder
+    cannot collide.
+    """
+    import papermill
+    from nbclient.exceptions import CellTimeoutError, DeadKernelError
+    from traitlets.config import Config
+
+    # configured, not passed as ``km=``: nbclient shuts down only a kernel manager it created
+    kernel = Config({"KernelManager": {"transport": "ipc", "ip": os.path.join(sockets, "kernel")}})
+
+    # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
+    # path of the machine that built it (and any path a warning prints is made relative too).
     try:
         papermill.execute_notebook(str(notebook), str(executed), parameters={"slug": slug, "root": "."},
                                    kernel_name="python3", cwd=str(root), progress_bar=False,
-                                   request_save_on_cell_execute=False, execution_timeout=timeout)
+                                   request_save_on_cell_execute=False, execution_timeout=timeout, config=kernel)
     except papermill.PapermillExecutionError as exc:
         raise NotebookError(f"notebook {notebook} (paper {slug}): cell {exc.exec_count} failed: "
                             f"{exc.ename}: {exc.evalue}") from None
@@ -216,9 +241,6 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
                             f"of {timeout:g} s and was stopped ({str(exc).splitlines()[0]})") from None
     except DeadKernelError as exc:
         raise NotebookError(f"notebook {notebook} (paper {slug}): the kernel died ({exc})") from None
-    exporter = HTMLExporter()
-    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
-    with atomic_path(html_out) as tmp:
-        tmp.write_text(relocate(strip_external_scripts(body), root))
-    os.chmod(html_out, 0o644)
-    return html_out
+    except RuntimeError as exc:  # nbclient's only signal that the kernel did not start
+        raise NotebookError(f"notebook {notebook} (paper {slug}): the kernel did not start ({exc}); "
+                            "its own error is printed above") from None
