@@ -1,5 +1,7 @@
 """Unit tests of the report generator's pure parts (no workflow run)."""
 
+import random
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -59,6 +61,24 @@ def test_relocate_leaves_long_words_without_interpreter_alone(tmp_path):
     blob = "data:image/png;base64," + "iVBOR/w0K+GgoA/" * 20000
     text = f"<img src=\"{blob}\"> ran /usr/bin/python3"
     assert relocate(text, tmp_path) == f"<img src=\"{blob}\"> ran python3"
+
+
+def _relocate_word_by_word(text, root):
+    """The reference: every whitespace/quote/bracket-delimited word holding /bin/python shortened."""
+    text = text.replace(f"{root}/", "").replace(str(root), ".")
+    interpreter = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
+    return re.sub(r"[^\s'\"<>]+", lambda w: interpreter.sub(r"\1", w.group(0)), text)
+
+
+def test_relocate_equals_the_word_by_word_rewrite_on_random_text(tmp_path):
+    # relocate visits only the words around each "/bin/python"; its word bounds must be the same
+    root = tmp_path.resolve()
+    pieces = ["/bin/python", "/bin/python3.11", "/usr", "/x/", "a", " ", "\n", "\t", "'", '"', "<", ">", ".", "~",
+              "-", "\u00a0", "\u2003", str(root), f"{root}/", "/", "python", "A" * 300]
+    rng = random.Random(20261127)
+    for _ in range(3000):
+        text = "".join(rng.choice(pieces) for _ in range(rng.randint(0, 60)))
+        assert relocate(text, root) == _relocate_word_by_word(text, root), repr(text)
 
 
 def test_source_pages_in_two_processes_equal_the_serial_pages():

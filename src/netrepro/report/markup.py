@@ -56,12 +56,6 @@ def strip_external_scripts(text: str) -> str:
 
 
 _PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
-_WORD = re.compile(r"[^\s'\"<>]+")
-
-
-def _short_interpreter(word: re.Match) -> str:
-    text = word.group(0)
-    return _PYTHON_PATH.sub(r"\1", text) if "/bin/python" in text else text
 
 
 def relocate(text: str, root: str | Path) -> str:
@@ -85,11 +79,33 @@ def relocate(text: str, root: str | Path) -> str:
 def _relocate_under(text: str, root: str) -> str:
     """:func:`relocate` with ``root`` already resolved."""
     text = text.replace(root + "/", "").replace(root, ".")
-    if "/bin/python" not in text:
-        return text
     # word by word: on a long word without spaces (a base64 image) the path pattern backtracks
-    # from every '/', quadratic in the word's length (seconds per notebook page)
-    return _WORD.sub(_short_interpreter, text)
+    # from every '/', quadratic in the word's length (seconds per notebook page). Only the words
+    # around an occurrence of "/bin/python" are visited (the whole 8 MB Snakemake report has
+    # ~400,000 words and a few hundred such occurrences).
+    parts, done = [], 0
+    hit = text.find("/bin/python")
+    while hit >= 0:
+        start, end = _word_start(text, hit), _WORD_END.search(text, hit).start()
+        parts += [text[done:start], _PYTHON_PATH.sub(r"\1", text[start:end])]
+        done = end
+        hit = text.find("/bin/python", end)
+    return "".join(parts) + text[done:] if parts else text
+
+
+_WORD_END = re.compile(r"[\s'\"<>]|\Z")
+_LAST_BREAK = re.compile(r".*[\s'\"<>]", re.S)
+
+
+def _word_start(text: str, pos: int, step: int = 256) -> int:
+    """Where the word (a run without whitespace, quotes or angle brackets) holding ``text[pos]`` begins."""
+    lo = pos
+    while lo > 0:
+        lo = max(0, lo - step)
+        last = _LAST_BREAK.match(text, lo, pos)
+        if last:
+            return last.end()
+    return 0
 
 
 def relocate_json(obj, root: str | Path):
