@@ -72,3 +72,14 @@ def _alive(pid):
     except ProcessLookupError:
         return False
     return True
+
+
+def test_the_kernel_sockets_move_to_tmp_when_tmpdir_is_too_long(tmp_path):
+    from netrepro.report.notebooks import SOCKET_PATH_MAX, _socket_parent
+
+    short = str(tmp_path)
+    assert _socket_parent(short) == short
+    deep = tmp_path / ("d" * 60) / ("e" * 60)
+    deep.mkdir(parents=True)
+    assert len(str(deep)) > SOCKET_PATH_MAX
+    assert _socket_parent(str(deep)) == "/tmp"  # Linux and macOS both have /tmp

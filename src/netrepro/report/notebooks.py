@@ -208,7 +208,7 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
 
     with ThreadPoolExecutor(max_workers=1) as pool:
         exporter = pool.submit(_html_exporter)
-        with tempfile.TemporaryDirectory(prefix="netrepro-kernel-") as sockets:
+        with tempfile.TemporaryDirectory(prefix="netrepro-kernel-", dir=_socket_parent()) as sockets:
             _run_papermill(slug, notebook, executed, root, timeout, sockets)
         exporter = exporter.result()
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
@@ -216,6 +216,27 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
         tmp.write_text(relocate(strip_external_scripts(body), root))
     os.chmod(html_out, 0o644)
     return html_out
+
+
+# A Unix socket's path must fit in sun_path: 108 bytes on Linux, 104 on macOS, including the final NUL.
+SOCKET_PATH_MAX = 103
+
+
+def _socket_parent(tmp: str | None = None) -> str | None:
+    """Where the kernel's socket folder goes: the temporary directory, or /tmp when the socket paths
+    under it would be too long for a Unix socket (a long ``TMPDIR``, as some clusters set).
+
+    Raises
+    ------
+    NotebookError
+        Neither folder gives short enough socket paths.
+    """
+    longest = os.path.join("netrepro-kernel-" + "x" * 8, "kernel-99")  # mkdtemp's 8 random characters
+    for parent in (tmp or tempfile.gettempdir(), "/tmp"):
+        if len(os.path.join(parent, longest).encode()) <= SOCKET_PATH_MAX and os.path.isdir(parent):
+            return parent
+    raise NotebookError(f"the kernel's Unix sockets would have paths longer than {SOCKET_PATH_MAX} bytes under "
+                        f"{tmp or tempfile.gettempdir()!r}, and /tmp is not usable: set TMPDIR to a shorter folder")
 
 
 def _html_exporter():
