@@ -84,3 +84,13 @@ def test_the_kernel_sockets_move_to_tmp_when_tmpdir_is_too_long(tmp_path):
     deep.mkdir(parents=True)
     assert len(str(deep)) > SOCKET_PATH_MAX
     assert _socket_parent(str(deep)) == "/tmp"  # Linux and macOS both have /tmp
+    # the bound itself: the longest socket is <parent>/netrepro-kernel-XXXXXXXX/kernel-NN
+    socket_tail = len("/netrepro-kernel-12345678/kernel-99")
+    with tempfile.TemporaryDirectory(dir="/tmp") as base:
+        fits = os.path.join(base, "p" * (SOCKET_PATH_MAX - socket_tail - len(base) - 1))
+        over = fits + "p"
+        os.makedirs(fits)
+        os.makedirs(over)
+        assert len(fits) + socket_tail == SOCKET_PATH_MAX
+        assert _socket_parent(fits) == fits
+        assert _socket_parent(over) == "/tmp"
