@@ -56,6 +56,9 @@ def strip_external_scripts(text: str) -> str:
 
 
 _PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
+# the bounds of a word (a run without whitespace, quotes or angle brackets) around a match
+_WORD_END = re.compile(r"[\s'\"<>]|\Z")
+_LAST_BREAK = re.compile(r".*[\s'\"<>]", re.S)
 
 
 def relocate(text: str, root: str | Path) -> str:
@@ -91,10 +94,6 @@ def _relocate_under(text: str, root: str) -> str:
         done = end
         hit = text.find("/bin/python", end)
     return "".join(parts) + text[done:] if parts else text
-
-
-_WORD_END = re.compile(r"[\s'\"<>]|\Z")
-_LAST_BREAK = re.compile(r".*[\s'\"<>]", re.S)
 
 
 def _word_start(text: str, pos: int, step: int = 256) -> int:

@@ -208,7 +208,7 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
 
     with ThreadPoolExecutor(max_workers=1) as pool:
         exporter = pool.submit(_html_exporter)
-        with tempfile.TemporaryDirectory(prefix="netrepro-kernel-", dir=_socket_parent()) as sockets:
+        with tempfile.TemporaryDirectory(prefix=SOCKET_FOLDER_PREFIX, dir=_socket_parent()) as sockets:
             _run_papermill(slug, notebook, executed, root, timeout, sockets)
         exporter = exporter.result()
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
@@ -220,9 +220,12 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
 
 # A Unix socket's path must fit in sun_path: 108 bytes on Linux, 104 on macOS, including the final NUL.
 SOCKET_PATH_MAX = 103
+# The kernel's sockets: <parent>/<prefix><8 random characters>/<name>-<channel number 1..5>.
+SOCKET_FOLDER_PREFIX = "netrepro-kernel-"
+SOCKET_NAME = "kernel"
 
 
-def _socket_parent(tmp: str | None = None) -> str | None:
+def _socket_parent(tmp: str | None = None) -> str:
     """Where the kernel's socket folder goes: the temporary directory, or /tmp when the socket paths
     under it would be too long for a Unix socket (a long ``TMPDIR``, as some clusters set).
 
@@ -231,7 +234,7 @@ def _socket_parent(tmp: str | None = None) -> str | None:
     NotebookError
         Neither folder gives short enough socket paths.
     """
-    longest = os.path.join("netrepro-kernel-" + "x" * 8, "kernel-99")  # mkdtemp's 8 random characters
+    longest = os.path.join(SOCKET_FOLDER_PREFIX + "x" * 8, SOCKET_NAME + "-99")  # a margin over channel 5
     for parent in (tmp or tempfile.gettempdir(), "/tmp"):
         if len(os.path.join(parent, longest).encode()) <= SOCKET_PATH_MAX and os.path.isdir(parent):
             return parent
@@ -263,7 +266,7 @@ def _run_papermill(slug: str, notebook, executed: Path, root: Path, timeout: flo
     from traitlets.config import Config
 
     # configured, not passed as ``km=``: nbclient shuts down only a kernel manager it created
-    kernel = Config({"KernelManager": {"transport": "ipc", "ip": os.path.join(sockets, "kernel")}})
+    kernel = Config({"KernelManager": {"transport": "ipc", "ip": os.path.join(sockets, SOCKET_NAME)}})
 
     # The kernel runs in ``root``, so the parameter cell says ``root = "."``: the page shows no
     # path of the machine that built it (and any path a warning prints is made relative too).
