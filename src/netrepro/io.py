@@ -15,29 +15,41 @@ import tempfile
 from pathlib import Path
 
 
-__all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml"]
+__all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml", "yaml_loader_class"]
 
 
-def _yaml_loader():
-    """libyaml's safe loader (PyYAML's when libyaml is missing) that reads YAML 1.2 floats such as ``1.0e12``.
+def yaml_loader_class(base=None):
+    """A safe loader class (libyaml's by default) that reads YAML 1.2 floats such as ``1.0e12``.
 
     YAML 1.1, which PyYAML implements, reads a float written without a dot or without a sign in
     its exponent (``1e-5``, ``1.0e12``) as text; YAML 1.2 and every other reader take it as a
-    number. Built once per process.
+    number. The default class is built once per process.
+
+    Parameters
+    ----------
+    base : type, optional
+        The loader to extend (default: ``yaml.CSafeLoader`` when PyYAML has libyaml, else
+        ``yaml.SafeLoader``).
+
+    Returns
+    -------
+    type
+        A subclass of ``base`` with the YAML 1.2 float resolver added.
     """
     import re
 
     import yaml
 
-    if _LOADER:
+    if base is None and _LOADER:
         return _LOADER[0]
-    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    loader = type("NetreproLoader", (base,), {})
+    parent = base or getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    loader = type("NetreproLoader", (parent,), {})
     loader.add_implicit_resolver(
         "tag:yaml.org,2002:float",
         re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
         list("-+0123456789."))
-    _LOADER.append(loader)
+    if base is None:
+        _LOADER.append(loader)
     return loader
 
 
@@ -64,7 +76,7 @@ def load_yaml(text: str):
     """
     import yaml
 
-    return yaml.load(text, Loader=_yaml_loader())  # noqa: S506 (a safe loader)
+    return yaml.load(text, Loader=yaml_loader_class())  # noqa: S506 (a safe loader)
 
 
 @contextlib.contextmanager
