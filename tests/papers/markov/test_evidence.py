@@ -129,6 +129,8 @@ def test_evidence_step_feeds_every_claim(markov_tables):
     assert claims.loc["exII_p0465_certified", "verdict"] == "erratum"
     assert claims.loc["exII_fig6_diverges", "robust"] == "yes"
     assert claims.loc["ref16_p004", "verdict"] == "not_checkable"
+    assert claims.loc["thm3_peak_implies_ms", "verdict"] == "reproduced"
+    assert "U = " in claims.loc["thm3_peak_implies_ms", "note"]
     errata = errata_table(data, ev).set_index("erratum_id")
     assert float(errata.loc["E10_prop2_signed_measure", "residual_printed"]) > 0
     assert float(errata.loc["E10_prop2_signed_measure", "residual_corrected"]) == 0
@@ -198,7 +200,8 @@ def test_claim_settings_reach_the_evidence_from_the_yaml(markov_cfg, markov_tabl
     at = evidence.claim_settings(claims, PKG / "findings.yaml")
     assert at["exI_loss_rate_004"]["at"] == {"p": 0.1, "q": 0.4}
     assert at["prop1_is_thm1_K0"]["at"] == {"q": 0.65}
-    inputs = {k: markov_tables[k] for k in ("checks", "tight", "curves", "iid", "map", "sensitivity", "moments")}
+    inputs = {k: markov_tables[k] for k in ("checks", "tight", "curves", "iid", "map", "sensitivity", "moments",
+                                            "holdout")}
     out = evidence.evidence_step(markov_cfg, dict(inputs, claims=claims, findings=PKG / "findings.yaml"), {})["table"]
     row = out[(out.quantity == "exI.loss_rate_p004") & (out.variant == "nominal")]
     assert float(row.value.iloc[0]) == pytest.approx(0.1 / (0.1 + 0.4), rel=1e-12)
