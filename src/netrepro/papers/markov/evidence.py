@@ -110,16 +110,20 @@ def _section52_rows(ex2, checks, tight, moments, growth_margins, growth_margin, 
     rows = [
         dict(quantity="exII.not_one_step_observable", value=bool(lo2 > 1),
              note=f"observability index l_o = {lo2} (Definition 2); |lambda_i| = {np.abs(np.linalg.eigvals(A2)).round(6)}"),
-        dict(quantity="exII.p_thm5_q05", value=lower, **bracket,
+        dict(quantity="exII.p_thm5_q05", value=0.5 * (lower + upper) if bracket["decided"] else lower,
+             uncertainty=0.5 * bracket["uncertainty"], decided=bracket["decided"],
              note=f"certified bisection bracket [{lower:.9f}, {upper:.9f}] at q = {q52:g} (lower end: "
                   f"{ck.loc['exII_q05_tight_lower', 'evidence']}; upper end: {ck.loc['exII_q05_tight_upper', 'evidence']}); "
                   f"closed form of the true critical value (1 - (|l|^2 (1-q))^2) / (|l|^4 q) = {analytic:.9f} lies "
                   f"{'inside' if lower <= analytic <= upper else 'OUTSIDE'} the bracket"),
     ]
     for t in tight[tight.check == "exII_q05"].itertuples():
+        # the certified bracket [p_lower, p_upper] holds p_underline: its midpoint, uncertain by its half-width
         width = float(t.p_upper - t.p_lower) if np.isfinite(t.p_upper) else np.inf
-        rows.append(dict(quantity="exII.p_thm5_q05", variant=f"checks.tight_tol={t.tol:g}", value=float(t.p_lower),
-                         uncertainty=width, decided=bool(t.certified and np.isfinite(width))))
+        done = bool(t.certified and np.isfinite(width))
+        rows.append(dict(quantity="exII.p_thm5_q05", variant=f"checks.tight_tol={t.tol:g}",
+                         value=float(t.p_lower + 0.5 * width) if done else float(t.p_lower),
+                         uncertainty=0.5 * width, decided=done))
     r = ck.loc["exII_thm5_p0465"]
     rows.append(dict(quantity="exII.p0465_certified", value=bool(r.verdict == "feasible"),
                      decided=bool(r.verdict != "undecided"),
