@@ -71,7 +71,9 @@ Tables (``results/markov/``)
     asym_lo, asym_hi, inside``.
 
 Every step that solves LMIs fails, naming itself and the solver statuses, when none of its LMI questions was
-decided by a certificate (:func:`_require_decisions`): a table of undecided answers only would be no result.
+decided by a certificate (:func:`_require_decisions`): a table of undecided answers only would be no result. The
+runner stops such a step too, from the engine's count of certified verdicts; this check counts the paper's own
+final verdicts (a point the engine certifies feasible but whose gain has ``rho(H(K)) >= 1`` is undecided here).
 """
 
 from __future__ import annotations
