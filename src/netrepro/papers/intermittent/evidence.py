@@ -584,7 +584,10 @@ def evidence_step(params, inputs, outputs):
     rows.append({"quantity": "plain_band_coverage", "value": cover[lam_s],
                  "note": f"fraction of k = 1..{int(bounds['k'].max())} at which the nominal 95 % band of the plain "
                          f"Monte Carlo mean of p_k contains the exact E(p_k) (Fig. S1): {cover[lam_s]:.0%} at "
-                         f"lambda_c + 0.1, {cover[lam_u]:.0%} at lambda_c - 0.1 (p_k is heavy-tailed: heavy_tail.csv)"})
+                         f"lambda_c + 0.1, {cover[lam_u]:.0%} at lambda_c - 0.1 (p_k is heavy-tailed: heavy_tail.csv). A count on "
+                         f"this run's fixed-seed bands against the exact mean, exact as a count (uncertainty 0); it "
+                         f"is not offered as an estimate of a coverage probability (the bands at different k share "
+                         f"their paths, so no binomial interval applies), and no verdict is judged on it"})
     rows += _transient_rows(sc, lam_s, ev, close)
     rows.append({"quantity": "estimate_error_profile", "value": close["err"],
                  "note": f"largest signed error {close['err']:+.2%} at k = {close['k_err']}, limit "
