@@ -145,7 +145,7 @@ def test_evidence_values(tables):
     assert claims.loc["same_loss", "verdict"] == "conditional"
     assert "alpha -> 1" in claims.loc["same_loss", "condition"].split("; not for")[0]
     assert claims.loc["rho_s_gt_rho_f", "verdict"] == "reproduced"
-    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 7
+    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 8
     # the crossing: a local fit on the crossing SNRs, the former straight line and the bound beside it
     assert "local fit, crossing SNRs" in ev["rho_s_crossing"][NOMINAL][1]
 
