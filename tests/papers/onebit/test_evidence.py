@@ -87,7 +87,8 @@ def tables(cfg, tmp_path_factory):
         shards.append(tmp / f"shard{i}.npz")
         steps.estimator_shard_step(dict(c, shard=i, n_shards=2), {}, {"runs": shards[-1]})
     est = steps.estimator_step(c, {"shards": shards}, {})
-    for name, key in (("estimator", "table"), ("estimator_ratios", "ratios"), ("crossing", "crossing")):
+    for name, key in (("estimator", "table"), ("estimator_ratios", "ratios"), ("crossing", "crossing"),
+                      ("coverage", "coverage"), ("edge", "edge")):
         paths[name] = tmp / f"{name}.csv"
         est[key].to_csv(paths[name], index=False)
     root = ROOT / "src" / "netrepro" / "papers" / "onebit"

@@ -457,8 +457,15 @@ def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> li
     for a in sorted(crossing["alpha"].unique(), reverse=True):
         e = cr.loc[(a, "estimate")]
         bound = float(cr.loc[(a, "bound"), "snr_db_crossing"])
+        label = "nominal" if a == a_nom else variant_label("estimator", alpha_label(1.0 - a))
         if not np.isfinite(e["snr_db_crossing"]):
             parts.append(f"alpha = {a:g}: achievable: no sign change on the simulated SNRs; bound {bound:.2f} dB")
+            rows.append(dict(quantity="rho_s_crossing_far_below_bound", variant=label, value=False, decided=False,
+                             note="no achievable crossing on the simulated SNRs" if a == a_nom else ""))
+            if a == a_nom:
+                rows += [dict(quantity=q, value=np.nan, uncertainty=np.nan, decided=False)
+                         for q in ("rho_s_crossing", "rho_s_crossing_gap")]
+                rows.append(dict(quantity="rho_s_crossing_bound", value=round(bound, 4), uncertainty=0.0))
             continue
         est, lo, hi = (float(cr.loc[(a, c), "snr_db_crossing"]) for c in ("estimate", "lo", "hi"))
         u = _half_width(est, lo, hi)
@@ -490,7 +497,6 @@ def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> li
         # the test: the achievable crossing lies below the bound's by more than the pre-set effect size;
         # decided only when the whole interval is on one side of the threshold
         gap_lo, gap_hi = bound - hi, bound - lo
-        label = "nominal" if a == a_nom else variant_label("estimator", alpha_label(1.0 - a))
         rows.append(dict(quantity="rho_s_crossing_far_below_bound", variant=label, value=bool(gap_lo > effect),
                          decided=bool(gap_lo > effect or gap_hi < effect),
                          note=f"bound minus achievable crossing {bound - est:.2f} dB [{gap_lo:.2f}, {gap_hi:.2f}] "

@@ -236,6 +236,8 @@ def figure_estimator_ratios(params, inputs, outputs):
         if lim is not None:
             near = lim[(lim["snr_db"] >= lo_x) & (lim["snr_db"] <= hi_x)]
             ins.plot(near["snr_db"], near["rho_s_achievable_db"], color="k", lw=1.0, ls="-.")
+        if len(rs):   # the data decide the range; the limit's plunge towards 3 dB leaves the inset
+            ins.set_ylim(min(rs["lo_db"].min(), 0.0) - 0.3, rs["hi_db"].max() + 0.3)
         ins.axhline(0.0, color="k", lw=0.6)
         ins.set_xlim(lo_x, hi_x)
         ins.tick_params(labelsize=6)
