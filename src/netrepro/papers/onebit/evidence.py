@@ -311,23 +311,25 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
         sub = rs_all[np.isclose(rs_all["alpha"], 1.0 - eps, rtol=0, atol=1e-15) & (rs_all["snr_db"] <= smax)]
         sub = sub.sort_values(["snr_db", "n_runs"])
         value = bool(len(sub) > 0 and (sub["lo_db"] > 0).all())
+        # decided: every interval above 0 (true), or one entirely below 0 (false); else some interval straddles 0
+        decided = bool(len(sub) > 0 and (value or (sub["hi_db"] < 0).any()))
         note = "; ".join(f"{r.snr_db:g} dB: {r.estimate_db:.2f} [{r.lo_db:.2f}, {r.hi_db:.2f}] (bound {r.bound_db:.2f}, "
                          f"n = {r.n_runs})" for r in sub.itertuples())
-        return value, note
+        return value, note, decided
 
     rows, outside = [], []
     for i, eps in enumerate(est["one_minus_alpha"]):
-        value, note = judged(float(eps), med_ends[0])
+        value, note, decided = judged(float(eps), med_ends[0])
         if i > 0 and not eps < eps_max:
             outside.append(f"{alpha_label(eps)} (outside 'alpha close to one', 1 - alpha >= {eps_max:.3g}): "
                            f"{'significant' if value else 'not significant'} at every SNR <= {med_ends[0]:g} dB; {note}")
             continue
-        rows.append(dict(quantity="achievable_rho_s_positive", value=value, note=note,
+        rows.append(dict(quantity="achievable_rho_s_positive", value=value, note=note, decided=decided,
                          variant="nominal" if i == 0 else variant_label("estimator", alpha_label(eps))))
     for smax in med_ends[1:]:
-        value, note = judged(eps0, smax)
+        value, note, decided = judged(eps0, smax)
         rows.append(dict(quantity="achievable_rho_s_positive", variant=f"medium_snr_regime={smax:g} dB", value=value,
-                         note=note))
+                         note=note, decided=decided))
     if outside:
         rows[0]["note"] += ". Not judged: " + " | ".join(outside)
     # the two halves of the runs at the nominal alpha: other seeds' blocks, half the sample size
@@ -346,7 +348,8 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
             continue
         label = variant_label("estimator", f"{alpha_label(eps0)}, runs {'first' if h == 0 else 'second'} half "
                                            f"(n = {res[0][4]})")
-        rows.append(dict(quantity="achievable_rho_s_positive", variant=label, value=all(r[2] > 0 for r in res)))
+        rows.append(dict(quantity="achievable_rho_s_positive", variant=label, value=all(r[2] > 0 for r in res),
+                         decided=all(r[2] > 0 for r in res) or any(r[3] < 0 for r in res)))
     return rows
 
 
@@ -374,9 +377,14 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
         g = g[g["snr_db"] >= lo_snr].sort_values("snr_db")
         lower = g["mse_lo"] / g["bound"]
         value = bool(len(g) > 1 and (lower > 1).all() and (np.diff(g["mse_over_bound"].to_numpy()) > 0).all())
+        # decided: each SNR's interval clear of the bound, and each step's change significant (independent cases)
+        ratio, half = g["mse_over_bound"].to_numpy(), ((g["mse_hi"] - g["mse"]) / g["bound"]).to_numpy()
+        clear = ((g["mse_lo"] / g["bound"] > 1) | (g["mse_hi"] / g["bound"] < 1)).all()
+        steps_sig = (np.abs(np.diff(ratio)) > np.hypot(half[1:], half[:-1])).all()
+        decided = bool(len(g) > 1 and clear and steps_sig)
         note = (f"1-bit smoother MSE/BCRB at {alpha_label(1.0 - alpha)}: " + ", ".join(
             f"{r.snr_db:g} dB: {r.mse_over_bound:.2f} (lower 95 % end {r.mse_lo / r.bound:.2f})" for r in g.itertuples()))
-        rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note,
+        rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note, decided=decided,
                          variant="nominal" if i == 0 else variant_label("alpha_to_1", alpha_label(1.0 - alpha))))
     # the break-even lag exists exactly where rho_S > 0 (so it is no separate claim), and how long it is
     merged = lag.merge(ratios[["alpha", "snr_db", "rho_s_db"]], on=["alpha", "snr_db"])
@@ -463,7 +471,7 @@ def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> li
             rows.append(dict(quantity="rho_s_crossing_far_below_bound", variant=label, value=False, decided=False,
                              note="no achievable crossing on the simulated SNRs" if a == a_nom else ""))
             if a == a_nom:
-                rows += [dict(quantity=q, value=np.nan, uncertainty=np.nan, decided=False)
+                rows += [dict(quantity=q, value=np.nan, uncertainty=math.inf, decided=False)
                          for q in ("rho_s_crossing", "rho_s_crossing_gap")]
                 rows.append(dict(quantity="rho_s_crossing_bound", value=round(bound, 4), uncertainty=0.0))
             continue
@@ -515,13 +523,13 @@ def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> li
                           "(quadrature, exact to 1e-8)"))
     ed = first.get(a_nom)
     rows.append(dict(quantity="rho_s_edge_bias_db", value=round(ed["bias"], 4) if ed else np.nan,
-                     uncertainty=round(ed["bias_u"], 4) if ed else np.nan, decided=ed is not None,
+                     uncertainty=round(ed["bias_u"], 4) if ed else math.inf, decided=ed is not None,
                      note=(f"{alpha_label(1.0 - a_nom)}, {ed['snr']:g} dB (the edge SNR nearest the crossing): rho_S on "
                            f"the standard record (5 time constants before and after the window) minus rho_S on a record "
                            f"{ed['extra']:g} time constants longer at each end, same {ed['n']} runs; 95 % paired "
                            "bootstrap half-width" if ed else "no edge case at the nominal alpha in this configuration")))
     rows.append(dict(quantity="rho_s_crossing_edge_shift_db", value=round(ed["shift"], 4) if ed else np.nan,
-                     uncertainty=round(ed["shift_u"], 4) if ed else np.nan, decided=ed is not None,
+                     uncertainty=round(ed["shift_u"], 4) if ed else math.inf, decided=ed is not None,
                      note="the edge bias over the fit's slope at the crossing: how far the 5-tau records move the "
                           "crossing (negative: too low)"))
     # at Fig 1's alpha, where simulated (config/paper-scale.yaml): context for the verdicts by scale
@@ -531,7 +539,7 @@ def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> li
     lo1, hi1 = ((float(cr.loc[(a_fig1, c), "snr_db_crossing"]) for c in ("lo", "hi")) if simulated else (np.nan, np.nan))
     rows.append(dict(quantity="rho_s_crossing_fig1_alpha",
                      value=round(float(fig1["snr_db_crossing"]), 4) if simulated else np.nan,
-                     uncertainty=round(_half_width(float(fig1["snr_db_crossing"]), lo1, hi1), 4) if simulated else np.nan,
+                     uncertainty=round(_half_width(float(fig1["snr_db_crossing"]), lo1, hi1), 4) if simulated else math.inf,
                      decided=bool(simulated),
                      note=(f"{alpha_label(1.0 - a_fig1)} (Fig 1): achievable {fig1['snr_db_crossing']:.2f} dB "
                            f"[{lo1:.2f}, {hi1:.2f}], bound {cr.loc[(a_fig1, 'bound'), 'snr_db_crossing']:.2f} dB"
@@ -559,7 +567,9 @@ def _limit_evidence(params, crossing: pd.DataFrame, est_ratios: pd.DataFrame) ->
                       "against adaptive quadrature to 1e-8); simulated crossings: " + ", ".join(
                           f"{alpha_label(1.0 - a)}: {v:.2f} dB" for a, v in zip(cr["alpha"], cr["snr_db_crossing"]))),
             dict(quantity="achievable_limit_snr_max_db", value=round(ACHIEVABLE_LIMIT_SNR_MAX_DB, 4), uncertainty=0.0,
-                 note="from Var[theta]/sigma_eta^2 = 2 on, E[F_q^(-1/2)] diverges: the limit is -inf dB")]
+                 note="from Var[theta]/sigma_eta^2 = 2 on, E[F_q^(-1/2)] diverges: the limit is -inf dB"),
+            dict(quantity="bound_limit_crossing_db", value=round(rho_s_zero_crossing_limit(), 4), uncertainty=0.0,
+                 note="the alpha -> 1 limit of the bound (49), 2 sqrt(sigma_eta^2 E[F_q]), crosses 0 dB here")]
     for x, lv, bv in zip(snrs, lim, blim):
         rows.append(dict(quantity=f"achievable_limit_db.{x:g}dB", value=round(float(lv), 4), uncertainty=0.0,
                          note=f"bound's limit 2 sqrt(sigma_eta^2 E[F_q]) there: {bv:.2f} dB"))
@@ -583,7 +593,7 @@ def _coverage_evidence(params, coverage: pd.DataFrame, est_mse: pd.DataFrame) ->
     if not len(coverage):
         return [dict(quantity="mse_standard_errors_valid", value=False, decided=False,
                      note="no case has enough runs for the replicates"),
-                dict(quantity="mse_interval_coverage", value=np.nan, uncertainty=np.nan, decided=False)]
+                dict(quantity="mse_interval_coverage", value=np.nan, uncertainty=math.inf, decided=False)]
     kinds = ("smoother_1bit", "filter_1bit", "kalman_filter", "rts_smoother")
     level = 0.05 / len(kinds)   # one-sided, Bonferroni over the estimators (each kind's replicates are independent)
     for i, eps in enumerate(est["one_minus_alpha"]):
