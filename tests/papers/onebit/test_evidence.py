@@ -135,9 +135,12 @@ def test_evidence_values(tables):
                 # a declared range (<key>: / <key>=) or the counterfactual a finding's cause names
                 assert label.split(":")[0].split("=")[0] in keys | {"cause"}, (q, label)
     causes = [(f.quantity, f.cause["variant"]) for f in load_paper_data("onebit").findings if f.cause]
-    assert causes
     for q, label in causes:  # the cause variant is a variant of the judged quantity
         assert label in ev[q], (q, label)
+    # the counterfactual of finite_alpha_low_snr (an observation since issue 37) stays in the evidence: without the
+    # mean reversion rho_SL stays near the -0.98 dB asymptote at -60 dB
+    cf = ev["finite_alpha_low_snr"]["cause: alpha = 1 in (24)/(27), same sigma_z^2, E[F_q]"][0]
+    assert cf == pytest.approx(-0.98, abs=0.01) and ev["finite_alpha_low_snr"][NOMINAL][0] > -0.5
     # the break-even lag exists exactly where rho_S > 0 (why it is no separate claim)
     assert ev["break_even_lag"][NOMINAL][0] is True
     # run halves: n = 20 of 40 runs each
@@ -152,11 +155,12 @@ def test_evidence_values(tables):
 
 
 def test_findings_are_judged_like_claims():
-    """Every finding has a rule, evidence quantities, depends_on naming reconstructions, and prior work (issue 27)."""
+    """Every judged finding has a rule (an observation none), every finding evidence quantities, depends_on naming
+    reconstructions, and prior work (issues 27 and 37)."""
     data = load_paper_data("onebit")
     keys = {r["key"] for r in data.reconstructions}
     for f in data.findings:
-        assert f.rule_reason, f.finding_id
+        assert bool(f.rule_reason) == (f.kind != "observation"), f.finding_id
         assert f.evidence_quantities and f.quantity in f.evidence_quantities, f.finding_id
         assert set(f.depends_on) <= keys, f.finding_id
         assert f.prior_work, f.finding_id
