@@ -162,7 +162,17 @@ def test_estimator_step_writes_coverage_and_edge_tables(cfg):
     out = steps.run_estimator(copy.deepcopy(cfg))
     cov, edge = out["coverage"], out["edge"]
     n_rep = cfg["estimator"]["n_replicates"]
-    assert set(cov["replicate"]) == set(range(n_rep)) and cov["covered"].dtype == bool
+    assert set(cov["replicate"]) == set(range(-1, n_rep)) and cov["covered"].dtype == bool
+    # the ratio band against its exact value: the Kalman filter's MSE over the RTS smoother's, per case
+    rat = cov[cov["kind"] == "ratio_db:kalman_filter/rts_smoother"]
+    mse_all = out["table"].set_index(["alpha", "snr_db", "kind", "case_set"])["bound"]
+    for r in rat.itertuples():
+        exact_db = 10 * np.log10(mse_all[(r.alpha, r.snr_db, "kalman_filter", r.case_set)]
+                                 / mse_all[(r.alpha, r.snr_db, "rts_smoother", r.case_set)])
+        assert r.reference == pytest.approx(exact_db, rel=1e-12) and r.replicate == -1
+    assert len(rat) == len(out["table"]) // 4
+    assert (out["ratios"]["se_rep_db"] > 0).all() and (out["ratios"]["se_boot_db"] > 0).all()
+    cov = cov[cov["replicate"] >= 0]
     exact = cov[cov["kind"].isin(["kalman_filter", "rts_smoother"])]
     assert (exact["reference_se"] == 0).all() and (cov[cov["kind"] == "smoother_1bit"]["reference_se"] > 0).all()
     # the Kalman reference is the finite-record bound of the MSE table

@@ -577,7 +577,7 @@ def _limit_evidence(params, crossing: pd.DataFrame, est_ratios: pd.DataFrame) ->
     return rows
 
 
-def _coverage_evidence(params, coverage: pd.DataFrame, est_mse: pd.DataFrame) -> list:
+def _coverage_evidence(params, coverage: pd.DataFrame, est_mse: pd.DataFrame, est_ratios: pd.DataFrame) -> list:
     """Whether the normal 95 % intervals of the MSEs cover: disjoint replicates against exact values (Kalman/RTS:
     the finite-record BCRB they attain) or against the other replicates (1-bit), per simulated alpha (issue 37).
 
@@ -627,6 +627,26 @@ def _coverage_evidence(params, coverage: pd.DataFrame, est_mse: pd.DataFrame) ->
                          note=f"{alpha_label(float(eps))}, {n_rep} disjoint replicates per case, one-sided binomial "
                               f"test at {level:g} per estimator, decided when rejected or when every Clopper-Pearson "
                               f"lower end >= {floor:g}: " + "; ".join(parts)))
+    # the ratios' paired bootstrap band: against an exact ratio (Kalman filter over RTS smoother), and, for the
+    # heavy-tailed rho_S, against the spread of the ratio over disjoint replicates
+    rat = coverage[coverage["kind"].astype(str).str.startswith("ratio_db:")]
+    if len(rat):
+        t = binomial_coverage(int(rat["covered"].sum()), len(rat))
+        rows.append(dict(quantity="ratio_band_exact_coverage", value=round(t["fraction"], 4),
+                         uncertainty=round(_half_width(t["fraction"], t["lo"], t["hi"]), 4),
+                         note=f"paired bootstrap 95 % intervals of the Kalman filter's MSE over the RTS smoother's (dB), "
+                              f"one per case, against the exact ratio of their finite-record bounds: {int(rat['covered'].sum())}"
+                              f" of {len(rat)} cover (Clopper-Pearson [{t['lo']:.3f}, {t['hi']:.3f}], p(under) = "
+                              f"{t['p_under']:.2g}); largest |z| = {rat['z'].abs().max():.2f}"))
+    if "se_rep_db" in est_ratios:
+        rs = est_ratios[(est_ratios["quantity"] == "rho_S") & (est_ratios["se_boot_db"] > 0)]
+        n_rep = int(est.get("n_replicates", 8))
+        pooled, df, b_lo, b_hi = pooled_se_ratio(rs["se_rep_db"] / rs["se_boot_db"], np.full(len(rs), n_rep))
+        rows.append(dict(quantity="rho_s_band_ratio", value=round(pooled, 4),
+                         uncertainty=round(max(pooled - b_lo, b_hi - pooled), 4),
+                         note=f"rho_S: standard error from {n_rep} disjoint replicates over that of the paired bootstrap, "
+                              f"pooled over {len(rs)} cases on {df} df: {pooled:.3f} (95 % chi-square band for a correct "
+                              f"bootstrap [{b_lo:.3f}, {b_hi:.3f}]; largest case {(rs['se_rep_db'] / rs['se_boot_db']).max():.2f})"))
     # context: the former batch-means check (seed blocks as replicates; same runs, so it shows independence only)
     one = est_mse[est_mse["kind"] == "smoother_1bit"]
     pooled, df, b_lo, b_hi = pooled_se_ratio(one["se_ratio"], one["n_blocks"])
@@ -796,7 +816,7 @@ def evidence_step(params, inputs, outputs):
     rows += _finding_rows(params, est_mse, pd.read_csv(inputs["lag"]), ratios)
     rows += _crossing_evidence(params, crossing, pd.read_csv(inputs["edge"]))
     rows += _limit_evidence(params, crossing, est_ratios)
-    rows += _coverage_evidence(params, pd.read_csv(inputs["coverage"]), est_mse)
+    rows += _coverage_evidence(params, pd.read_csv(inputs["coverage"]), est_mse, est_ratios)
     rows += errata_rows(params)
     rows += _reconstruction_rows(params)
     return {"table": evidence_frame(rows)}

@@ -558,7 +558,11 @@ def estimator_step(params, inputs, outputs):
     ``estimator.n_replicates`` disjoint replicates; per replicate and estimator the normal 95 %
     interval of the MSE against the exact value (Kalman/RTS: the finite-record BCRB, which they
     attain) or, for the 1-bit estimators, against the other replicates' mean
-    (:func:`.estimators.replicate_coverage`). ``estimator_edge.csv`` (issue 37): for the edge
+    (:func:`.estimators.replicate_coverage`); and, per case (``replicate = -1``), the paired bootstrap 95 %
+    interval of the Kalman filter's MSE over the RTS smoother's (dB) against its exact value, the ratio
+    of their finite-record bounds. ``estimator_ratios.csv`` also checks each ratio's bootstrap band against
+    the replicates: ``se_boot_db`` (interval width over 2 x 1.96) and ``se_rep_db`` (standard deviation of
+    the ratio over ``estimator.n_replicates`` disjoint replicates, over sqrt(replicates)). ``estimator_edge.csv`` (issue 37): for the edge
     cases, the bias of the 5-tau record edges: each MSE on the standard record over the MSE on
     the long record around it, and rho_S, rho_F, rho_SL on the standard minus the long record, in dB
     with paired bootstrap intervals (:func:`_edge_rows`).
@@ -622,15 +626,25 @@ def estimator_step(params, inputs, outputs):
                                  n_runs=len(v), steady_dev=dev[kind], **design_cols, case_set=case.case_set,
                                  **tails))
         bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
-        pairs = [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()]
+        # the three ratios, and the Kalman filter over the RTS smoother: both attain their bound, so that ratio is
+        # known exactly and checks the paired bootstrap band (adding the pair changes no other pair's numbers)
+        pairs = [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()] + [("kalman_filter", "rts_smoother")]
         intervals, reps = paired_ratio_intervals(runs, pairs, est["n_boot"], seed,  # one resampling per case,
                                                  replicates=True)                    # shared by the ratios
         for (qty, (ref, onebit, col)), (e, lo, hi) in zip(RATIO_DEFS.items(), intervals):
+            rep = _replicate_ratios_db(runs[ref], runs[onebit], n_rep)
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
                                    steady_dev=max(dev[ref], dev[onebit]), **design_cols, case_set=case.case_set,
-                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit]),
-                                   rep_db=_replicate_ratios_db(runs[ref], runs[onebit], n_rep)))
+                                   se_boot_db=(hi - lo) / (2.0 * z), se_rep_db=float(np.std(rep, ddof=1) / math.sqrt(n_rep)),
+                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit]), rep_db=rep))
+        e, lo, hi = intervals[-1]
+        exact_db = 10.0 * math.log10(bounds["kalman_filter"] / bounds["rts_smoother"])
+        se_b = (hi - lo) / (2.0 * z)
+        cov_rows.append(dict(alpha=1.0 - eps, snr_db=snr, kind="ratio_db:kalman_filter/rts_smoother",
+                             case_set=case.case_set, replicate=-1, reference_kind="exact (ratio of the finite-record BCRBs)",
+                             kurtosis=float("nan"), n=float(len(runs["kalman_filter"])), mean=e, se=se_b,
+                             reference=exact_db, reference_se=0.0, z=(e - exact_db) / se_b, covered=lo <= exact_db <= hi))
         # bootstrap replicates of the achievable rho_S for the crossing fit: bootstrap_ratio_db(runs[ref_s],
         # runs[onebit_s], n_boot, seed), the same numbers as the intervals' resampling (same seed), not redrawn
         boot[key] = reps[pairs.index((ref_s, onebit_s))]
