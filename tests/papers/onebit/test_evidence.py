@@ -164,3 +164,33 @@ def test_findings_are_judged_like_claims():
         assert f.evidence_quantities and f.quantity in f.evidence_quantities, f.finding_id
         assert set(f.depends_on) <= keys, f.finding_id
         assert f.prior_work, f.finding_id
+
+
+def _crossing_table(est, lo, hi, bound, alpha=0.999):
+    rows = [dict(alpha=alpha, curve=c, snr_db_crossing=v, method="local fit, crossing SNRs", fit_snr_lo=1.0,
+                 fit_snr_hi=2.5, n_points=7, n_runs=4000, n_boot=4000, fit_residual_rms=0.05,
+                 slope_db_per_db=-0.5 if c == "estimate" else np.nan)
+            for c, v in (("estimate", est), ("lo", lo), ("hi", hi))]
+    rows += [dict(alpha=alpha, curve="grid_linear", snr_db_crossing=est), dict(alpha=alpha, curve="bound",
+                                                                               snr_db_crossing=bound)]
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("est,lo,hi,bound,value,decided", [
+    (2.0, 1.8, 2.3, 7.0, True, True),      # gap [4.7, 5.2] > 3 dB: holds
+    (2.0, 1.8, 2.3, 5.0, False, False),    # gap [2.7, 3.2] straddles 3 dB: undecided
+    (2.0, 1.8, 2.3, 4.0, False, True),     # gap [1.7, 2.2] < 3 dB: fails, decided
+])
+def test_crossing_test_is_undecided_while_the_interval_straddles_the_effect_size(cfg, est, lo, hi, bound, value,
+                                                                                decided):
+    at = {"rho_s_crossing": {"one_minus_alpha": 1e-3, "effect_size_db": 3.0}}
+    edge = pd.DataFrame([dict(alpha=0.999, snr_db=2.0, quantity="edge_bias_db.rho_S", estimate=-0.1, lo=-0.2, hi=0.0,
+                              extra_taus=20.0, n_runs=100)])
+    rows = evidence._crossing_evidence(dict(cfg, _at=at), _crossing_table(est, lo, hi, bound), edge)
+    test = next(r for r in rows if r["quantity"] == "rho_s_crossing_far_below_bound")
+    assert (test["value"], test["decided"]) == (value, decided)
+    q = {r["quantity"]: r for r in rows}
+    assert q["rho_s_crossing"]["uncertainty"] == pytest.approx(0.3)       # the larger side of the interval
+    # the edge bias -0.1 dB on a slope of -0.5 dB/dB moves the crossing by -0.2 dB (+- 0.1 / 0.5)
+    assert q["rho_s_crossing_edge_shift_db"]["value"] == pytest.approx(-0.2)
+    assert q["rho_s_crossing_edge_shift_db"]["uncertainty"] == pytest.approx(0.2)
