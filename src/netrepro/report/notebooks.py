@@ -214,7 +214,6 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
     with atomic_path(html_out) as tmp:
         tmp.write_text(relocate(strip_external_scripts(body), root))
-    os.chmod(html_out, 0o644)
     return html_out
 
 
