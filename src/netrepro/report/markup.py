@@ -2,7 +2,8 @@
 
 * :func:`strip_external_scripts` drops everything a page would fetch from the network.
 * :func:`relocate` / :func:`relocate_json` rewrite absolute paths of the build machine.
-* :func:`render` fills a Jinja2 template of ``netrepro/report/templates/``.
+* :func:`render` fills a Jinja2 template of ``netrepro/report/templates/``; every page template
+  sets the report's content security policy (``{{ csp }}``, :data:`netrepro.report.csp.PAGE_POLICY`).
 """
 
 from __future__ import annotations
@@ -18,6 +19,9 @@ from typing import TYPE_CHECKING
 from jinja2 import Environment, FileSystemBytecodeCache, PackageLoader
 from jinja2.ext import Extension
 from markupsafe import Markup, escape
+
+from .captions import caption_html
+from .csp import policy_attribute
 
 if TYPE_CHECKING:  # pandas is imported where a table is read: the notebook driver and relocate never need it
     import pandas as pd
@@ -214,7 +218,10 @@ def short(sha) -> str:
 
 
 def rst_html(text: str) -> Markup:
-    """Render a caption written in reStructuredText (fallback: escaped paragraphs).
+    """Render a caption written in reStructuredText, inert (:func:`netrepro.report.captions.caption_html`).
+
+    Raw HTML and file insertion are off and links go only to http(s), mailto, ``#`` and relative
+    addresses: a caption can show text, never run a script or read a file.
 
     Parameters
     ----------
@@ -226,18 +233,7 @@ def rst_html(text: str) -> Markup:
     markupsafe.Markup
         Its HTML body (``""`` for an empty caption).
     """
-    text = text.strip()
-    if not text:
-        return Markup("")
-    try:
-        from docutils.core import publish_parts
-
-        body = publish_parts(text, writer_name="html5",
-                             settings_overrides={"report_level": 5, "halt_level": 5, "syntax_highlight": "none",
-                                                 "embed_stylesheet": False, "math_output": "HTML"})["body"]
-        return Markup(body)
-    except Exception:  # noqa: BLE001 - any docutils failure falls back to plain text
-        return Markup("").join(Markup("<p>{}</p>").format(p) for p in re.split(r"\n\s*\n", text))
+    return caption_html(text)
 
 
 def img(path: Path) -> Markup:
@@ -326,6 +322,7 @@ def _bytecode_cache():
 _ENV = Environment(loader=PackageLoader("netrepro.report", "templates"), autoescape=True,
                    extensions=[_JoinLines], finalize=_finalize, keep_trailing_newline=False,
                    bytecode_cache=_bytecode_cache())
+_ENV.globals["csp"] = policy_attribute()  # <meta http-equiv="Content-Security-Policy" content="{{ csp }}">
 _ENV.filters.update(num=num, value=fmt_value, short=short, rst=rst_html,
                     css=lambda text: re.sub(r"[^a-z]+", "-", str(text).lower()).strip("-"))
 
