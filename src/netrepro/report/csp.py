@@ -19,8 +19,10 @@ from __future__ import annotations
 import base64
 import functools
 import hashlib
+import importlib.util
 import json
 import re
+from pathlib import Path
 
 from markupsafe import Markup
 
@@ -189,26 +191,28 @@ def snakemake_known_scripts() -> frozenset[str]:
     """The texts of the scripts that the installed Snakemake's report template puts into its page.
 
     The template's fixed inline scripts, its components (``template/components/*.js``) and the
-    libraries it embeds (React, Vega, ...: Snakemake's report packages).
+    libraries it embeds (React, Vega, ..., the ``.js`` and ``.css`` files of Snakemake's assets: the
+    template puts Tailwind's ``tailwind.css`` into a script). Read from Snakemake's installed files
+    without importing it (``relocate`` is the last, serial step of ``make report``).
 
     Returns
     -------
     frozenset of str
         The scripts' texts (empty if Snakemake or its report assets are not installed).
     """
-    try:
-        from importlib.resources import files
-
-        from snakemake.report.html_reporter.data.packages import get_packages
-
-        template = files("snakemake.report.html_reporter") / "template"
-        page = (template / "index.html.jinja2").read_text()
-        texts = {text for _, text in inline_scripts(page) if "{{" not in text and "{%" not in text}
-        texts |= {p.read_text() for p in (template / "components").iterdir() if p.name.endswith(".js")}
-        for package in get_packages().packages.values():
-            texts |= {s for s in [getattr(package, "source", None), *getattr(package, "sources", {}).values()] if s}
-    except Exception:  # noqa: BLE001 - no Snakemake, no assets: no script is known, none is allowed
+    spec = importlib.util.find_spec("snakemake")
+    if spec is None or not spec.submodule_search_locations:
         return frozenset()
+    package = Path(next(iter(spec.submodule_search_locations)))
+    template = package / "report" / "html_reporter" / "template"
+    try:
+        page = (template / "index.html.jinja2").read_text(encoding="utf-8")
+    except OSError:
+        return frozenset()
+    texts = {text for _, text in inline_scripts(page) if "{{" not in text and "{%" not in text}
+    files = [*(template / "components").glob("*.js"), *(package / "assets" / "data").rglob("*.js"),
+             *(package / "assets" / "data").rglob("*.css")]
+    texts |= {path.read_text(encoding="utf-8") for path in files}
     return frozenset(texts)
 
 
