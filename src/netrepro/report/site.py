@@ -101,7 +101,6 @@ class Site:
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(page)
 
-
     def _confine_copies(self) -> None:
         """Refuse a copy whose source is outside the checkout or whose target is outside ``out_dir``."""
         pages = [] if self.pages_made else sorted(self.sources)
