@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from .csp import snakemake_report_policy, with_csp
-from .markup import relocate
+from .markup import relocate, with_empty_favicon
 from .notebooks import EXECUTION_TIMEOUT_S, NotebookError, execute_notebook, make_notebook
 
 __all__ = ["main", "relocate_page"]
@@ -28,11 +28,11 @@ def relocate_page(page: str, root: str | Path) -> str:
     Returns
     -------
     str
-        The page without paths of this checkout, with a policy that allows the scripts Snakemake
-        wrote and nothing else (:func:`netrepro.report.csp.snakemake_report_policy`; hashed after
-        relocating, which may change a script's text).
+        The page without paths of this checkout, asking for no favicon, with a policy that allows
+        the scripts Snakemake wrote and nothing else (:func:`netrepro.report.csp.snakemake_report_policy`;
+        hashed after relocating, which may change a script's text).
     """
-    page = relocate(page, root)
+    page = with_empty_favicon(relocate(page, root))
     return with_csp(page, snakemake_report_policy(page))
 
 

@@ -26,7 +26,7 @@ from .csp import policy_attribute
 if TYPE_CHECKING:  # pandas is imported where a table is read: the notebook driver and relocate never need it
     import pandas as pd
 
-__all__ = ["NO_FAVICON", "strip_external_scripts", "relocate", "relocate_json", "render", "read_csv",
+__all__ = ["NO_FAVICON", "strip_external_scripts", "with_empty_favicon", "relocate", "relocate_json", "render", "read_csv",
            "rst_html", "img", "num", "fmt_value", "short", "blank"]
 
 _EXTERNAL = re.compile(r"<script[^>]*\bsrc=\"https?://[^\"]*\"[^>]*>\s*</script>|<link[^>]*\bhref=\"https?://[^\"]*\"[^>]*>",
@@ -53,10 +53,29 @@ def strip_external_scripts(text: str) -> str:
     str
         The page without network requests, with an empty favicon.
     """
-    text = _EXTERNAL.sub("", text)
-    if 'rel="icon"' not in text:  # no favicon request: a static page makes no request it cannot satisfy
-        text = re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
+    text = with_empty_favicon(_EXTERNAL.sub("", text))
     return _INLINE_SCRIPT.sub(lambda m: "" if _REMOTE_IMPORT.search(m.group(1)) else m.group(0), text)
+
+
+def with_empty_favicon(text: str) -> str:
+    """A page that asks for no favicon (``<link rel="icon" href="data:,">``), unless it names one.
+
+    A browser asks a page's server for ``/favicon.ico`` otherwise: a static page makes no request it
+    cannot satisfy (over HTTP the request fails, and the console shows the error).
+
+    Parameters
+    ----------
+    text : str
+        An HTML page.
+
+    Returns
+    -------
+    str
+        The page, with :data:`NO_FAVICON` right after ``<head>`` if it had no icon.
+    """
+    if 'rel="icon"' in text:
+        return text
+    return re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
 
 
 _PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
