@@ -11,7 +11,8 @@ reading the files (nothing is imported or run), and names the file and line of e
   module in ``__all__`` has numpydoc sections (``Parameters`` when it takes arguments, ``Returns``
   or ``Yields`` when it returns a value);
 * ``claim-quantity``: every claim and finding names an evidence quantity that the evidence step
-  produces (the built ``results/evidence/<slug>.csv`` when present, else a string in ``evidence.py``);
+  produces (the built ``results/evidence/<slug>.csv`` when it is no older than the paper's code and
+  data files, else a string in ``evidence.py``);
 * ``findings-gate``: the data files load as the workflow loads them (schemas, cross-checks, every
   finding's rule registered in ``findings.lock`` or amended); with a current evidence table, no
   statement types a number that is one of its evidence values, and no numeric rule that agrees
@@ -237,10 +238,18 @@ def _line_of(text: str, needle: str) -> int:
     return text.count("\n", 0, pos) + 1 if pos >= 0 else 0
 
 
+def _current(built: Path, pkg: Path) -> bool:
+    """Whether a built table exists and is no older than the paper's code and data files (else it is stale)."""
+    if not built.is_file():
+        return False
+    sources = [p for p in pkg.iterdir() if p.suffix in (".py", ".yaml", ".lock")]
+    return all(built.stat().st_mtime >= p.stat().st_mtime for p in sources)
+
+
 def _evidence_quantities(slug: str, pkg: Path, root: Path):
     """(set of quantities, how they were found, a matcher for quantities built by f-strings)."""
     built = root / "results/evidence" / f"{slug}.csv"
-    if built.is_file():
+    if _current(built, pkg):
         with built.open(newline="") as handle:
             return {row["quantity"] for row in csv.DictReader(handle)}, [], "results/evidence"
     path = pkg / "evidence.py"
@@ -308,7 +317,7 @@ def _check_findings_gate(slug: str, pkg: Path, root: Path) -> list[Violation]:
     except NetreproError as exc:
         return [Violation(_rel(findings_path, root), 0, "findings-gate", str(exc).replace("\n", " "))]
     built = root / "results/evidence" / f"{slug}.csv"
-    if not built.is_file() or not findings_path.is_file() or built.stat().st_mtime < findings_path.stat().st_mtime:
+    if not findings_path.is_file() or not _current(built, pkg):
         return []
     evidence = read_evidence(built)
     text = findings_path.read_text()
