@@ -128,3 +128,14 @@ def test_scheduling_step_nests_the_families(cfg, sys, paper, tmp_path):
     et = out[out["comparison"] == "exact_tuned"].set_index("family")["value"]
     assert et["scheduled"] <= et["fixed_gain"]
     assert set(out.loc[out["comparison"] == "schedule_size", "family"]) == {"performance"}
+
+
+def test_a_step_with_every_decision_undecided_stops_naming_step_and_status():
+    from netrepro.papers.gainsched.model import GainschedError
+    from netrepro.papers.gainsched.steps import _no_decision
+
+    rows = [{"verdict": "undecided", "status": "user_limit"}, {"verdict": "undecided", "status": "optimal_inaccurate"}]
+    with pytest.raises(GainschedError, match=r"gainsched_scheduling: every decision .* user_limit"):
+        _no_decision(rows, "gainsched_scheduling", "the performance LMI")
+    _no_decision(rows + [{"verdict": "feasible", "status": "user_limit"}], "gainsched_scheduling", "x")  # one decided
+    _no_decision([], "gainsched_scheduling", "x")  # nothing to decide

@@ -146,8 +146,9 @@ def evidence_step(params, inputs, outputs):
 
     # ---- Theorem 3 feasible for the example: designs.csv at sigma2; certified threshold (feasibility_limit.csv)
     t3 = designs.loc["theorem3"]
-    t3_ok = t3["verdict"] == "feasible" and bool(thm1.loc["theorem3", "thm1_certified"]) \
-        and float(thm1.loc["theorem3", "thm3_cert_max_eig_grid"]) < 0
+    # the rule: a certified point of (24) whose rebuilt certificate passes the fine grid check of (12) (numpy only);
+    # the fresh Theorem 1 solve of theorem1.csv is information (a capped solver must not decide this claim)
+    t3_ok = t3["verdict"] == "feasible" and float(thm1.loc["theorem3", "thm3_cert_max_eig_grid"]) < 0
     other = _vertex_row(vt, "scheduled", "free", "zero", s2_nom)
     sl = limits.loc["scheduled"]
     add({"quantity": "thm3_feasible", "value": bool(t3_ok),
@@ -387,6 +388,25 @@ def _z22_tags(limits) -> list:
     return [d.split(" ", 1)[1] for d in limits.index if d.startswith("plant ") and "Z22=" in d]
 
 
+def _same_threshold(limits, designs, plant) -> tuple:
+    """Do the designs' certified sigma^2 thresholds sit at the plant's lattice point? ``(value, decided)``.
+
+    True when every design's certified feasible end is the plant's (the rule of F5); False when a design is
+    certified infeasible at or below a sigma^2 where the plant is certified feasible (its threshold is certainly
+    lower); otherwise undecided (a bracket not certified, or a lower feasible end that undecided lattice points,
+    e.g. of a capped solver, may explain).
+    """
+    rows = [limits.loc[d] for d in designs]
+    p = limits.loc[plant]
+    if not bool(p["certified"]) or not all(bool(r["certified"]) for r in rows):
+        return None, False
+    if all(r["sigma2_lo"] == p["sigma2_lo"] for r in rows):
+        return True, True
+    if any(float(r["sigma2_hi"]) <= float(p["sigma2_lo"]) for r in rows):
+        return False, True
+    return None, False
+
+
 def _lattice_spacing(limits) -> float:
     """Spacing of the certified sigma^2 bisection: the width of the scheduled design's certified bracket."""
     t3 = limits.loc["scheduled"]
@@ -451,11 +471,9 @@ def _finding_rows(exact, thm1, vt, limits, lim, sched_tab, at) -> list:
 
     # F5: feasibility decided by the plant (class (3))
     t3_ends = {d: lim[d][0] for d in ("scheduled", "fixed_gain", "zero")}
-    same = all(np.isclose(e, lim["plant"][0], rtol=0, atol=0) for e in t3_ends.values())
-    certified = bool(all(limits.loc[d, "certified"] for d in ("scheduled", "fixed_gain", "zero", "plant")))
+    f5, f5_decided = _same_threshold(limits, ("scheduled", "fixed_gain", "zero"), "plant")
     spacing = _lattice_spacing(limits)
-    add({"quantity": "feasibility_decided_by_plant", "value": bool(same) if certified else None,
-         "decided": certified,
+    add({"quantity": "feasibility_decided_by_plant", "value": f5, "decided": f5_decided,
          "note": "certified feasible ends of sigma2 (lattice spacing of the bisection below 1e-5): "
                  + ", ".join(f"{d} {e:.7g}" for d, e in t3_ends.items())
                  + f"; plant, scalar multiplier (class (3)) {lim['plant'][0]:.7g}; infeasible ends: "
@@ -465,10 +483,8 @@ def _finding_rows(exact, thm1, vt, limits, lim, sched_tab, at) -> list:
 
     # the same at the other readings of Z[1][1] (reconstruction Z22): the plant bracket and Theorem 3's end
     for z in _z22_tags(limits):
-        ok = bool(limits.loc[f"scheduled {z}", "certified"]) and bool(limits.loc[f"plant {z}", "certified"])
-        add({"quantity": "feasibility_decided_by_plant", "variant": z,
-             "value": bool(limits.loc[f"scheduled {z}", "sigma2_lo"] == limits.loc[f"plant {z}", "sigma2_lo"])
-             if ok else None, "decided": ok})
+        v5, d5 = _same_threshold(limits, (f"scheduled {z}",), f"plant {z}")
+        add({"quantity": "feasibility_decided_by_plant", "variant": z, "value": v5, "decided": d5})
 
     # F6: Theorem 3 against the plant's robust limit for class (3); its uncertainty: Theorem 3's own threshold lies
     # in its certified bracket, the necessary end in a bracket of width 1e-6 (half-widths relative to the end)
