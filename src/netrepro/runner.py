@@ -140,6 +140,15 @@ def _nonfinite(frame: pd.DataFrame) -> dict:
     return counts
 
 
+def _solver_statuses() -> dict:
+    """The solver statuses of this process's solves (:func:`netrepro.engines.cvx.solver_statuses`); {} if none.
+
+    Read only when the step imported the engine: a step without LMIs does not import cvxpy for this.
+    """
+    module = sys.modules.get("netrepro.engines.cvx")
+    return module.solver_statuses() if module is not None else {}
+
+
 def _summarize_warnings(caught) -> list[dict]:
     """Warnings raised by a step, one entry per distinct (category, message, place) with its count.
 
@@ -217,6 +226,15 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
                     item["count"])
     if summary:
         extra.setdefault("warnings", summary)
+    statuses = _solver_statuses()
+    if statuses:
+        extra.setdefault("solver_statuses", statuses)
+        unsure = {k: v for k, v in statuses.items() if k != "optimal"}
+        if unsure:
+            log.warning("rule %s: %d of %d solves did not end optimal (%s): their decisions rest on the "
+                        "certificates, and points the certificates cannot decide are undecided", rule,
+                        sum(unsure.values()), sum(statuses.values()),
+                        ", ".join(f"{k}: {v}" for k, v in unsure.items()))
     nonfinite = {}
     for name, value in result.items():
         if name not in outputs:
