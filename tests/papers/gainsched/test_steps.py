@@ -139,3 +139,14 @@ def test_a_step_with_every_decision_undecided_stops_naming_step_and_status():
         _no_decision(rows, "gainsched_scheduling", "the performance LMI")
     _no_decision(rows + [{"verdict": "feasible", "status": "user_limit"}], "gainsched_scheduling", "x")  # one decided
     _no_decision([], "gainsched_scheduling", "x")  # nothing to decide
+
+
+def test_design_step_without_a_certified_design_names_the_step_and_the_solver_status(cfg, monkeypatch):
+    """A one-iteration solver (the fault injection of the shared engine) leaves Theorem 3 undecided: the design
+    step stops at once, naming itself and the solver's status, instead of a later step missing the design."""
+    from netrepro.papers.gainsched.model import GainschedError
+    from netrepro.papers.gainsched.steps import design_step
+
+    monkeypatch.setenv("NETREPRO_SOLVER_MAX_ITER", "1")
+    with pytest.raises(GainschedError, match=r"gainsched_design: the theorem3 design .* undecided .*solver status user_limit"):
+        design_step(cfg, {}, {})
