@@ -297,3 +297,33 @@ def test_evidence_rows_carry_uncertainty_and_decided(tmp_path):
     path.write_text("quantity,variant,value,note\nx,nominal,2.5,\n")
     cell = read_evidence(path)["x"]["nominal"]
     assert (cell[0], cell.uncertainty, cell.decided) == (2.5, 0.0, True)
+
+
+# ----------------------------------------------------------------------------- the solver's faults, counted
+def test_solves_are_counted_capped_and_a_step_that_decides_nothing_stops(monkeypatch):
+    from netrepro.engines import cvx
+    from netrepro.engines.certify import CertifiedLMI
+    from netrepro.errors import LMIError
+    from netrepro.runner import _refuse_undecided_step
+
+    cp = cvx.cp
+    monkeypatch.setattr(cvx, "_STATUSES", __import__("collections").Counter())
+    monkeypatch.setattr(cvx, "_DECISIONS", __import__("collections").Counter())
+    # X > I, X < 3 I: feasible; a solver capped at one iteration cannot certify it
+    X = cp.Variable((2, 2), symmetric=True)
+    lmi = CertifiedLMI([("X - I", X - np.eye(2)), ("3I - X", 3 * np.eye(2) - X)],
+                       problem=cp.Problem(cp.Minimize(0), [X >> 1.5 * np.eye(2), X << 2.5 * np.eye(2)]))
+    assert cvx.solver_options() == {"solver": "CLARABEL"}
+    assert lmi.solve().verdict == "feasible"
+    monkeypatch.setenv(cvx.FAULT_MAX_ITER, "1")
+    assert cvx.solver_options()["max_iter"] == 1
+    capped = lmi.solve()
+    assert capped.verdict in ("feasible", "undecided")  # never a wrong "infeasible"
+    assert sum(cvx.solver_statuses().values()) == 2 and cvx.solver_statuses().get("optimal") == 1
+    _refuse_undecided_step("demo")  # one decided verdict: the step stands
+    monkeypatch.setattr(cvx, "_DECISIONS", __import__("collections").Counter({"undecided": 3}))
+    with pytest.raises(LMIError, match=r"rule demo: every one of its 3 certified decisions is undecided .*CLARABEL"):
+        _refuse_undecided_step("demo")
+    monkeypatch.setenv(cvx.FAULT_MAX_ITER, "zero")
+    with pytest.raises(ValueError, match="must be a positive integer"):
+        cvx.solver_options()

@@ -18,7 +18,13 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
-    from netrepro.paperdata import DATA_FILES, LOCK_FILE, load_paper_data, paper_dir, referenced_tables
+    from netrepro.paperdata import (
+        DATA_FILES,
+        LOCK_FILE,
+        load_paper_data,
+        paper_dir,
+        referenced_tables,
+    )
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "

@@ -797,6 +797,34 @@ class CertifiedLMI:
 
     def certify(self, solver_status: str = "", necessary: Callable[[], tuple] | None = None,
                 coeffs: LMICoefficients | None = None) -> Verdict:
+        """Decide the system at the current parameter values (:meth:`decide`), counted for the step.
+
+        Each verdict is counted (:func:`netrepro.engines.cvx.record_decision`): a step whose
+        certificates decide nothing fails at its end naming the solver's statuses, instead of
+        writing tables that a later step would find empty.
+
+        Parameters
+        ----------
+        solver_status : str
+            As :meth:`decide`.
+        necessary : callable, optional
+            As :meth:`decide`.
+        coeffs : LMICoefficients, optional
+            As :meth:`decide`.
+
+        Returns
+        -------
+        Verdict
+            The certified verdict.
+        """
+        from .cvx import record_decision
+
+        verdict = self.decide(solver_status, necessary, coeffs)
+        record_decision(verdict.verdict)
+        return verdict
+
+    def decide(self, solver_status: str = "", necessary: Callable[[], tuple] | None = None,
+               coeffs: LMICoefficients | None = None) -> Verdict:
         """Decide the system at the current parameter values from the current variable values.
 
         Order: (1) our eigenvalue check of the point (:func:`check_point`): ``feasible``;

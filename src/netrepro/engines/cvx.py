@@ -33,13 +33,15 @@ import sys
 import types
 
 __all__ = ["import_cvxpy", "cp", "SOLVER", "FAULT_MAX_ITER", "solver_options", "solve_problem", "record_status",
-           "solver_statuses", "clarabel_settings"]
+           "solver_statuses", "clarabel_settings", "record_decision", "certified_decisions"]
 
 SOLVER = "CLARABEL"
 # fault injection (tests only): caps the solver's iterations in every solve of the process
 FAULT_MAX_ITER = "NETREPRO_SOLVER_MAX_ITER"
 # statuses of the solves of this process (one step per process): read by the runner for the provenance
 _STATUSES: collections.Counter = collections.Counter()
+# verdicts of the certificates of this process (feasible / infeasible / undecided)
+_DECISIONS: collections.Counter = collections.Counter()
 
 _STATS = "scipy.stats"
 
@@ -191,3 +193,25 @@ def solver_statuses() -> dict:
         Sorted by status.
     """
     return dict(sorted(_STATUSES.items()))
+
+
+def record_decision(verdict: str) -> None:
+    """Count one certified verdict (``feasible``, ``infeasible`` or ``undecided``).
+
+    Parameters
+    ----------
+    verdict : str
+        The certificate's verdict.
+    """
+    _DECISIONS[str(verdict)] += 1
+
+
+def certified_decisions() -> dict:
+    """``{verdict: count}`` of the certificates of this process so far.
+
+    Returns
+    -------
+    dict
+        Sorted by verdict.
+    """
+    return dict(sorted(_DECISIONS.items()))
