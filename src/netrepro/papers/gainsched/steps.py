@@ -823,6 +823,18 @@ def scheduling_step(params, inputs, outputs):
                      "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
                      "status": f"certified bisection on the cost level ({und} undecided lattice points)",
                      "lambda": np.nan, "start": f"reference fixed_gain {ref:.9g}", "n_evaluations": n_eval})
+    # the zero filter's least guaranteed cost (min tr Q of x_f = 0) with the multiplier free, bracketed the same way
+    prob, sol, ref = solved[("free", "zero")]
+    if sol.values and np.isfinite(ref):
+        b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]), float(cfg["cost_resolution"]))
+        lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
+    else:
+        lower, upper, n_eval, und = np.nan, np.nan, 0, 0
+    for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
+        rows.append({"comparison": name, "family": "zero", "multiplier": "free", "value": value,
+                     "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
+                     "status": f"certified bisection on the cost level ({und} undecided lattice points)",
+                     "lambda": np.nan, "start": f"reference zero {ref:.9g}", "n_evaluations": n_eval})
     table = read_table(inputs["gains"])
     p_seq = p_sequence(params, sys)
     mid = 0.5 * (sys.F1 + sys.F2)
