@@ -187,7 +187,14 @@ def design_step(params, inputs, outputs):
     dict
         ``{"gains", "designs", "solutions": DataFrame, "provenance": {"solver_status": ...}}``;
         ``solutions`` holds every Theorem 3 variable entry by entry (problem, variable, row, col,
-        value), read back by :func:`load_solutions`.
+        value), read back by :func:`load_solutions`. Only designs whose point the shared engine
+        certifies get gains and solutions (the solver's status is information).
+
+    Raises
+    ------
+    GainschedError
+        When ``theorem3`` or ``performance`` (whose gains later steps use) has no certified point:
+        the message names the step, the design, the solver's status and the engine's evidence.
     """
     from .design import Theorem3, certified_cost, recover_gains, recover_output_gains
 
@@ -604,7 +611,10 @@ def sensitivity_step(params, inputs, outputs):
     ----------
     params : dict
         The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi`` and ``sensitivity``
-        (``sigma2_grid``, ``sigma2_zoom``, and the bisection bracket ``sigma2_lo``, ``sigma2_hi``, ``tol``) sections.
+        (``sigma2_grid``, ``sigma2_zoom``, the bisection bracket ``sigma2_lo``, ``sigma2_hi``, ``tol``, and
+        ``z22_readings``: the declared range of reconstruction Z22, at whose other readings the rows
+        ``plant Z22=<value>``, ``plant_necessary Z22=<value>`` and ``scheduled Z22=<value>`` are added;
+        column ``Z22`` gives every row's reading) sections.
     inputs : dict
         Only the step's code (no table is read).
     outputs : dict
@@ -759,8 +769,14 @@ def scheduling_step(params, inputs, outputs):
 
     * ``guaranteed_cost``: the certified cost gamma of the performance LMI (Theorem 3 plus the bound
       sum_k E||e(k)||^2 <= gamma, full slack, :class:`.design.Theorem3` ``output_slack``) for the
-      scheduled family, fixed gains (Gf = Hf = 0) and the zero filter (x_f = 0): the conservatism of
-      the LMI design itself; the verdict is the engine's check of the point;
+      scheduled family, fixed gains (Gf = Hf = 0) and the zero filter (x_f = 0), with the S-procedure
+      multiplier free (column ``multiplier``: ``free``, its value in ``lambda``) and fixed as printed
+      in (12) (``fixed``, the paper's rows): the conservatism of the LMI design itself; the verdict is
+      the engine's check of the point;
+    * ``guaranteed_cost_lower`` / ``guaranteed_cost_upper``: the certified bracket of the least
+      guaranteed cost (multiplier free) of the scheduled family, on a lattice around the fixed
+      family's certified cost (``scheduling.cost_span``, ``cost_resolution``), and of the zero filter
+      (:func:`.design.guaranteed_cost_bracket`): what scheduling can buy in the guarantee, at most;
     * ``exact_tuned``: the best gains found for the exact sum_k E||e(k)||^2 (f = (F1+F2)/2 z,
       x(0) ~ N(0, I), the configured p(k)) in each family (:func:`.tuning.best_exact_gains`, BFGS
       from the designs named in ``scheduling.starts``, or from x_f = 0 if none; the scheduled search
@@ -783,8 +799,13 @@ def scheduling_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame}`` with columns comparison, family, value, verdict, certified_slack,
-        status, start, n_evaluations.
+        ``{"table": DataFrame}`` with columns comparison, family, multiplier, value, verdict,
+        certified_slack, status, lambda, start, n_evaluations.
+
+    Raises
+    ------
+    GainschedError
+        When every guaranteed-cost solve is undecided (the message names the step and the statuses).
     """
     from .design import Theorem3, certified_cost, guaranteed_cost_bracket
     from .tuning import best_exact_gains
