@@ -109,7 +109,8 @@ def test_full_slack_performance_design_cost_is_certified_and_respected(sys):
     g = recover_output_gains(sol.values)
     # Theorem 1 with the performance term, rebuilt from the final gains and the transformed certificate
     c = output_certificate(sol.values)
-    worst, qmin, _ = theorem1_grid_check(sys, g, c["Q0"], c["Qp"], c["S"], n_fine=9, performance=True)
+    worst, qmin, _ = theorem1_grid_check(sys, g, c["Q0"], c["Qp"], c["S"], n_fine=9, performance=True,
+                                         multiplier=c["multiplier"])
     assert worst < 0 and qmin > 0
     sums = {}
     for name, gains in (("perf", g), ("zero", zero_gains(sys))):

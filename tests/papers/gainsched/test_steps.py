@@ -77,8 +77,19 @@ def test_sensitivity_step_brackets_both_classes(cfg, sys):
     out = sensitivity_step(params, {}, {})
     lim = out["limits"].set_index("design")
     assert set(lim.index) == {"plant", "plant_componentwise", "scheduled", "fixed_gain", "zero", "printed_gains",
-                              "plant_necessary", "plant_componentwise_necessary"}
+                              "plant_necessary", "plant_componentwise_necessary",
+                              "plant Z22=0.62", "plant_necessary Z22=0.62", "scheduled Z22=0.62"}
     assert lim["certified"].all()
+    # the other reading of Z22 (reconstruction range): a sound bracket there too, the necessary end from the
+    # closed-form limit of that system's worst gain
+    import dataclasses
+
+    Zz = sys.Z.copy()
+    Zz[1, 1] = 0.62
+    assert (lim["Z22"] == 0.62).sum() == 3
+    assert lim.loc["plant Z22=0.62", "sigma2_lo"] <= lim.loc["plant_necessary Z22=0.62", "sigma2_hi"]
+    assert lim.loc["plant_necessary Z22=0.62", "sigma2_hi"] == pytest.approx(
+        worst_sector_gain(dataclasses.replace(sys, Z=Zz))["value"], abs=2e-6)
     assert lim.loc["plant", "sigma2_lo"] <= lim.loc["plant_necessary", "sigma2_hi"]
     assert lim.loc["plant_necessary", "sigma2_hi"] < lim.loc["plant_componentwise_necessary", "sigma2_lo"]
     assert lim.loc["plant_componentwise", "sigma2_lo"] <= lim.loc["plant_componentwise_necessary", "sigma2_hi"]
@@ -99,11 +110,43 @@ def test_scheduling_step_nests_the_families(cfg, sys, paper, tmp_path):
     pd.concat([gains_table("paper", paper), gains_table("performance", zero_gains(sys))]).to_csv(tmp_path / "g.csv",
                                                                                                index=False)
     out = scheduling_step(cfg, {"gains": tmp_path / "g.csv"}, {})["table"]
-    gc = out[out["comparison"] == "guaranteed_cost"].set_index("family")
-    assert set(gc["verdict"]) == {"feasible"}
-    # nested families: x_f = 0 within fixed gains within scheduled gains, so the guaranteed costs are ordered
-    assert gc.loc["scheduled", "value"] <= gc.loc["fixed_gain", "value"] * (1 + 1e-6) <= gc.loc["zero", "value"] * (
-        1 + 1e-6)
+    gc_all = out[out["comparison"] == "guaranteed_cost"]
+    assert set(gc_all["verdict"]) == {"feasible"}
+    assert set(gc_all["multiplier"]) == {"free", "fixed"}
+    for mult, gc in gc_all.groupby("multiplier"):
+        gc = gc.set_index("family")
+        # nested families: x_f = 0 within fixed gains within scheduled gains, so the guaranteed costs are ordered
+        assert gc.loc["scheduled", "value"] <= gc.loc["fixed_gain", "value"] * (1 + 1e-6) <= gc.loc["zero", "value"] * (
+            1 + 1e-6), mult
+    free = gc_all[gc_all["multiplier"] == "free"].set_index("family")["value"]
+    fixed = gc_all[gc_all["multiplier"] == "fixed"].set_index("family")["value"]
+    assert (free <= fixed * (1 + 1e-6)).all()  # the fixed multiplier is one value of the free one
+    # the certified bracket of the scheduled family's least cost holds its certified point's cost
+    for family in ("scheduled", "zero"):
+        rows = out[out["family"] == family].set_index("comparison")["value"]
+        assert rows["guaranteed_cost_lower"] <= free[family] <= rows["guaranteed_cost_upper"] + 1e-12, family
     et = out[out["comparison"] == "exact_tuned"].set_index("family")["value"]
     assert et["scheduled"] <= et["fixed_gain"]
     assert set(out.loc[out["comparison"] == "schedule_size", "family"]) == {"performance"}
+
+
+def test_a_step_with_every_decision_undecided_stops_naming_step_and_status():
+    from netrepro.papers.gainsched.model import GainschedError
+    from netrepro.papers.gainsched.steps import _no_decision
+
+    rows = [{"verdict": "undecided", "status": "user_limit"}, {"verdict": "undecided", "status": "optimal_inaccurate"}]
+    with pytest.raises(GainschedError, match=r"gainsched_scheduling: every decision .* user_limit"):
+        _no_decision(rows, "gainsched_scheduling", "the performance LMI")
+    _no_decision(rows + [{"verdict": "feasible", "status": "user_limit"}], "gainsched_scheduling", "x")  # one decided
+    _no_decision([], "gainsched_scheduling", "x")  # nothing to decide
+
+
+def test_design_step_without_a_certified_design_names_the_step_and_the_solver_status(cfg, monkeypatch):
+    """A one-iteration solver (the fault injection of the shared engine) leaves Theorem 3 undecided: the design
+    step stops at once, naming itself and the solver's status, instead of a later step missing the design."""
+    from netrepro.papers.gainsched.model import GainschedError
+    from netrepro.papers.gainsched.steps import design_step
+
+    monkeypatch.setenv("NETREPRO_SOLVER_MAX_ITER", "1")
+    with pytest.raises(GainschedError, match=r"gainsched_design: the theorem3 design .* undecided .*solver status user_limit"):
+        design_step(cfg, {}, {})

@@ -48,6 +48,7 @@ from ...engines.cvx import cp, solve_problem
 from .model import Gains, GainschedError, System
 
 __all__ = ["Theorem3", "Theorem3Solution", "FixedGainsVertexLMI", "zero_diagonal_blocks", "recover_gains", "recover_output_gains", "certified_cost",
+           "guaranteed_cost_bracket",
            "output_certificate",
            "certificate_from_solution", "congruence_residual", "REALISATIONS"]
 
@@ -137,6 +138,16 @@ class Theorem3:
         Keep the last block row/column (Γ4, -σ²Λ) of (24). At σ² = 0 it is a zero
         block, so the strict LMI as printed is infeasible; ``False`` drops it
         (the correct noise-free condition).
+    multiplier : {"fixed", "free"} or None
+        The S-procedure multiplier λ of the sector term (5) in (15): the second block row of
+        (12) and (24) is [λ FZN, -2λ I]. ``"fixed"``: λ = 1, as printed (the -2I of (12));
+        ``"free"``: λ a scalar decision variable (``vars["lam"]``). The blocks stay linear
+        (λ multiplies constants), and a strictly negative -2λI forces λ > 0, so no sign
+        constraint is needed. For the feasibility problems the choice loses nothing: every
+        block is then homogeneous in (Q̄, S, Ḡ, H̄, λ), so a strict solution with any λ > 0 scales
+        to λ = 1. The performance bound's constant term breaks that homogeneity, so there a
+        fixed λ restricts the guaranteed cost. ``None`` (default): ``"free"`` for the
+        performance designs, ``"fixed"`` otherwise.
 
     Returns
     -------
@@ -152,7 +163,12 @@ class Theorem3:
     def __init__(self, sys: System, scheduled: bool = True, performance: bool = False, qp_positive: bool = True,
                  eps: float = 1e-6, bound: float = 1e3, X0=None, margin_cap: float = 0.1,
                  gamma3_top: str = "HC", noise_row: bool = True, zero_filter: bool = False,
-                 output_slack: bool = False, fixed_gains: Gains | None = None):
+                 output_slack: bool = False, fixed_gains: Gains | None = None, multiplier: str | None = None):
+        if multiplier is None:
+            multiplier = "free" if performance else "fixed"
+        if multiplier not in ("fixed", "free"):
+            raise GainschedError(f"multiplier must be 'fixed' or 'free', got {multiplier!r}")
+        self.multiplier = multiplier
         self.noise_row = noise_row
         self.fixed_gains = fixed_gains
         if fixed_gains is not None:
@@ -185,6 +201,8 @@ class Theorem3:
             v["Hf"] = cp.Variable((n, m), name="Hbarf")
         if self.output_slack:
             v["Lbar"] = cp.Variable((n, n), name="Lbar")
+        if multiplier == "free":
+            v["lam"] = cp.Variable(name="lambda")
         self.vars = v
         self.t = cp.Variable(name="t")
         ps = (sys.p1, sys.p2)
@@ -388,6 +406,21 @@ class Theorem3:
         s, v = self.sys, self.vars
         return cp.vstack([v["S11"].T @ s.B, v["R1"].T @ s.B])
 
+    def sector_blocks(self):
+        """The sector row of (12), (24): (λ FZN, -2λ I), λ = 1 (``multiplier="fixed"``) or a variable.
+
+        Returns
+        -------
+        tuple
+            ``(λ F Z N, -2 λ I)`` as arrays (fixed) or cvxpy expressions (free).
+        """
+        s = self.sys
+        FZN, m2I = s.F @ s.Z @ s.N, -2.0 * np.eye(s.nz)
+        if self.multiplier == "fixed":
+            return FZN, m2I
+        lam = self.vars["lam"]
+        return lam * FZN, lam * m2I
+
     def vertex(self, pi, pj, pr, pl):
         """The vertex matrix M^{ijrl} of (24) (lower triangle written, upper by transposition).
 
@@ -402,8 +435,8 @@ class Theorem3:
         s = self.sys
         nn, nz = 2 * s.n, s.nz
         theta = pj * (1.0 - pr)
-        FZN = s.F @ s.Z @ s.N
         part = self._part
+        FZN, m2I = part(("sector",), self.sector_blocks)
         G1 = part(("Gamma1", pi, pj), self.Gamma1, pi, pj)
         G3 = part(("Gamma3", pi, pj, pr), self.Gamma3, pi, pj, pr)
         Bh = part(("Bhat",), self.Bhat)
@@ -413,14 +446,14 @@ class Theorem3:
         if not self.noise_row:
             return cp.bmat([
                 [mQ, FZN.T, G1.T, G3.T],
-                [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn))],
+                [FZN, m2I, Bh.T, O((nz, nn))],
                 [G1, Bh, -Lam, O((nn, nn))],
                 [G3, O((nn, nz)), O((nn, nn)), -theta * Lam],
             ])
         G4 = part(("Gamma4",), self.Gamma4)
         return cp.bmat([
             [mQ, FZN.T, G1.T, G3.T, G4.T],
-            [FZN, -2 * np.eye(nz), Bh.T, O((nz, nn)), O((nz, nn))],
+            [FZN, m2I, Bh.T, O((nz, nn)), O((nz, nn))],
             [G1, Bh, -Lam, O((nn, nn)), O((nn, nn))],
             [G3, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
             [G4, O((nn, nz)), O((nn, nn)), O((nn, nn)), -self.sigma2 * Lam],
@@ -473,7 +506,8 @@ class Theorem3:
             values["Gf"] = np.zeros_like(values["G0"])
             values["Hf"] = np.zeros_like(values["H0"])
         ok_status = status == cp.OPTIMAL
-        has_values = status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) and values.get("R2") is not None
+        # the point is kept whatever the status: the shared engine decides it (the status is information only)
+        has_values = values.get("R2") is not None
         if self.performance:
             margin = self.margin_tol if has_values else np.nan
             objective = float(self.gamma.value) if self.gamma.value is not None else np.nan
@@ -647,6 +681,67 @@ def certified_cost(values: dict, X0, p1: float, p2: float) -> float:
     return max(float(np.trace((values["Q0"] + p * values["Qp"]) @ X0)) for p in (p1, p2))
 
 
+def guaranteed_cost_bracket(prob: Theorem3, values: dict, X0, reference: float, span: float = 1e-3,
+                            resolution: float = 1e-5):
+    r"""Certified bracket of the least guaranteed cost of a performance design (:class:`Theorem3`).
+
+    The strict system of the design (its vertices with the bound term, Q̄0, Q̄p > 0) plus
+
+    .. math:: c - \mathrm{tr}(\bar Q^l X_0) > 0,\qquad l = 1, 2,
+
+    is feasible iff the infimum of the guaranteed cost over the design's family is below c, so
+    its feasibility is monotone in c. The shared engine decides it at each c of a lattice of
+    ``[reference (1 - span), reference (1 + resolution)]`` with spacing ``reference * resolution``
+    (:func:`netrepro.engines.certify.bisect_certified`): feasible by the eigenvalue check of the
+    design's own point (``values``, no new solve), infeasible by a checked dual certificate.
+    The infeasible end is a certified lower bound of the infimum, the feasible end an upper bound.
+
+    Parameters
+    ----------
+    prob : Theorem3
+        A performance design (``performance=True``), solved or not.
+    values : dict
+        Its point (``Theorem3Solution.values``): variable name -> ndarray.
+    X0 : ndarray (2n, 2n)
+        E z̄(0) z̄(0)^T of the cost (as in the design).
+    reference : float
+        The cost the lattice is placed around (e.g. another family's certified cost), > 0.
+    span, resolution : float
+        Relative extent below ``reference`` and relative lattice spacing.
+
+    Returns
+    -------
+    netrepro.engines.certify.CertifiedBracket
+        ``infeasible_end`` (certified lower bound, nan if none) and ``feasible_end`` (certified
+        upper bound, nan if none) of the least guaranteed cost.
+
+    Raises
+    ------
+    GainschedError
+        If ``prob`` is not a performance design, or ``reference``, ``span`` or ``resolution`` is not positive.
+    """
+    from ...engines.certify import CertifiedLMI, bisect_certified
+
+    if not prob.performance:
+        raise GainschedError("guaranteed_cost_bracket needs a performance design (performance=True)")
+    if not (reference > 0 and span > 0 and resolution > 0):
+        raise GainschedError(f"guaranteed_cost_bracket: reference, span and resolution must be > 0, got "
+                             f"{reference}, {span}, {resolution}")
+    X0 = np.asarray(X0, dtype=float)
+    level = cp.Parameter(name="cost_level")
+    costs = cp.hstack([level - cp.trace(prob.Qbar(p) @ X0) for p in (prob.sys.p1, prob.sys.p2)])
+    cert = CertifiedLMI(list(prob._blocks) + [("cost", costs)])
+    for name, var in prob.vars.items():
+        var.value = None if values.get(name) is None else np.asarray(values[name], dtype=float).reshape(var.shape)
+
+    def decide(c):
+        level.value = float(c)
+        return cert.certify("point of the performance solve")
+
+    return bisect_certified(decide, reference * (1.0 - span), reference * (1.0 + resolution),
+                            tol=reference * resolution, feasible_above=True)
+
+
 def output_certificate(values: dict) -> dict:
     """Theorem 1 certificate (Q0, Qp, S) of the full-slack performance design in the coordinates of its form-(9) gains.
 
@@ -662,13 +757,16 @@ def output_certificate(values: dict) -> dict:
     Returns
     -------
     dict
-        ``Q0``, ``Qp``, ``S`` for (12) with the gains of :func:`recover_output_gains`.
+        ``Q0``, ``Qp``, ``S`` for (12) with the gains of :func:`recover_output_gains`, and
+        ``multiplier``: the S-procedure multiplier λ of the solution (1 when it was fixed).
     """
     _, extra = recover_gains(values, "identity_T")
     n = values["R2"].shape[0]
     Tp = np.eye(2 * n)
     Tp[n:, n:] = np.linalg.inv(np.asarray(values["Lbar"], dtype=float))
-    return {"Q0": Tp.T @ values["Q0"] @ Tp, "Qp": Tp.T @ values["Qp"] @ Tp, "S": Tp.T @ extra["S"] @ Tp}
+    lam = float(np.asarray(values["lam"]).ravel()[0]) if values.get("lam") is not None else 1.0
+    return {"Q0": Tp.T @ values["Q0"] @ Tp, "Qp": Tp.T @ values["Qp"] @ Tp, "S": Tp.T @ extra["S"] @ Tp,
+            "multiplier": lam}
 
 
 def certificate_from_solution(values: dict, realisation: str = "identity_T") -> dict:

@@ -175,8 +175,8 @@ def worst_sector_gain(sys: System, sigma2: float | None = None, n_grid: int = 72
     """The worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U in O(2), for the plant's mean-square stability.
 
     Every such K meets condition (3) (:func:`sector_gain`), so a K whose second-moment radius
-    reaches 1 shows that the plant is not mean-square stable for every f of the paper's class:
-    a necessary condition. O(2) is two circles (rotations and reflections by an angle); each is
+    reaches 1 shows that the plant is not mean-square stable for some f of the paper's class
+    (that linear one): a necessary condition. O(2) is two circles (rotations and reflections by an angle); each is
     searched on ``n_grid`` angles (the diagonal vertices U = diag(+-1) among them), then refined
     around the best angle by a bounded scalar minimisation. Any K found is valid; the search only
     decides how strong the condition is.
@@ -237,7 +237,7 @@ def sector_class_radius(sys: System, sigma2: float) -> float:
 
     The diagonal vertices of :func:`.model.sector_cases` (:func:`plant_vertex_radius`) and, for
     nz = 2, the worst K of :func:`worst_sector_gain` at this sigma^2. Every gain meets (3), so
-    a value >= 1 means the plant is not mean-square stable for every f of the class.
+    a value >= 1 means the plant is not mean-square stable for some f of the class.
 
     Parameters
     ----------
@@ -308,7 +308,7 @@ def plant_necessary_fails(sys: System, sigma2: float, sector: str = "condition3"
     Returns
     -------
     bool
-        ``radius >= 1 + RADIUS_MARGIN``.
+        ``radius >= 1 + RADIUS_MARGIN`` (the plant is not mean-square stable for some f of the class).
     """
     radius, _ = _radius_function(sector)
     return radius(sys, sigma2) >= 1.0 + RADIUS_MARGIN

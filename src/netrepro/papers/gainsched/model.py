@@ -415,7 +415,7 @@ def p_schedule(k, p1: float, p2: float, omega: float):
 
 
 # ----------------------------------------------------------------------------- Theorem 1
-def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
+def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float, multiplier: float = 1.0):
     """The matrix of Theorem 1 (12), evaluated numerically (or as a cvxpy expression).
 
     .. math::
@@ -444,6 +444,9 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
         The slack variable of (12).
     p : float
         p(k).
+    multiplier : float
+        The S-procedure multiplier λ > 0 of the sector term (5): the second block row is
+        [λ FZN, -2λ I]; 1 as printed in (12) (a free λ is used by the performance designs).
 
     Returns
     -------
@@ -463,11 +466,11 @@ def theorem1_matrix(sys: System, gains: Gains, Q_now, Q_next, S, p: float):
     Om2 = theta * (ST @ aug["C"] @ N)
     SB = ST @ aug["B"]
     SD = s2 * (ST @ aug["D"] @ N)
-    FZN = sys.F @ sys.Z @ N
+    FZN = float(multiplier) * (sys.F @ sys.Z @ N)
     O = np.zeros
     rows = [
         [-Q_now, T(FZN), T(Om1), T(Om2), T(SD)],
-        [FZN, -2 * np.eye(nz), T(SB), O((nz, nn)), O((nz, nn))],
+        [FZN, -2 * float(multiplier) * np.eye(nz), T(SB), O((nz, nn)), O((nz, nn))],
         [Om1, SB, -Lam, O((nn, nn)), O((nn, nn))],
         [Om2, O((nn, nz)), O((nn, nn)), -theta * Lam, O((nn, nn))],
         [SD, O((nn, nz)), O((nn, nn)), O((nn, nn)), -s2 * Lam],
@@ -594,7 +597,8 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     return Theorem1Result(status, margin, ok, Q0.value, Qp.value, S.value, len(grid) ** 2, v.verdict, v.evidence)
 
 
-def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, performance: bool = False):
+def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, performance: bool = False,
+                        multiplier: float = 1.0):
     r"""Largest eigenvalue of (12) and smallest of Q(p) over an ``n_fine`` x ``n_fine`` grid of (p(k), p(k+1)).
 
     An independent numerical check (no solver) of a Theorem 1 certificate.
@@ -613,6 +617,8 @@ def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, 
         Grid points per axis.
     performance : bool
         Add L^T L to the (1,1) block.
+    multiplier : float
+        The S-procedure multiplier λ of the certificate (:func:`theorem1_matrix`; 1 as in (12)).
 
     Returns
     -------
@@ -626,8 +632,8 @@ def theorem1_grid_check(sys: System, gains: Gains, Q0, Qp, S, n_fine: int = 41, 
         Q_now = Q0 + p * Qp
         qmin = min(qmin, float(np.linalg.eigvalsh(0.5 * (Q_now + Q_now.T)).min()))
         # (12) is affine in p(k+1) (through Q(p(k+1)) in Λ): build it at p+ = 0 and 1, then batch
-        M0 = theorem1_matrix(sys, gains, Q_now, Q0, S, p)
-        M1 = theorem1_matrix(sys, gains, Q_now, Q0 + Qp, S, p)
+        M0 = theorem1_matrix(sys, gains, Q_now, Q0, S, p, multiplier)
+        M1 = theorem1_matrix(sys, gains, Q_now, Q0 + Qp, S, p, multiplier)
         if performance:
             M0[: 2 * sys.n, : 2 * sys.n] += L.T @ L
             M1[: 2 * sys.n, : 2 * sys.n] += L.T @ L

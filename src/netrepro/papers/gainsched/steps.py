@@ -27,6 +27,7 @@ Designs compared (column ``design`` of the tables):
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -186,7 +187,14 @@ def design_step(params, inputs, outputs):
     dict
         ``{"gains", "designs", "solutions": DataFrame, "provenance": {"solver_status": ...}}``;
         ``solutions`` holds every Theorem 3 variable entry by entry (problem, variable, row, col,
-        value), read back by :func:`load_solutions`.
+        value), read back by :func:`load_solutions`. Only designs whose point the shared engine
+        certifies get gains and solutions (the solver's status is information).
+
+    Raises
+    ------
+    GainschedError
+        When ``theorem3`` or ``performance`` (whose gains later steps use) has no certified point:
+        the message names the step, the design, the solver's status and the engine's evidence.
     """
     from .design import Theorem3, certified_cost, recover_gains, recover_output_gains
 
@@ -216,16 +224,20 @@ def design_step(params, inputs, outputs):
         prob = Theorem3(sys, X0=X0 if opts["performance"] else None, **opts, **common)
         sol = prob.solve()
         solutions[name] = sol
-        for var, val in sol.values.items():
-            for (r, c), x in np.ndenumerate(np.atleast_2d(val)):
-                lmi_rows.append({"problem": name, "variable": var, "row": r, "col": c, "value": float(x)})
-        verdict, slack = _decide_point(prob, sol, sys)
-        if not sol.values:
+        verdict, slack, evidence = _decide_point(prob, sol, sys, with_evidence=True)
+        if verdict != "feasible":  # no certified point: no design (its gains would carry no guarantee)
+            if name in _NEEDED_DESIGNS:
+                raise GainschedError(
+                    f"gainsched_design: the {name} design of Theorem 3 is {verdict} at sigma2 = {sys.sigma2:g} "
+                    f"(solver status {sol.status}; engine: {evidence}): the steps that use its gains cannot run")
             rows.append({"design": name, "method": "Theorem 3", "status": sol.status, "margin": sol.margin,
                          "objective": sol.objective, "solver_feasible": False, "solve_time_s": sol.solve_time_s,
                          "n_scalar_variables": sol.n_scalar_variables, "realisation": "", "verdict": verdict,
                          "certified_slack": slack})
             continue
+        for var, val in sol.values.items():
+            for (r, c), x in np.ndenumerate(np.atleast_2d(val)):
+                lmi_rows.append({"problem": name, "variable": var, "row": r, "col": c, "value": float(x)})
         realisations = [("identity_T", name)]
         if name == "theorem3":
             realisations.append(("S21_identity", "theorem3_S21I"))
@@ -278,12 +290,41 @@ def design_step(params, inputs, outputs):
             "provenance": {"solver_status": {k: v.status for k, v in solutions.items()}}}
 
 
-def _decide_point(prob, sol, sys):
+# Theorem 3 designs whose gains later steps use (stability certificates, the exact tuning's start, evidence)
+_NEEDED_DESIGNS = ("theorem3", "performance")
+
+
+def _decide_point(prob, sol, sys, with_evidence=False):
     """Certified verdict of a solved Theorem 3 problem at the system's sigma^2 (no re-solve), by the shared engine."""
     from .feasibility import necessary_condition
 
     v = prob.certifier.certify(sol.status, necessary=necessary_condition(sys, sys.sigma2))
-    return v.verdict, (v.point.slack if v.point is not None else np.nan)
+    out = (v.verdict, (v.point.slack if v.point is not None else np.nan))
+    return out + (v.evidence,) if with_evidence else out
+
+
+def _no_decision(rows, step, what):
+    """Stop a step whose every LMI decision is undecided, naming the step and the solver statuses.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The step's rows so far, each with ``verdict`` and ``status``.
+    step : str
+        The rule's name (for the message).
+    what : str
+        What was decided (for the message).
+
+    Raises
+    ------
+    GainschedError
+        If there is at least one row and every ``verdict`` is ``undecided``.
+    """
+    verdicts = [r.get("verdict") for r in rows]
+    if verdicts and all(v == "undecided" for v in verdicts):
+        statuses = sorted({str(r.get("status")) for r in rows})
+        raise GainschedError(f"{step}: every decision of {what} is undecided (no certified point, no certificate of "
+                             f"infeasibility); solver statuses: {', '.join(statuses)}")
 
 
 def load_solutions(path) -> dict:
@@ -369,13 +410,14 @@ def stability_step(params, inputs, outputs):
         if "Lbar" in values:  # full-slack performance design: certificate in the coordinates of its gains
             c = output_certificate(values)
             cert[name] = theorem1_grid_check(sys, recover_output_gains(values), c["Q0"], c["Qp"], c["S"],
-                                             int(lmi["check_grid"]), performance=True)
+                                             int(lmi["check_grid"]), performance=True, multiplier=c["multiplier"])
             continue
+        lam = float(np.asarray(values["lam"]).ravel()[0]) if "lam" in values else 1.0
         for real, dname in reals:
             g, _ = recover_gains(values, real)
             c = certificate_from_solution(values, real)
             cert[dname] = theorem1_grid_check(sys, g, c["Q0"], c["Qp"], c["S"], int(lmi["check_grid"]),
-                                              performance=perf and real == "identity_T")
+                                              performance=perf and real == "identity_T", multiplier=lam)
     for d in designs:
         gains = gains_from_table(table, d, sys)
         for p in ps:
@@ -569,7 +611,10 @@ def sensitivity_step(params, inputs, outputs):
     ----------
     params : dict
         The ``gainsched`` configuration's ``system``, ``paper_gains``, ``lmi`` and ``sensitivity``
-        (``sigma2_grid``, ``sigma2_zoom``, and the bisection bracket ``sigma2_lo``, ``sigma2_hi``, ``tol``) sections.
+        (``sigma2_grid``, ``sigma2_zoom``, the bisection bracket ``sigma2_lo``, ``sigma2_hi``, ``tol``, and
+        ``z22_readings``: the declared range of reconstruction Z22, at whose other readings the rows
+        ``plant Z22=<value>``, ``plant_necessary Z22=<value>`` and ``scheduled Z22=<value>`` are added;
+        column ``Z22`` gives every row's reading) sections.
     inputs : dict
         Only the step's code (no table is read).
     outputs : dict
@@ -685,6 +730,34 @@ def sensitivity_step(params, inputs, outputs):
                                         "gain of the class (not mean-square stable for that f)",
                        "sector_class": "condition (3)" if sector == "condition3" else "componentwise sectors",
                        "role": "necessary"})
+    for row in limits:
+        row["Z22"] = float(base.Z[1, 1])
+    # the other readings of Z[1][1] (reconstruction Z22): the plant bracket for class (3) (scalar-multiplier LMI,
+    # worst linear gain) and Theorem 3's certified end, rows "<design> Z22=<value>"
+    for z22 in sorted({float(z) for z in sens.get("z22_readings", [])} - {float(base.Z[1, 1])}):
+        Zz = base.Z.copy()
+        Zz[1, 1] = z22
+        sysz = dataclasses.replace(base, Z=Zz)
+        tag = f" Z22={z22:g}"
+        below, above = necessary_limit(sysz, lo0, hi0, sector="condition3")
+        plant = PlantLMI(sysz, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]), multiplier="scalar")
+        prob = Theorem3(sysz, scheduled=True, **common)
+        top = above if np.isfinite(above) else hi0
+        for name, decide in (("plant", plant.certify), ("scheduled", lambda s2, prob=prob: prob.certify(s2)[0])):
+            b = bisect_certified(decide, lo0, top, tol=tol, feasible_above=False, guess=guesses.get("condition3"),
+                                 width=2 * tol)
+            ends = (b.feasible_end, b.infeasible_end)
+            between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
+            row = limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
+                            b.verdicts[b.infeasible_end].evidence if b.certified else "")
+            limits.append(dict(row, design=name + tag, Z22=z22))
+        limits.append({"design": "plant_necessary" + tag, "sigma2_max": np.nan, "sigma2_lo": below,
+                       "sigma2_hi": above, "certified": bool(np.isfinite(above)), "undecided_from": np.nan,
+                       "n_undecided": 0, "n_solves": 0,
+                       "method": f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal, with Z22 = {z22:g}",
+                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
+                                        "gain of the class (not mean-square stable for that f)",
+                       "sector_class": "condition (3)", "role": "necessary", "Z22": z22})
     return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
 
 
@@ -696,8 +769,14 @@ def scheduling_step(params, inputs, outputs):
 
     * ``guaranteed_cost``: the certified cost gamma of the performance LMI (Theorem 3 plus the bound
       sum_k E||e(k)||^2 <= gamma, full slack, :class:`.design.Theorem3` ``output_slack``) for the
-      scheduled family, fixed gains (Gf = Hf = 0) and the zero filter (x_f = 0): the conservatism of
-      the LMI design itself; the verdict is the engine's check of the point;
+      scheduled family, fixed gains (Gf = Hf = 0) and the zero filter (x_f = 0), with the S-procedure
+      multiplier free (column ``multiplier``: ``free``, its value in ``lambda``) and fixed as printed
+      in (12) (``fixed``, the paper's rows): the conservatism of the LMI design itself; the verdict is
+      the engine's check of the point;
+    * ``guaranteed_cost_lower`` / ``guaranteed_cost_upper``: the certified bracket of the least
+      guaranteed cost (multiplier free) of the scheduled family, on a lattice around the fixed
+      family's certified cost (``scheduling.cost_span``, ``cost_resolution``), and of the zero filter
+      (:func:`.design.guaranteed_cost_bracket`): what scheduling can buy in the guarantee, at most;
     * ``exact_tuned``: the best gains found for the exact sum_k E||e(k)||^2 (f = (F1+F2)/2 z,
       x(0) ~ N(0, I), the configured p(k)) in each family (:func:`.tuning.best_exact_gains`, BFGS
       from the designs named in ``scheduling.starts``, or from x_f = 0 if none; the scheduled search
@@ -720,26 +799,63 @@ def scheduling_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame}`` with columns comparison, family, value, verdict, certified_slack,
-        status, start, n_evaluations.
+        ``{"table": DataFrame}`` with columns comparison, family, multiplier, value, verdict,
+        certified_slack, status, lambda, start, n_evaluations.
+
+    Raises
+    ------
+    GainschedError
+        When every guaranteed-cost solve is undecided (the message names the step and the statuses).
     """
-    from .design import Theorem3, certified_cost
+    from .design import Theorem3, certified_cost, guaranteed_cost_bracket
     from .tuning import best_exact_gains
 
     sys = _sys(params)
     lmi = params["lmi"]
+    cfg = params["scheduling"]
     X0 = augmented_initial_moment(params["performance"]["initial_cov"], sys.n)
     common = dict(eps=float(lmi["eps"]), bound=float(lmi["bound"]), qp_positive=bool(lmi["qp_positive"]),
                   margin_cap=float(lmi["margin_cap"]), gamma3_top=lmi.get("gamma3_top", "HC"))
-    rows = []
-    for family, opts in (("scheduled", dict(scheduled=True)), ("fixed_gain", dict(scheduled=False)),
-                         ("zero", dict(zero_filter=True))):
-        prob = Theorem3(sys, X0=X0, performance=True, output_slack=True, **opts, **common)
-        sol = prob.solve()
-        verdict, slack = _decide_point(prob, sol, sys)
-        cost = certified_cost(sol.values, X0, sys.p1, sys.p2) if verdict == "feasible" else np.nan
-        rows.append({"comparison": "guaranteed_cost", "family": family, "value": cost, "verdict": verdict,
-                     "certified_slack": slack, "status": sol.status, "start": "", "n_evaluations": np.nan})
+    rows, solved = [], {}
+    for multiplier in ("free", "fixed"):
+        for family, opts in (("scheduled", dict(scheduled=True)), ("fixed_gain", dict(scheduled=False)),
+                             ("zero", dict(zero_filter=True))):
+            prob = Theorem3(sys, X0=X0, performance=True, output_slack=True, multiplier=multiplier, **opts, **common)
+            sol = prob.solve()
+            verdict, slack = _decide_point(prob, sol, sys)
+            cost = certified_cost(sol.values, X0, sys.p1, sys.p2) if verdict == "feasible" else np.nan
+            lam = float(np.asarray(sol.values["lam"])) if "lam" in sol.values else 1.0
+            solved[(multiplier, family)] = (prob, sol, cost)
+            rows.append({"comparison": "guaranteed_cost", "family": family, "multiplier": multiplier,
+                         "value": cost, "verdict": verdict, "certified_slack": slack, "status": sol.status,
+                         "lambda": lam if sol.values else np.nan, "start": "", "n_evaluations": np.nan})
+    _no_decision(rows, "gainsched_scheduling", "the performance LMI (guaranteed cost)")
+    # certified lower bound of the scheduled family's least guaranteed cost (free multiplier), on a lattice
+    # around the fixed-gain family's certified cost: the most scheduling can buy in the guarantee
+    prob, sol, _ = solved[("free", "scheduled")]
+    ref = solved[("free", "fixed_gain")][2]
+    if sol.values and np.isfinite(ref):
+        b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]), float(cfg["cost_resolution"]))
+        lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
+    else:
+        lower, upper, n_eval, und = np.nan, np.nan, 0, 0
+    for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
+        rows.append({"comparison": name, "family": "scheduled", "multiplier": "free", "value": value,
+                     "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
+                     "status": f"certified bisection on the cost level ({und} undecided lattice points)",
+                     "lambda": np.nan, "start": f"reference fixed_gain {ref:.9g}", "n_evaluations": n_eval})
+    # the zero filter's least guaranteed cost (min tr Q of x_f = 0) with the multiplier free, bracketed the same way
+    prob, sol, ref = solved[("free", "zero")]
+    if sol.values and np.isfinite(ref):
+        b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]), float(cfg["cost_resolution"]))
+        lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
+    else:
+        lower, upper, n_eval, und = np.nan, np.nan, 0, 0
+    for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
+        rows.append({"comparison": name, "family": "zero", "multiplier": "free", "value": value,
+                     "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
+                     "status": f"certified bisection on the cost level ({und} undecided lattice points)",
+                     "lambda": np.nan, "start": f"reference zero {ref:.9g}", "n_evaluations": n_eval})
     table = read_table(inputs["gains"])
     p_seq = p_sequence(params, sys)
     mid = 0.5 * (sys.F1 + sys.F2)
@@ -748,13 +864,14 @@ def scheduling_step(params, inputs, outputs):
     fixed, info_f = best_exact_gains(sys, p_seq, mid, Xg, False, named or [("zero", zero_gains(sys))])
     sched, info_s = best_exact_gains(sys, p_seq, mid, Xg, True, [("best fixed", fixed)] + named)
     for family, info in (("fixed_gain", info_f), ("scheduled", info_s)):
-        rows.append({"comparison": "exact_tuned", "family": family, "value": info["cost"], "verdict": "",
+        rows.append({"comparison": "exact_tuned", "family": family, "multiplier": "", "value": info["cost"],
+                     "verdict": "", "lambda": np.nan,
                      "certified_slack": np.nan, "status": "local minimum (BFGS)", "start": info["start"],
                      "n_evaluations": info["n_eval"]})
     for d in dict.fromkeys(table["design"]):
         if d in ("theorem3", "fixed_gain", "performance", "performance_tied"):
             g = gains_from_table(table, d, sys)
-            rows.append({"comparison": "schedule_size", "family": d,
+            rows.append({"comparison": "schedule_size", "family": d, "multiplier": "", "lambda": np.nan,
                          "value": float(max(np.abs(g.Gf).max(), np.abs(g.Hf).max())), "verdict": "",
                          "certified_slack": np.nan, "status": "", "start": "", "n_evaluations": np.nan})
     return {"table": pd.DataFrame(rows)}

@@ -30,6 +30,8 @@ from .moments import linear_gains
 
 __all__ = [
     "ms_stability_index",
+    "frozen_ms_radius",
+    "ms_stable_decision",
     "convergence_rate",
     "r2_congruence_residuals",
     "missing_fraction",
@@ -40,12 +42,17 @@ __all__ = [
 ]
 
 
-def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
+def ms_stability_index(sys: System, gains: Gains, ps, p_seq, worst_gain: bool = True) -> float:
     """Largest frozen second-moment radius of (10) and growth rate along ``p_seq`` (the MS stability index).
 
-    Frozen radii at p in ``ps`` with f = F z at the diagonal sector vertices; growth along the
-    scheduled ``p_seq``. (10) is exponentially mean-square stable for these linear f iff this is
-    below 1 (Definition 1).
+    Frozen radii at p in ``ps`` with f = F z at the diagonal sector vertices and (``worst_gain``,
+    nz = 2) at the worst linear gain of class (3), K = (F1+F2)/2 + U(F2-F1)/2 with U orthogonal
+    (:func:`.feasibility.worst_sector_gain` at ``sys.sigma2``: it meets (3) with equality and is
+    not diagonal); growth along the scheduled ``p_seq``. (10) is exponentially mean-square stable
+    for these linear f iff this is below 1 (Definition 1); a value >= 1 shows an f of class (3)
+    for which (10) is not mean-square stable. (10) is block-triangular, so its radius is at least
+    the plant's for the same f: the rotated gain reaches 1 at the plant's necessary end for class
+    (3), below the diagonal vertices' end.
 
     Parameters
     ----------
@@ -57,6 +64,9 @@ def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
         Frozen probabilities.
     p_seq : array_like
         The scheduled p(k) of Section IV.
+    worst_gain : bool
+        Add the worst rotated gain of class (3) to the diagonal vertices (default; ``False``: the
+        four diagonal vertices only, the former index).
 
     Returns
     -------
@@ -64,10 +74,85 @@ def ms_stability_index(sys: System, gains: Gains, ps, p_seq) -> float:
         The larger of the largest frozen radius and the largest growth rate; below 1 for mean-square
         stability.
     """
-    cases = sector_cases(sys).values()
+    from .feasibility import worst_sector_gain
+
+    cases = list(sector_cases(sys).values())
+    if worst_gain and sys.nz == 2:
+        cases.append(worst_sector_gain(sys, sys.sigma2)["K"])
     rho = max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases)
     growth = max(scheduled_growth_rate(sys, gains, p_seq, F) for F in cases)
     return float(max(rho, growth))
+
+
+def frozen_ms_radius(sys: System, gains: Gains, ps, worst_gain: bool = True) -> float:
+    """Largest second-moment spectral radius of (10) at frozen p in ``ps`` over linear f of class (3).
+
+    A constant p(k) = p in [p1, p2] is an admissible schedule and f = F z with F meeting (3) an
+    admissible nonlinearity, so a radius >= 1 shows that (10) is not exponentially mean-square
+    stable for that f and p(k) (Definition 1): a necessary condition, unlike the finite-horizon
+    growth rate of :func:`ms_stability_index` (a norm of a finite product, which exceeds the
+    asymptotic rate by its transient). The gains F are the diagonal sector vertices and (nz = 2,
+    ``worst_gain``) the worst rotated gain of :func:`.feasibility.worst_sector_gain` at ``sys.sigma2``.
+
+    Parameters
+    ----------
+    sys : System
+        The plant (1), (2), (6) with its sector (3), noise variance and bounds of p(k).
+    gains : Gains
+        The filter gains of (9).
+    ps : array_like
+        Frozen probabilities in [p1, p2].
+    worst_gain : bool
+        Add the worst rotated gain of class (3) to the diagonal vertices.
+
+    Returns
+    -------
+    float
+        The largest frozen radius.
+    """
+    from .feasibility import worst_sector_gain
+
+    cases = list(sector_cases(sys).values())
+    if worst_gain and sys.nz == 2:
+        cases.append(worst_sector_gain(sys, sys.sigma2)["K"])
+    return float(max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases))
+
+
+def ms_stable_decision(index: float, sigma2: float, certified_to: float, refuted_from: float) -> tuple:
+    """Decide mean-square stability of (10) for every f of class (3) at ``sigma2`` from its certificates.
+
+    Sufficient: (24) with these gains certified feasible at ``certified_to`` (feasibility of (24) is
+    monotone in sigma^2 > 0, and (24) implies (12), which implies mean-square stability for every f
+    of the class: Theorems 1-3), so stable for every ``sigma2 <= certified_to``. Necessary: the
+    frozen radius of :func:`frozen_ms_radius` >= 1 + RADIUS_MARGIN (a linear f of the class that is not
+    mean-square stable), or ``sigma2 >= refuted_from`` (the plant alone is not mean-square stable
+    for some f of the class from there on; the radius is nondecreasing in sigma^2). Otherwise
+    undecided.
+
+    Parameters
+    ----------
+    index : float
+        :func:`frozen_ms_radius` at ``sigma2`` (a necessary condition: >= 1 refutes).
+    sigma2 : float
+        Variance of the multiplicative noise w(k) of (1).
+    certified_to : float
+        Certified feasible end of (24) for these gains (nan: none).
+    refuted_from : float
+        Certified infeasible end (the class's necessary end; nan: none).
+
+    Returns
+    -------
+    tuple
+        ``(value, decided)``: ``value`` a Python bool (True: stable for every f of the class),
+        ``decided`` False when neither certificate applies (``value`` is then ``index < 1``, information).
+    """
+    from .feasibility import RADIUS_MARGIN
+
+    if np.isfinite(certified_to) and sigma2 <= certified_to:
+        return True, True
+    if index >= 1.0 + RADIUS_MARGIN or (np.isfinite(refuted_from) and sigma2 >= refuted_from):
+        return False, True
+    return bool(index < 1.0), False
 
 
 def convergence_rate(sys: System, gains: Gains, p_seq) -> float:
