@@ -32,7 +32,8 @@ from .filters import FilterDoesNotExist
 from .model import advantage, paired_z, settle_step
 from .noise import NoiseModel
 
-__all__ = ["evidence_step", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS"]
+__all__ = ["evidence_step", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS", "registered_band",
+           "swap_verdicts"]
 
 # reconstruction key -> the parameter of the one-at-a-time sweeps (results/hinf/sensitivity*.csv) that varies it
 RECONSTRUCTION_SWEEPS = {"filter.gamma": "gamma", "consensus.gamma_c": "gamma_c", "consensus.K_p": "K_p",
@@ -529,7 +530,54 @@ def _fig6_path_rows(fp: pd.DataFrame, at: dict) -> list[dict]:
     return rows
 
 
-def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
+def registered_band(kb: pd.DataFrame, alpha: float, lo: float = 1.5, hi: float = 5.0) -> dict:
+    """The registered rule of ``F_kalman_at_best`` (issue 37) on each target of ``kalman_best.csv``.
+
+    For each filter kind of the table: H-infinity (gamma = ``filter.gamma``) beats Kalman(W) (``z < -z_c``);
+    Kalman(W_f) beats it for every W_f in the registered band ``lo <= W_f / W <= hi`` (``z > z_c``); and the best
+    Kalman filter beats the best H-infinity filter (``z > z_c``; the best over gamma at the paper's W against the
+    best over the declared W_f grid, each chosen on the separate selection runs). ``z_c`` is the two-sided
+    Bonferroni level over that family only (its size: the rows the rule reads, 6 per kind when the grid holds
+    1.5, 2, 3 and 5 W); W_f beyond ``hi`` is exploratory and not judged.
+
+    Parameters
+    ----------
+    kb : DataFrame
+        ``kalman_best.csv`` (``target, kind, comparison, W_factor_b, z``; z of H-infinity minus Kalman).
+    alpha : float
+        Family-wise two-sided level.
+    lo, hi : float
+        The registered band of design-W factors.
+
+    Returns
+    -------
+    dict
+        ``holds`` (target -> bool), ``family`` (target -> number of comparisons judged), ``z_crit``
+        (target -> level) and ``note`` (target -> text).
+    """
+    from .model import bonferroni_z
+
+    out = {"holds": {}, "family": {}, "z_crit": {}, "note": {}}
+    for t, g in kb.groupby("target", sort=False):
+        best = g["comparison"].str.startswith("best")
+        at_w = g[~best & (g["W_factor_b"] == 1.0)]
+        in_band = g[~best & (g["W_factor_b"] >= lo) & (g["W_factor_b"] <= hi)]
+        judged = pd.concat([at_w, in_band, g[best]])
+        zc = bonferroni_z(float(alpha), max(1, len(judged)))
+        ok = bool(len(at_w) and len(in_band) and best.any() and (at_w["z"] < -zc).all()
+                  and (in_band["z"] > zc).all() and (g[best]["z"] > zc).all())
+        beyond = g[~best & (g["W_factor_b"] > hi)]
+        out["holds"][t], out["family"][t], out["z_crit"][t] = ok, int(len(judged)), zc
+        out["note"][t] = (
+            f"registered rule, family of {len(judged)} comparisons (per kind: W_f = W, W_f in {lo:g}-{hi:g} W, best vs "
+            f"best), two-sided Bonferroni at family-wise 5 % (|z| > {zc:.2f}); z of H-infinity minus Kalman: "
+            + "; ".join(f"{r.kind} {r.comparison} z = {r.z:+.1f}" for r in judged.itertuples())
+            + ". Exploratory, not judged (W_f > " + f"{hi:g} W): "
+            + (", ".join(f"{r.kind} W_f = {r.W_factor_b:g} z = {r.z:+.1f}" for r in beyond.itertuples()) or "none"))
+    return out
+
+
+def _kalman_best_rows(kb: pd.DataFrame, alpha: float = 0.05, band_lo: float = 1.5, band_hi: float = 5.0) -> list[dict]:
     """Issue 28, part 2: H-infinity against Kalman filters at their best, and the control targets (kalman_best.csv)."""
     zc, m = float(kb["z_crit"].iloc[0]), len(kb)
     head = (f"same trajectories and measurements, {int(kb['runs'].iloc[0])} judged runs (best settings chosen on separate "
@@ -574,15 +622,158 @@ def _kalman_best_rows(kb: pd.DataFrame) -> list[dict]:
                 + "; best: " + ", ".join(f"{r.label_a} vs {r.label_b}" for r in best.itertuples()))
 
     targets = list(dict.fromkeys(kb["target"]))
+    band = registered_band(kb, alpha, band_lo, band_hi)
+    rows.append({"quantity": "premise.kalman_registered_band", "value": band["holds"]["evasive"],
+                 "note": band["note"]["evasive"]})
+    for t in targets:
+        if t != "evasive":
+            rows.append({"quantity": "premise.kalman_registered_band", "variant": f"target={t}",
+                         "value": band["holds"][t], "note": band["note"][t]})
     rows.append({"quantity": "premise.kalman_at_best", "value": pattern("evasive"),
                  "note": head + ". Above each kind's best W_f (over-tuned, not judged), evasive target: "
                          + beyond_best("evasive") + ". " + " | ".join(text(t) for t in targets)})
-    controls = [t for t in targets if t in ("drift", "evasive_noise")]
+    controls = [t for t in targets if t in ("drift", "evasive_noise", "evader_replay")]
     rows.append({"quantity": "premise.control_targets", "value": bool(controls and all(pattern(t) for t in controls)),
                  "note": "the pattern of the evasive target (H-infinity beats the Kalman filter designed for W, loses to it "
                          f"designed for {kb.loc[kb['W_factor_b'] > 1.0, 'W_factor_b'].min():g} W up to the kind's best "
                          "setting and at the best settings) at the control targets: "
-                         + ", ".join(f"{t} {'same' if pattern(t) else 'different'}" for t in controls)})
+                         + ", ".join(f"{t} {'same' if pattern(t) else 'different'}" for t in controls)
+                         + "; with the registered 1.5-5 W band: "
+                         + ", ".join(f"{t} {'same' if band['holds'][t] else 'different'}" for t in controls)})
+    return rows
+
+
+def swap_verdicts(sw: pd.DataFrame) -> dict:
+    """The decisions of ``F_evasive_loss_paths`` and ``F_steering_local_error`` per setting of ``loop_swap.csv``.
+
+    Parameters
+    ----------
+    sw : DataFrame
+        ``loop_swap.csv`` (:func:`.steps.swap_comparisons`).
+
+    Returns
+    -------
+    dict
+        ``loss_on_own_paths`` (setting -> bool: on the PI loop's paths PI ``reversed`` and every other design
+        ``holds``; on the local loop's paths every design ``holds``; False where a path set is missing) and
+        ``steering_lowers_local`` (setting -> bool: the local filters' error in the PI loop minus in the local loop
+        ``holds``).
+    """
+    out = {"loss_on_own_paths": {}, "steering_lowers_local": {}}
+    for setting, g in sw.groupby("setting", sort=False):
+        fp = g[g["comparison"] == "fixed_paths"].set_index(["loop", "design"])["tag"]
+        on_pi = fp.loc["pi"] if "pi" in fp.index.get_level_values(0) else pd.Series(dtype=object)
+        on_loc = fp.loc["local_loop"] if "local_loop" in fp.index.get_level_values(0) else pd.Series(dtype=object)
+        out["loss_on_own_paths"][setting] = bool(
+            len(on_pi) and len(on_loc) and on_pi.get("pi") == "reversed"
+            and (on_pi.drop("pi", errors="ignore") == "holds").all() and (on_loc == "holds").all())
+        st = g[(g["comparison"] == "steering_local") & (g["loop"] == "pi")]
+        out["steering_lowers_local"][setting] = bool(len(st) and (st["tag"] == "holds").all())
+    return out
+
+
+def _swap_rows(sw: pd.DataFrame) -> list[dict]:
+    """Issue 37: the fixed-path swap (loop_swap.csv): every design on each loop's recorded paths, same seeds."""
+    zc, m = float(sw["z_crit"].iloc[0]), len(sw)
+    head = (f"{int(sw['runs'].iloc[0])} runs per loop, seed-paired; tags at the two-sided Bonferroni level over the {m} "
+            f"comparisons of loop_swap.csv (|z| > {zc:.2f}); uncertainty: half-width {zc:.2f} SE")
+    settings = list(dict.fromkeys(sw["setting"]))
+    nominal = settings[0]
+    dec = swap_verdicts(sw)
+
+    def one(r):
+        return {"value": float(r.mean_diff), "uncertainty": float(zc * r.se) if np.isfinite(r.se) else 0.0}
+
+    def txt(r):
+        return f"{r.design} {r.mean_diff:+.3f} ({r.tag}, z = {r.z:+.1f})"
+
+    rows = []
+    fp = sw[sw["comparison"] == "fixed_paths"]
+    for setting in settings:
+        g = fp[fp["setting"] == setting]
+        parts = []
+        for loop, h in g.groupby("loop", sort=False):
+            parts.append(f"on the {loop} paths (connected {h['connected_fraction'].iloc[0]:.0%}, "
+                         f"{h['topology_changes'].iloc[0]:.0f} topology changes per run; local {h['error_b'].iloc[0]:.3f}): "
+                         + ", ".join(txt(r) for r in h.itertuples()))
+        note = "decentralized minus local filters, open loop on recorded paths: " + "; ".join(parts)
+        for r in g.itertuples():
+            nom = setting == nominal and r.loop == "pi" and r.design == "pi"
+            rows.append({"quantity": "swap.fixed_paths", **one(r),
+                         **({} if nom else {"variant": f"{setting}: paths={r.loop}, design={r.design}"}),
+                         "note": f"{head}. {note}" if nom else ""})
+        rows.append({"quantity": "swap.loss_on_own_paths", "value": dec["loss_on_own_paths"][setting],
+                     **({} if setting == nominal else {"variant": setting}), "note": note})
+    vs_pi = sw[sw["comparison"] == "fixed_paths_vs_pi"]
+    for r in vs_pi.itertuples():
+        rows.append({"quantity": "swap.fixed_paths_vs_pi", **one(r), "variant": f"{r.setting}: paths={r.loop}, design={r.design}"})
+    st = sw[sw["comparison"] == "steering_local"]
+    for r in st.itertuples():
+        nom = r.setting == nominal and r.loop == "pi"
+        rows.append({"quantity": "loop.steering_local", **one(r),
+                     **({} if nom else {"variant": f"{r.setting}: loop={r.loop}"}),
+                     "note": (f"{head}. Local filters' late error in the loop {r.loop} steers, {r.error_a:.3f}, minus in the "
+                              f"loop the local filters steer, {r.error_b:.3f}: {r.mean_diff:+.3f} ({r.tag}, z = {r.z:+.1f})")})
+    for setting in settings:
+        rows.append({"quantity": "loop.steering_lowers_local", "value": dec["steering_lowers_local"][setting],
+                     **({} if setting == nominal else {"variant": setting})})
+    sysm = sw[sw["comparison"] == "system"]
+    vs = sw[sw["comparison"] == "system_vs_pi"].set_index(["setting", "design"])
+    for setting in settings:
+        g = sysm[sysm["setting"] == setting].sort_values("error_a")
+        rank = " < ".join(f"{r.design} {r.error_a:.3f}" for r in g.itertuples()) + f" (local loop {g['error_b'].iloc[0]:.3f})"
+        detail = "; ".join(
+            f"{r.design}: vs local loop {r.mean_diff:+.3f} ({r.tag}, z = {r.z:+.1f})"
+            + (f", vs PI {vs.loc[(setting, r.design), 'mean_diff']:+.3f} ({vs.loc[(setting, r.design), 'tag']}, "
+               f"z = {vs.loc[(setting, r.design), 'z']:+.1f})" if (setting, r.design) in vs.index else "")
+            for r in g.itertuples())
+        rows.append({"quantity": "loop.system_rank", "value": " < ".join(g["design"]),
+                     **({} if setting == nominal else {"variant": setting}),
+                     "note": (f"{head}. Closed loops ranked by the late error of the decentralized filter that steers "
+                              f"them (the system's error): {rank}. {detail}")})
+        for r in g.itertuples():
+            rows.append({"quantity": "loop.system_vs_local", **one(r),
+                         **({} if setting == nominal and r.design == "pi" else {"variant": f"{setting}: design={r.design}"})})
+    for (setting, design), r in vs.iterrows():
+        rows.append({"quantity": "loop.system_vs_pi", "value": float(r["mean_diff"]),
+                     "uncertainty": float(zc * r["se"]), "variant": f"{setting}: design={design}"})
+    return rows
+
+
+def _fig6_recursion_rows(fp: pd.DataFrame, at: dict) -> list[dict]:
+    """Issue 37: is the zig-zag made by the gradient recursion (14)? (fig6_paths.csv, F_fig6_zigzag_recursion's ``at``)."""
+    t = fp.set_index("variant")
+    est, truth, base_t = at["estimate_variant"], at["truth_variant"], at["truth_baseline"]
+    cap = float(at["leaves_at_most"])
+    def share(v, b):  # no reversal in the baseline (a very short run): no share, and no decision
+        base = float(t.loc[b, "reversal_fraction"])
+        return float(t.loc[v, "reversal_fraction"]) / base if base > 0 else math.nan
+
+    share_est, share_truth = share(est, "nominal"), share(truth, base_t)
+    decided = bool(np.isfinite(share_est) and np.isfinite(share_truth))
+    ok = bool(decided and share_est <= cap and t.loc[est, "tag"] == "holds" and share_truth <= cap
+              and t.loc[truth, "tag"] in ("exact", "holds"))
+
+    def strokes(v):
+        r = t.loc[v]
+        return (f"{v}: median stroke {r['stroke_median']:.0f} steps between reversals, {r['one_step_strokes']:.0%} of "
+                f"strokes one step long, tangential share of the step length {r['tangential_share']:.2f} "
+                f"(SE {r['tangential_se']:.3f}; 0.5 for random directions), reversals {r['reversal_fraction']:.2%}")
+
+    rows = [{"quantity": "fig6.zigzag_recursion", "value": ok, "decided": decided,
+             "note": (f"without (14), steering by the estimates: {share_est:.0%} of the nominal reversals "
+                      f"({t.loc[est, 'tag']}, z = {t.loc[est, 'z']:+.1f} at |z| > {t.loc[est, 'z_crit']:.2f}); steering by "
+                      f"the truth: {share_truth:.0%} of {base_t}'s ({t.loc[truth, 'tag']}); rule: at most {cap:.0%} each. "
+                      + "; ".join(strokes(v) for v in t.index))}]
+    nom = t.loc["nominal"]
+    rows.append({"quantity": "fig6.strokes", "value": float(nom["stroke_median"]),
+                 "note": "median length (steps) of the strokes between heading reversals; " + "; ".join(strokes(v) for v in t.index)})
+    for v in t.index:
+        if v != "nominal":
+            rows.append({"quantity": "fig6.strokes", "variant": v, "value": float(t.loc[v, "stroke_median"])})
+        rows.append({"quantity": "fig6.tangential_share", **({} if v == "nominal" else {"variant": v}),
+                     "value": float(t.loc[v, "tangential_share"]),
+                     "uncertainty": float(1.96 * t.loc[v, "tangential_se"]) if np.isfinite(t.loc[v, "tangential_se"]) else 0.0})
     return rows
 
 
@@ -744,8 +935,10 @@ def evidence_step(params, inputs, outputs):
     rows += _abstract_rows(pe, summ, z_sig, ev_frac)
     loop_horizon = int(cfg["scenarios"][cfg["loop_variants"]["scenario"]]["horizon"])
     rows += _loop_rows(pd.read_csv(inputs["loop_variants"]), loop_horizon)
-    rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]))
+    rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]), float(cfg["tests"]["alpha"]))
+    rows += _swap_rows(pd.read_csv(inputs["loop_swap"]))
     rows += _fig6_path_rows(pd.read_csv(inputs["fig6_paths"]), finding_settings["F_fig6_zigzag_cause"])
+    rows += _fig6_recursion_rows(pd.read_csv(inputs["fig6_paths"]), finding_settings["F_fig6_zigzag_recursion"])
     ev_conv = pd.read_csv(inputs["evader"])
     rows.append({"quantity": "evader.convergence", "value": float(ev_conv.loc[ev_conv["configured"], "certified_fraction"].iloc[0]),
                  "note": evader_text(ev_conv)})
