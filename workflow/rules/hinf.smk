@@ -424,6 +424,7 @@ rule hinf_kalman_best:
         ),
     output:
         table="results/hinf/kalman_best.csv",
+        fused="results/hinf/evader_fused.csv",
     log:
         "logs/hinf/kalman_best.log",
     localrule: True
@@ -486,6 +487,7 @@ rule hinf_evidence:
         loop_variants=rules.hinf_loop_variants.output.table,
         loop_swap=rules.hinf_loop_swap.output.table,
         kalman_best=rules.hinf_kalman_best.output.table,
+        evader_fused=rules.hinf_kalman_best.output.fused,
         fig6_paths=rules.hinf_fig6_paths.output.table,
     output:
         table="results/evidence/hinf.csv",
@@ -535,6 +537,7 @@ if enabled("hinf"):
         rules.hinf_loop_swap.output.table,
         rules.hinf_loop_swap.output.runs,
         rules.hinf_kalman_best.output.table,
+        rules.hinf_kalman_best.output.fused,
         rules.hinf_fig6_paths.output.table,
         rules.hinf_fig6_paths.output.paths,
         rules.hinf_evidence.output.table,

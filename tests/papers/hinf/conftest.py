@@ -98,6 +98,9 @@ def hinf_run(tmp_path_factory):
         files[name] = d / f"{name}.csv"
         merged = run_sharded(shard_step, merge_step, cfg, 2, d, name)
         merged["table"].to_csv(files[name], index=False)
+        if "fused" in merged:
+            files["evader_fused"] = d / "evader_fused.csv"
+            merged["fused"].to_csv(files["evader_fused"], index=False)
         if "runs" in merged:
             files[f"{name}_runs"] = d / f"{name}_runs.csv"
             merged["runs"].to_csv(files[f"{name}_runs"], index=False)

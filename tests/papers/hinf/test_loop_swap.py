@@ -162,3 +162,27 @@ def test_strokes_and_tangential_share_on_hand_made_paths():
         np.cos(0.1) ** 2, rel=1e-9)  # a chord: cos^2 of half the angle it subtends
     radial = np.stack([np.linspace(10, 5, 6), np.zeros(6)], -1)
     assert path_statistics(_one(radial), 5.0, tgt)["tangential_share"][0] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_fused_trace_along_an_evaders_path_is_the_value_it_maximised():
+    from netrepro.papers.hinf.evader import fused_trace_along
+
+    cfg = tiny_section()
+    sc = resolve_scenario(cfg, "evasive_hinf", runs=2, horizon=20, seed=3)
+    out = simulate({**sc, "target": "evasive", "filters": [sc["driver"]]})
+    # the evader records the value of the move it chose (evader_move); recomputed here from the paths alone
+    np.testing.assert_allclose(fused_trace_along(out["target"], out["agents"], sc["model"]), out["fused_trace"][:, 1:],
+                               rtol=1e-12)
+
+
+def test_fused_comparisons_pair_the_targets_by_run():
+    rows = []
+    for t, base in (("evasive", 2.0), ("evader_replay", 1.0), ("random", 0.5)):
+        for lab in ("a", "b"):
+            for r in range(5):
+                rows.append({"target": t, "phase": "judge", "label": lab, "run": r, "fused_trace": base + 0.1 * r})
+    rows.append({"target": "evasive", "phase": "select", "label": "a", "run": 0, "fused_trace": 99.0})
+    t = steps.fused_comparisons(pd.DataFrame(rows), 0.05).set_index("target_b")
+    assert list(t.index) == ["evader_replay", "random"]
+    assert t.loc["evader_replay", "mean_diff"] == pytest.approx(1.0) and t.loc["random", "mean_diff"] == pytest.approx(1.5)
+    assert t.loc["random", "fused_a"] == pytest.approx(2.2)  # judge runs only

@@ -26,11 +26,11 @@ import pandas as pd
 
 from ...paperdata import load_claims, load_findings
 from ...verdicts import erratum_evidence, evidence_frame
-from .analysis import (E9_RADII, ERRATA_POINT, difference_correlation, disturbance_weight, errata_residuals,
+from .analysis import (E9_RADII, ERRATA_POINT, covariance_sampling_scale, difference_correlation, disturbance_weight, errata_residuals,
                        information_at_positions, mean_gain_norms, order_violation, settles_first, sweet_spot_grid)
 from .filters import FilterDoesNotExist
 from .model import advantage, paired_z, settle_step
-from .noise import NoiseModel
+from .noise import NoiseModel, noise_covariance
 
 __all__ = ["evidence_step", "sensitivity_text", "evader_text", "RECONSTRUCTION_SWEEPS", "registered_band",
            "swap_verdicts"]
@@ -153,14 +153,23 @@ def _errata_rows(cfg) -> list[dict]:
     r0, th0 = ERRATA_POINT
     rows = []
 
-    def add(eid, note):
+    def add(eid, note, uncertainty=0.0):
         printed, corrected = res[eid][:2]
-        rows.extend(erratum_evidence(eid, float(printed), float(corrected), note))
+        new = erratum_evidence(eid, float(printed), float(corrected), note)
+        for row in new:
+            row["uncertainty"] = float(uncertainty)
+        rows.extend(new)
 
-    add("E1", f"relative Frobenius distance to the empirical covariance of {n} sampled m_i at r={r0:g}, theta={th0:g}")
+    # E1's residuals are Monte Carlo distances: their uncertainty is 3 x the distance sampling alone makes (issue 37)
+    u1 = 3.0 * covariance_sampling_scale(noise_covariance(r0, th0, model), n)
+    add("E1", f"relative Frobenius distance to the empirical covariance of {n} sampled m_i at r={r0:g}, theta={th0:g}; "
+        f"sampling alone makes a distance of {u1 / 3:.4f} RMS (Isserlis), so the corrected form's "
+        f"{res['E1'][1]:.4f} is sampling noise (uncertainty 3 x RMS = {u1:.4f})", uncertainty=u1)
     add("E2", "relative distance of Delta Omega^-1 to Sigma of eq (6) (4 sensors, Delta fixed)")
     add("E3", "relative distance to the central finite difference of Sigma w.r.t. r_1 (eq (16) as printed for the "
-        "printed form)")
+        f"printed form); the finite difference's own error, its spread over half steps 5e-7..2e-6, is "
+        f"{res['E3'][2]:.1e}: the corrected form's {res['E3'][1]:.1e} is that error, not a mismatch",
+        uncertainty=float(res["E3"][2]))
     where = ", ".join(f"{x:g}" for x in res["E4_radii"])
     add("E4", f"max over r in {{{where}}} of the relative distance to the central finite difference of M^-1 w.r.t. "
         "theta")
@@ -777,6 +786,28 @@ def _fig6_recursion_rows(fp: pd.DataFrame, at: dict) -> list[dict]:
     return rows
 
 
+def _fused_rows(fz: pd.DataFrame) -> list[dict]:
+    """Issue 37: does the evader raise its objective tr Q_fused (19)-(24)? (evader_fused.csv, judge runs, seed-paired)."""
+    if not len(fz):
+        return [{"quantity": "evader.raises_fused_trace", "value": math.nan, "decided": False,
+                 "note": "no target to compare the evader with"}]
+    zc = float(fz["z_crit"].iloc[0])
+    t = fz.set_index("target_b")
+    ref = "evader_replay" if "evader_replay" in t.index else t.index[0]
+    note = (f"late-window mean of tr Q_fused (min over lambda of (24), exact and certified) at the target's position and the "
+            f"agents' positions the evader saw, {int(t['runs'].iloc[0])} judge runs, evasive target minus each other target "
+            f"(same seeds; the agents react to what they track), two-sided Bonferroni over {len(t)} (|z| > {zc:.2f}): "
+            + "; ".join(f"vs {b}: {r.fused_a:.3f} - {r.fused_b:.3f} = {r.mean_diff:+.3f} (z = {r.z:+.1f}, evader higher "
+                        f"in {r.frac_a_higher:.0%} of runs)" for b, r in t.iterrows()))
+    rows = [{"quantity": "evader.raises_fused_trace", "value": float(t.loc[ref, "mean_diff"]),
+             "uncertainty": float(zc * t.loc[ref, "se"]), "note": note}]
+    for b, r in t.iterrows():
+        if b != ref:
+            rows.append({"quantity": "evader.raises_fused_trace", "variant": f"vs target={b}", "value": float(r["mean_diff"]),
+                         "uncertainty": float(zc * r["se"])})
+    return rows
+
+
 def _abstract_rows(pe, summ, z_sig, conn_frac):
     ev = pe[pe["target"] == "evasive"]
     h = ev[(ev["filter_a"] == "decentralized") & (ev["filter_b"] == "local")].iloc[0]
@@ -894,6 +925,10 @@ def evidence_step(params, inputs, outputs):
                  "note": f"slowest disagreement mode of (5) on the Fig-2 path graph: {slow:.0f} steps with K_i = "
                          f"{cfg['consensus']['K_i']}, {slow0:.1f} steps with K_i = 0 (consensus_modes.csv); "
                          f"{_agent_summary(pa, 'fig2', z_sig)}"})
+    longest = max(int(h) for h in cfg["fig2_horizon"]["horizons"])
+    rows.append({"quantity": "fig2.slow_mode_beyond_horizon", "value": bool(slow > longest),
+                 "note": f"time constant of the slowest disagreement mode, {slow:.0f} steps (an eigenvalue computation, "
+                         f"exact), against the longest horizon judged, {longest} steps"})
     noise_rows, adv = _noise_gain_rows(summ, sens, pa, cfg)
     rows += noise_rows
     rows += erratum_evidence(
@@ -937,6 +972,7 @@ def evidence_step(params, inputs, outputs):
     rows += _loop_rows(pd.read_csv(inputs["loop_variants"]), loop_horizon)
     rows += _kalman_best_rows(pd.read_csv(inputs["kalman_best"]), float(cfg["tests"]["alpha"]))
     rows += _swap_rows(pd.read_csv(inputs["loop_swap"]))
+    rows += _fused_rows(pd.read_csv(inputs["evader_fused"]))
     rows += _fig6_path_rows(pd.read_csv(inputs["fig6_paths"]), finding_settings["F_fig6_zigzag_cause"])
     rows += _fig6_recursion_rows(pd.read_csv(inputs["fig6_paths"]), finding_settings["F_fig6_zigzag_recursion"])
     ev_conv = pd.read_csv(inputs["evader"])

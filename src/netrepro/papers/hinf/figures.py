@@ -270,7 +270,10 @@ def figure_paired(params, inputs, outputs):
 
 
 def _loop_label(loop: str) -> str:
-    return loop.split("|")[-1].replace("evader.step_scale", "pi, evader step").replace("layouts.four", "pi, layout")
+    """A short tick label of a loop of loop_variants.csv (``pi|evader.step_scale=2`` -> ``pi, step x2``)."""
+    label = loop.split("|")[-1]
+    label = label.replace("evader.step_scale=", "pi, step x").replace("layouts.four=radius ", "pi, layout r")
+    return label.replace(" deg", "\u00b0").replace("exact_component", "exact comp.")
 
 
 def figure_loop_variants(params, inputs, outputs):
@@ -286,7 +289,7 @@ def figure_loop_variants(params, inputs, outputs):
     lv = lv[lv["target"] == "evasive"]
     sw = pd.read_csv(inputs["swap"]) if "swap" in inputs else None
     zc = float(lv["z_crit"].iloc[0])
-    fig, axes = new_figure(2, 2, figsize=(15, 9.5), squeeze=False)
+    fig, axes = new_figure(2, 2, figsize=(15, 10.5), squeeze=False, gridspec_kw={"hspace": 0.55})
     ax = axes[0][0]
     same = lv[lv["comparison"] == "same_paths"].set_index("loop")
     loops = list(same.index)
@@ -295,15 +298,15 @@ def figure_loop_variants(params, inputs, outputs):
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xticks(x)
     ax.set_xticklabels([f"{_loop_label(lp)}\n{r.connected_fraction:.0%} / {r.topology_changes:.0f}"
-                        for lp, r in zip(loops, same.itertuples())], fontsize=6.5, rotation=35, ha="right")
+                        for lp, r in zip(loops, same.itertuples())], fontsize=6.5, rotation=30, ha="right")
     ax.set_ylabel("decentralized minus local late error")
-    ax.set_title(f"(a) closed loops, each on its own paths (+- {zc:.2f} SE; under the labels: connected fraction / "
-                 "topology changes per run)", fontsize=8)
+    ax.set_title(f"(a) closed loops, each on its own paths (+- {zc:.2f} SE);\nunder the labels: connected fraction / "
+                 "topology changes per run", fontsize=8)
     ax = axes[0][1]
     ax.plot(x, same["error_b"], "o-", color="C0", label="local filters (the baseline moves with the loop)")
     ax.plot(x, same["error_a"], "s-", color="C3", label="decentralized filter")
     ax.set_xticks(x)
-    ax.set_xticklabels([_loop_label(lp) for lp in loops], fontsize=6.5, rotation=35, ha="right")
+    ax.set_xticklabels([_loop_label(lp) for lp in loops], fontsize=6.5, rotation=30, ha="right")
     ax.set_ylabel("late error |x_hat - x| (mean over runs)")
     ax.set_title("(b) the errors compared in (a): each loop's own local baseline", fontsize=8)
     ax.legend(fontsize=7)
@@ -325,8 +328,8 @@ def figure_loop_variants(params, inputs, outputs):
         ax.set_xticks(xd)
         ax.set_xticklabels(designs, fontsize=7)
         ax.set_ylabel("decentralized minus local late error")
-        ax.set_title(f"(c) fixed-path swap ({nominal}): every design open loop on recorded paths, same seeds "
-                     f"(+- {zs:.2f} SE)", fontsize=8)
+        ax.set_title(f"(c) fixed-path swap ({nominal}): every design open loop on recorded paths,\nsame target "
+                     f"path and noise seeds (+- {zs:.2f} SE)", fontsize=8)
         ax.legend(fontsize=7)
         ax = axes[1][1]
         sysm = sw[sw["comparison"] == "system"]
@@ -341,8 +344,8 @@ def figure_loop_variants(params, inputs, outputs):
         ax.set_xticks(np.arange(len(cd)))
         ax.set_xticklabels(cd, fontsize=7)
         ax.set_ylabel("system late error minus the local-steered loop's")
-        ax.set_title(f"(d) systems: each design's closed loop vs the local loop, paired by seed (+- {zs:.2f} SE)",
-                     fontsize=8)
+        ax.set_title(f"(d) systems: each design's closed loop minus the loop the local filters steer,\npaired by seed "
+                     f"(+- {zs:.2f} SE); settings: evader step and four-agent layout", fontsize=8)
         ax.legend(fontsize=6.5)
     else:
         axes[1][0].set_visible(False)

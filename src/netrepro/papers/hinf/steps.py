@@ -81,6 +81,8 @@ Tables (all under ``results/hinf/``)
     :func:`swap_comparisons`.
 ``kalman_best.csv`` (issue 28)
     H-infinity against Kalman filters at their best, see :func:`kalman_best_merge_step`.
+``evader_fused.csv`` (issue 37)
+    the evader's objective tr Q_fused against the other targets, see :func:`fused_comparisons`.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
     connected_fraction, min_lambda2, topology_changes`` per trajectory run (steps at which a link appears or
@@ -97,7 +99,7 @@ import pandas as pd
 from .algebra import rotation
 from .consensus import (adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius,
                         pi_consensus_time_constants, run_pi_consensus, topology_changed)
-from .evader import evader_decisions
+from .evader import evader_decisions, fused_trace_along
 from ...errors import InputError
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
 from .model import (FILTER_KINDS, KINDS, FilterDoesNotExist, bonferroni_z, layout_positions, paired_z, resolve_scenario,
@@ -109,7 +111,7 @@ __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
     "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step", "loop_variants_shard_step",
-    "loop_variants_merge_step", "recorded_evader_paths", "kalman_best_shard_step", "kalman_best_merge_step", "fig6_paths_step",
+    "loop_variants_merge_step", "recorded_evader_paths", "kalman_best_shard_step", "fused_comparisons", "kalman_best_merge_step", "fig6_paths_step",
     "design_consensus", "loop_swap_shard_step", "swap_comparisons", "loop_swap_merge_step",
 ]
 
@@ -1183,14 +1185,17 @@ def kalman_best_shard_step(params, inputs, outputs):
             sc.update(target="replay", target_path=recorded_evader_paths(sc, int(kb["replay_seeds"][phase])))
         res = run_paired(sc, [float(c) for c in kb["gamma_factors"]], [float(f) for f in kb["W_factors"]])
         disp = _displacement(res["out"]["target"], int(kb["displacement_lag"]))
+        # the evader's objective (19) along this task's paths, late window (steps start..K of tr Q_fused)
+        fz = fused_trace_along(res["out"]["target"], res["out"]["agents"], sc["model"])[:, start - 1:].mean(1)
         for lab, e in res["out"]["errors"].items():
             base = res["base"][lab]
             frames.append(pd.DataFrame({
                 "task": int(t), "target": target, "phase": phase, "label": lab, "family": "kalman" if FILTER_KINDS[base][1] else "hinf",
                 "kind": FILTER_KINDS[base][0], "gamma": res["gammas"][lab],
                 "W_factor": res["w_factor"].get(lab, 1.0), "run": np.arange(runs), "error": window_means(e, start),
-                "displacement": disp}))
-    cols = ["task", "target", "phase", "label", "family", "kind", "gamma", "W_factor", "run", "error", "displacement"]
+                "displacement": disp, "fused_trace": fz}))
+    cols = ["task", "target", "phase", "label", "family", "kind", "gamma", "W_factor", "run", "error", "displacement",
+            "fused_trace"]
     table = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
     return {"table": table, "provenance": {"tasks": [int(t) for t in mine]}}
 
@@ -1212,13 +1217,14 @@ def kalman_best_merge_step(params, inputs, outputs):
     inputs : dict
         ``shards``: the shard tables of :func:`kalman_best_shard_step`.
     outputs : dict
-        ``table`` (``results/hinf/kalman_best.csv``).
+        ``table`` (``results/hinf/kalman_best.csv``) and ``fused`` (``results/hinf/evader_fused.csv``).
 
     Returns
     -------
     dict
-        ``{"table": DataFrame}``: one row per target, kind and comparison (labels, means, paired
-        difference, standard error, z, ``z_crit``, ``tag`` and displacement).
+        ``{"table": DataFrame, "fused": DataFrame}``: one row per target, kind and comparison (labels, means,
+        paired difference, standard error, z, ``z_crit``, ``tag`` and displacement), and the evader's objective
+        against the other targets (:func:`fused_comparisons`).
     """
     runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
     runs = runs.sort_values(["task", "label", "run"], kind="stable").drop(columns="task").reset_index(drop=True)
@@ -1251,7 +1257,48 @@ def kalman_best_merge_step(params, inputs, outputs):
     zc = bonferroni_z(float(params["tests"]["alpha"]), len(table))
     table["z_crit"] = zc
     table["tag"] = [tag_z(z, zc) for z in table["z"]]
-    return {"table": table}
+    return {"table": table, "fused": fused_comparisons(runs, float(params["tests"]["alpha"]))}
+
+
+def fused_comparisons(runs: pd.DataFrame, alpha: float, reference: str = "evasive") -> pd.DataFrame:
+    """Does the evader raise its objective? Late-window ``tr Q_fused`` (19)-(24) of the evasive target against the
+    other targets of ``kalman_best`` on the judge runs, paired by seed (``evader_fused.csv``).
+
+    Each target's judge runs share the seed, hence the agents' start, noise stream and initial estimates; the paths
+    differ (the agents react to the target they see). Tagged at the two-sided Bonferroni level over the rows.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        Merged shard rows of :func:`kalman_best_shard_step` (``target, phase, label, run, fused_trace``).
+    alpha : float
+        Family-wise two-sided level.
+    reference : str
+        The target the others are compared with (arm a).
+
+    Returns
+    -------
+    DataFrame
+        ``target_a, target_b, runs, fused_a, fused_b, mean_diff, se, z, frac_a_higher, z_crit, tag`` (``tag``
+        ``holds`` here means the reference's value is significantly *lower*; ``reversed``: higher).
+    """
+    jud = runs[runs["phase"] == "judge"]
+    per = {t: g[g["label"] == g["label"].iloc[0]].sort_values("run")["fused_trace"].to_numpy()
+           for t, g in jud.groupby("target", sort=False)}
+    rows = []
+    for t, b in per.items():
+        if t == reference or reference not in per:
+            continue
+        a = per[reference]
+        m, se, z = paired_z(a, b)
+        rows.append({"target_a": reference, "target_b": t, "runs": len(a), "fused_a": float(a.mean()),
+                     "fused_b": float(b.mean()), "mean_diff": m, "se": se, "z": z, "frac_a_higher": float(np.mean(a > b))})
+    cols = ["target_a", "target_b", "runs", "fused_a", "fused_b", "mean_diff", "se", "z", "frac_a_higher"]
+    table = pd.DataFrame(rows, columns=cols)
+    zc = bonferroni_z(float(alpha), max(1, len(table)))
+    table["z_crit"] = zc
+    table["tag"] = [tag_z(z, zc) for z in table["z"]]
+    return table
 
 
 # --------------------------------------------------------------------------- issue 28: why Fig 6's paths zig-zag
