@@ -399,7 +399,7 @@ def _gain_rows(cfg, traj):
 def _sweet_spot_rows(cfg, summ, at):
     r_max = float(at["r_max"])
     r_tr, r_det, step = sweet_spot_grid(NoiseModel.from_config(cfg["noise"]), r_max, float(at["r_step"]))
-    rows = [{"quantity": "noise.sweet_spot", "value": r_tr,
+    rows = [{"quantity": "noise.sweet_spot", "value": r_tr, "uncertainty": float(step),  # a grid argmin: its step
              "note": f"argmin over r in [0, {r_max:g}] (step {step:g}) of tr M(r) {r_tr:g} and of det M(r) {r_det:g}"}]
     md = summ.loc[("static_mobile", "decentralized")]
     ev = summ.loc[("evasive_hinf", "decentralized")]
@@ -428,6 +428,7 @@ def _premise_rows(pe, evp, z_sig, gamma):
         rows.append({"quantity": "premise.hinf_beats_kalman_evasive",
                      "variant": f"evader.solver={_solver_label(solver, n_iter)} ({runs} runs)",
                      "value": bool((g["z"] < -z_sig).all())})
+    # a test statistic judged against the claims' level z = 2: uncertainty 0 (the threshold is the test's level)
     rows.append({"quantity": "premise.random_target", "value": float(rnd["z"].max()),
                  "note": "paired z (H-infinity minus Kalman) against the random-walk target, by filter and gamma: "
                          + ", ".join(f"{r.label_a} {r.z:+.1f}" for r in rnd.itertuples())})
@@ -453,6 +454,8 @@ def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
 
     same = [desc(ev, d, "same_paths") for d in designs]
     loc = ev.loc[("local_loop", "same_paths")]
+    # the values are paired z scores, test statistics judged against z_crit (the test's level): uncertainty 0, not
+    # a second interval around the statistic (the decisions read the tags)
     rows = [{"quantity": "loop.dec_vs_local_same_paths", "value": float(ev.loc[("pi", "same_paths"), "z"]),
              "note": f"{head}; decentralized minus local filter on each loop's own paths, evasive target: " + "; ".join(same)
                      + ("; random target: " + ", ".join(f"{d} {rnd.loc[(d, 'same_paths'), 'tag']} "
@@ -525,9 +528,14 @@ def _fig6_path_rows(fp: pd.DataFrame, at: dict) -> list[dict]:
 
     head = (f"{int(nom['runs'])} closed-loop runs per variant (Fig 6's scenario, agents moved by the driver), same seeds; "
             f"Bonferroni over the {len(share)} variants at the 5 % family-wise level")
-    rows = [{"quantity": "fig6.reversals", "value": float(nom["reversal_fraction"]), "note": f"{head}. {describe('nominal')}"}]
-    rows += [{"quantity": "fig6.reversals", "variant": v, "value": float(t.loc[v, "reversal_fraction"]), "note": describe(v)}
-             for v in share]
+    # uncertainty: the reversal fraction's half-width at its family's Bonferroni level (z_crit x SE over runs)
+    zc_of = {v: float(t.loc[v, "z_crit"]) if np.isfinite(t.loc[v, "z_crit"]) else
+             float(t["z_crit"].dropna().iloc[0]) if t["z_crit"].notna().any() else 1.96 for v in t.index}
+    unc = {v: float(zc_of[v] * t.loc[v, "reversal_se"]) if np.isfinite(t.loc[v, "reversal_se"]) else 0.0 for v in t.index}
+    rows = [{"quantity": "fig6.reversals", "value": float(nom["reversal_fraction"]), "uncertainty": unc["nominal"],
+             "note": f"{head}. {describe('nominal')}"}]
+    rows += [{"quantity": "fig6.reversals", "variant": v, "value": float(t.loc[v, "reversal_fraction"]),
+              "uncertainty": unc[v], "note": describe(v)} for v in share]
     truth, gain = at["truth_variant"], at["gain_variant"]
     cause = bool(share[truth] >= float(at["truth_keeps_at_least"]) and share[gain] <= float(at["gain_leaves_at_most"])
                  and t.loc[gain, "tag"] == "holds")
