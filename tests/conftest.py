@@ -75,10 +75,10 @@ def copy_repo(target: Path) -> Path:
     return target
 
 
-def run_snakemake(workdir, *args, config="config/test.yaml", check=True, timeout=900):
-    """Snakemake in ``workdir``, running that copy's own ``src/`` (not the live checkout)."""
+def run_snakemake(workdir, *args, config="config/test.yaml", check=True, timeout=900, env=None):
+    """Snakemake in ``workdir``, running that copy's own ``src/`` (not the live checkout); ``env`` adds variables."""
     cmd = [sys.executable, "-m", "snakemake", "--configfile", config, *args]
-    env = dict(os.environ, PYTHONPATH=str(Path(workdir) / "src"))
+    env = dict(os.environ, **(env or {}), PYTHONPATH=str(Path(workdir) / "src"))
     proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=timeout, env=env)
     if check and proc.returncode != 0:
         raise AssertionError(f"{' '.join(cmd)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"

@@ -1,5 +1,6 @@
 """Loading and validating the four data files of a paper (netrepro.paperdata; issues 15, 27, 29)."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -116,7 +117,7 @@ PAPER = {
   statement: "the printed gain is worse than no filter, by a factor of about 3"
   kind: numeric
   asserted: 3.0
-  rule: {value: 0.5, reason: "'about 3': half a unit of the one digit stated"}
+  rule: {value: 0.5, reason: "'about 3': half a unit of the one digit stated", source: {kind: effect_size, ref: "a factor of 3 set before the runs"}}
   quantity: gain_vs_none
   evidence_quantities: [gain]
   depends_on: [horizon]
@@ -132,7 +133,7 @@ PAPER = {
   evidence_quantities: [mse_finite, gain]
   depends_on: []
   asserts_cause: true
-  cause: {variant: "gain=2.5", reason: "with the printed gain 2.5 > 2 the MSE diverges"}
+  cause: {variant: "gain=2.5", reason: "with the printed gain 2.5 > 2 the MSE diverges", control: {holds_fixed: "the plant and the noise", changes: "only the gain"}}
   prior_work: "Sinopoli et al. 2004 (IEEE TAC 49(9)), Theorem 2"
   known: true
   table: results/p/mse.csv
@@ -140,12 +141,24 @@ PAPER = {
 }
 
 
+def registry_text(findings_yaml: str) -> str:
+    """A findings.lock registering the rules of ``findings_yaml`` as written."""
+    import yaml
+
+    from netrepro.paperdata import registered_fields, rule_hash
+
+    return "".join(f'{e["id"]}: {{rule: "{rule_hash(registered_fields(e))}", registered: "2026-12-02", '
+                   f'commit: "fixture"}}\n' for e in yaml.safe_load(findings_yaml))
+
+
 def write_paper(tmp_path, **edits):
+    """The synthetic paper's four data files (with ``edits``) and the registry of its unedited findings."""
     for name, text in PAPER.items():
         for old, new in edits.get(name.split(".")[0], []):
             assert old in text, old
             text = text.replace(old, new, 1)
         (tmp_path / name).write_text(text)
+    (tmp_path / "findings.lock").write_text(registry_text(PAPER["findings.yaml"]))
     return tmp_path
 
 
@@ -182,7 +195,8 @@ def test_malformed_data_files_are_rejected_naming_file_entry_and_field(tmp_path,
 
 
 # ----------------------------------------------------------------------------- the findings gate (issue 27)
-F1_RULE = "  rule: {value: 0.5, reason: \"'about 3': half a unit of the one digit stated\"}\n"
+F1_RULE = ("  rule: {value: 0.5, reason: \"'about 3': half a unit of the one digit stated\", source: {kind: effect_size, "
+           "ref: \"a factor of 3 set before the runs\"}}\n")
 F1_PRIOR = ("  prior_work: \"none found (searched: Google Scholar 'gain scheduled filter printed gains', "
             "the paper's citations)\"\n")
 
@@ -242,11 +256,16 @@ SLUGS = sorted(p.parent.name for p in Path(__file__).resolve().parents[1].glob("
 
 @pytest.mark.parametrize("slug", SLUGS)
 def test_every_finding_of_a_paper_has_a_rule_evidence_and_prior_work(slug):
-    """Every real findings.yaml passes the gate (issue 27): a decision rule with its reason, at least one
-    evidence quantity, depends_on, prior work (a citation, or 'none found' with what was searched)."""
+    """Every real findings.yaml passes the gate (issues 27, 37): a judged finding has a decision rule with its
+    reason (a numeric one, the source of its threshold), an observation has none; every finding has at least one
+    evidence quantity, depends_on, prior work (a citation, or 'none found' with what was searched), and a causal
+    one its isolating control."""
     data = load_paper_data(slug)
     for f in data.findings:
-        assert f.rule_reason and f.evidence_quantities and f.prior_work, f.finding_id
+        assert f.evidence_quantities and f.prior_work, f.finding_id
+        assert bool(f.rule_reason) != f.observation, f.finding_id
+        assert f.kind != "numeric" or f.source, f.finding_id
+        assert not f.asserts_cause or {"holds_fixed", "changes"} <= set(f.cause.get("control", {})), f.finding_id
 
 
 # ----------------------------------------------------------------------------- settings ('at') of errata (issue 29)
@@ -275,8 +294,14 @@ def test_settings_gather_claims_findings_and_errata_by_id(tmp_path):
 
 
 def test_an_id_with_settings_in_two_files_is_refused(tmp_path):
+    """Ids are unique across the four files (issue 38), so the evidence step's settings by id are unambiguous."""
     root = write_paper(tmp_path, errata=[(E1_AT, E1_AT + "  at: {K: 200}\n")],
                        claims=[("- id: C3", "- id: E1"), ("  erratum_id: E1\n", "  at: {a: 1}\n")])
-    data = load_paper_data("p", root)
+    with pytest.raises(ConfigError, match="id 'E1' of errata.yaml clashes with 'E1' of claims.yaml"):
+        load_paper_data("p", root)
+    (tmp_path / "ok").mkdir()
+    data = load_paper_data("p", write_paper(tmp_path / "ok"))
+    clash = type(data)("p", [replace(data.claims[0], claim_id="E1", at={"a": 1})], [dict(data.errata[0], at={"K": 2})],
+                       data.reconstructions, data.findings)
     with pytest.raises(ConfigError, match="id 'E1' has settings .* in both claims.yaml and errata.yaml"):
-        data.settings()
+        clash.settings()

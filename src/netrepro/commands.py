@@ -1,4 +1,4 @@
-"""``python -m netrepro new-paper | check-paper | diff | scale-record | scaling``: the commands for people, beside the runner's.
+"""``python -m netrepro new-paper | check-paper | register-findings | diff | scale-record | scaling``: the commands for people.
 
 Kept apart from :mod:`netrepro.runner`, which every pipeline job runs: a rule's code inputs are the
 modules its job can reach, so the scaffold, the contract and the diff tool stay out of them (an
@@ -12,7 +12,7 @@ import sys
 
 __all__ = ["COMMANDS", "main"]
 
-COMMANDS = ("new-paper", "check-paper", "diff", "scale-record", "scaling")
+COMMANDS = ("new-paper", "check-paper", "register-findings", "diff", "scale-record", "scaling")
 
 
 def _new_paper(args) -> int:
@@ -31,12 +31,50 @@ def _new_paper(args) -> int:
     return 0
 
 
+def _git_head(root) -> str:
+    """The short commit of ``root``'s checkout ("" outside git), with ``+dirty`` when it has uncommitted changes."""
+    import subprocess
+
+    def git(*args):
+        out = subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True, check=False)
+        return out.stdout.strip() if out.returncode == 0 else ""
+
+    head = git("rev-parse", "--short", "HEAD")
+    return head + ("+dirty" if head and git("status", "--porcelain", "--untracked-files=no") else "")
+
+
+def _register_findings(args) -> int:
+    import datetime
+    from pathlib import Path
+
+    from .errors import NetreproError
+    from .paperdata import paper_dir, register_findings
+    from .registry import paper_slugs
+
+    slugs = args.slugs or list(paper_slugs())
+    commit = _git_head(args.root)
+    today = datetime.date.today().isoformat()
+    status = 0
+    for slug in slugs:
+        root = Path(args.root) / "src" / "netrepro" / "papers" / slug if args.root != "." else paper_dir(slug)
+        try:
+            new = register_findings(slug, root, commit=commit, date=today)
+        except NetreproError as exc:
+            print(f"error: {slug}: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        print(f"{slug}: registered {', '.join(new)} at {commit or 'no commit'}; commit findings.lock before the runs"
+              if new else f"{slug}: every finding is registered")
+    return status
+
+
 def main(argv=None) -> int:
     """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code.
 
     ``diff``, ``scale-record`` and ``scaling`` are handed to :func:`netrepro.diff.main`,
     :func:`netrepro.scale.main` and :func:`netrepro.scaling.main` (their own parsers); ``new-paper`` writes a
-    paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`.
+    paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`; ``register-findings`` registers
+    the rules of new findings (:func:`netrepro.paperdata.register_findings`).
 
     Parameters
     ----------
@@ -73,9 +111,15 @@ def main(argv=None) -> int:
     chk = sub.add_parser("check-paper", help="check that papers follow the paper contract (file:line per violation)")
     chk.add_argument("slugs", nargs="*", help="papers to check (default: every registered paper)")
     chk.add_argument("--root", default=".", help="the repository's root (default: here)")
+    reg = sub.add_parser("register-findings",
+                         help="register the rules of new findings in findings.lock, before the runs that test them")
+    reg.add_argument("slugs", nargs="*", help="papers (default: every registered paper)")
+    reg.add_argument("--root", default=".", help="the repository's root (default: here)")
     args = parser.parse_args(argv)
     if args.command == "new-paper":
         return _new_paper(args)
+    if args.command == "register-findings":
+        return _register_findings(args)
     from .contract import main as check_main
 
     return check_main(args.slugs, args.root)

@@ -12,6 +12,10 @@ reading the files (nothing is imported or run), and names the file and line of e
   or ``Yields`` when it returns a value);
 * ``claim-quantity``: every claim and finding names an evidence quantity that the evidence step
   produces (the built ``results/evidence/<slug>.csv`` when present, else a string in ``evidence.py``);
+* ``findings-gate``: the data files load as the workflow loads them (schemas, cross-checks, every
+  finding's rule registered in ``findings.lock`` or amended); with a current evidence table, no
+  statement types a number that is one of its evidence values, and no numeric rule that agrees
+  with our value lacks an independent source of its threshold (issue 37);
 * ``figure-spec``: every figure of ``figures.yaml`` has its plotting function and a caption;
 * ``rule-name``: every rule of ``workflow/rules/<slug>.smk`` starts with the slug;
 * ``config-key``: every configuration key the rules pick for their steps is in the paper's schema.
@@ -285,6 +289,50 @@ def _check_quantities(slug: str, pkg: Path, root: Path) -> list[Violation]:
     return out
 
 
+def _check_findings_gate(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    """The verdict gate of issue 37 on the paper's data: files valid, rules registered, statements from evidence.
+
+    The data files are loaded as the workflow loads them (schema, cross-checks, ``findings.lock``);
+    with a built evidence table no older than ``findings.yaml``, every finding's statement is
+    checked for a typed number that is one of its evidence values (a self-referential statement)
+    and every numeric rule whose asserted value equals our value within its tolerance must name
+    an independent source of its threshold.
+    """
+    from .errors import NetreproError
+    from .paperdata import load_paper_data, typed_numbers
+    from .verdicts import NOMINAL, agrees, read_evidence
+
+    findings_path = pkg / "findings.yaml"
+    try:
+        data = load_paper_data(slug, pkg)
+    except NetreproError as exc:
+        return [Violation(_rel(findings_path, root), 0, "findings-gate", str(exc).replace("\n", " "))]
+    built = root / "results/evidence" / f"{slug}.csv"
+    if not built.is_file() or not findings_path.is_file() or built.stat().st_mtime < findings_path.stat().st_mtime:
+        return []
+    evidence = read_evidence(built)
+    text = findings_path.read_text()
+    out = []
+    for f in data.findings:
+        line = _line_of(text, f"id: {f.finding_id}")
+        values = {q: evidence[q][NOMINAL][0] for q in f.evidence_quantities if NOMINAL in evidence.get(q, {})}
+        typed = typed_numbers(f.statement, values)
+        if typed:
+            out.append(Violation(_rel(findings_path, root), line, "findings-gate",
+                                 f"{f.finding_id}: the statement types {', '.join(typed)}; write a template field "
+                                 "({quantity:.2f}) so it is filled from the evidence"))
+        rules = [f.registered_rule, f] if f.amendments else [f]
+        for rule in rules[-1:]:
+            ours = evidence.get(rule.quantity, {}).get(NOMINAL)
+            if rule.kind == "numeric" and ours is not None and agrees(rule, ours) and not rule.source:
+                out.append(Violation(_rel(findings_path, root), line, "findings-gate",
+                                     f"{f.finding_id}: the rule's threshold {rule.asserted:g} equals our value within "
+                                     "its tolerance and names no independent source (rule.source: paper, limit, "
+                                     "control or effect_size): it only checks our own rounding; make it an "
+                                     "observation or give the source"))
+    return out
+
+
 def _check_figures(slug: str, pkg: Path, root: Path) -> list[Violation]:
     spec_path, fig_path = pkg / "figures.yaml", pkg / "figures.py"
     if not spec_path.is_file():
@@ -399,7 +447,8 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     if not pkg.is_dir():
         return [Violation(_rel(pkg, root), 0, "roles", f"paper {slug!r} has no package")]
     return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
-            *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_figures(slug, pkg, root),
+            *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_findings_gate(slug, pkg, root),
+            *_check_figures(slug, pkg, root),
             *_check_rule_names(slug, root), *_check_config_keys(slug, root)]
 
 

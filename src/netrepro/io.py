@@ -18,11 +18,39 @@ from pathlib import Path
 __all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml"]
 
 
+def _yaml_loader():
+    """libyaml's safe loader (PyYAML's when libyaml is missing) that reads YAML 1.2 floats such as ``1.0e12``.
+
+    YAML 1.1, which PyYAML implements, reads a float written without a dot or without a sign in
+    its exponent (``1e-5``, ``1.0e12``) as text; YAML 1.2 and every other reader take it as a
+    number. Built once per process.
+    """
+    import re
+
+    import yaml
+
+    if _LOADER:
+        return _LOADER[0]
+    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    loader = type("NetreproLoader", (base,), {})
+    loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+        list("-+0123456789."))
+    _LOADER.append(loader)
+    return loader
+
+
+_LOADER: list = []
+
+
 def load_yaml(text: str):
     """``yaml.safe_load`` through libyaml's parser when PyYAML has it (same objects, ~10x faster).
 
     The workflow parses the papers' claims, errata, findings and figure lists at every start
-    (also a no-op rerun), where the pure-Python parser took seconds.
+    (also a no-op rerun), where the pure-Python parser took seconds. Floats in exponent form are
+    read as numbers whether or not they carry a dot and an exponent sign (``1e-5``, ``1.0e12``:
+    YAML 1.2), where YAML 1.1 would read them as text.
 
     Parameters
     ----------
@@ -36,7 +64,7 @@ def load_yaml(text: str):
     """
     import yaml
 
-    return yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # noqa: S506 (a safe loader)
+    return yaml.load(text, Loader=_yaml_loader())  # noqa: S506 (a safe loader)
 
 
 @contextlib.contextmanager

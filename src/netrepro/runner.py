@@ -39,6 +39,7 @@ import time
 import warnings
 from pathlib import Path
 
+from .errors import LMIError
 from .io import write_table
 from .provenance import (PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, step_environment, verify_output,
                          verify_tree, write_sidecar, write_unfinished_sidecar)
@@ -140,6 +141,31 @@ def _nonfinite(frame: pd.DataFrame) -> dict:
     return counts
 
 
+def _refuse_undecided_step(rule: str) -> None:
+    """Stop a step whose certificates decided nothing, naming the solver's statuses (before any table is written).
+
+    Its tables would hold no decision, and a later step would stop on a symptom (a design missing
+    from a table) instead of the cause.
+    """
+    module = sys.modules.get("netrepro.engines.cvx")
+    decisions = module.certified_decisions() if module is not None else {}
+    if decisions and set(decisions) == {"undecided"}:
+        statuses = ", ".join(f"{k}: {v}" for k, v in module.solver_statuses().items()) or "none recorded"
+        raise LMIError(f"rule {rule}: every one of its {decisions['undecided']} certified decisions is undecided "
+                        f"(solver {module.SOLVER}, statuses {statuses}): the solver did not converge, so this "
+                        "step decides nothing; check the solver's installation and settings "
+                        f"({module.FAULT_MAX_ITER} caps it when set)")
+
+
+def _solver_statuses() -> dict:
+    """The solver statuses of this process's solves (:func:`netrepro.engines.cvx.solver_statuses`); {} if none.
+
+    Read only when the step imported the engine: a step without LMIs does not import cvxpy for this.
+    """
+    module = sys.modules.get("netrepro.engines.cvx")
+    return module.solver_statuses() if module is not None else {}
+
+
 def _summarize_warnings(caught) -> list[dict]:
     """Warnings raised by a step, one entry per distinct (category, message, place) with its count.
 
@@ -210,6 +236,7 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
         warnings.simplefilter("always")
         result = func(params, inputs, outputs) or {}
     elapsed = time.perf_counter() - start
+    _refuse_undecided_step(rule)
     extra = dict(result.pop("provenance", {}) if isinstance(result, dict) else {})
     summary = _summarize_warnings(caught)
     for item in summary:
@@ -217,6 +244,15 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
                     item["count"])
     if summary:
         extra.setdefault("warnings", summary)
+    statuses = _solver_statuses()
+    if statuses:
+        extra.setdefault("solver_statuses", statuses)
+        unsure = {k: v for k, v in statuses.items() if k != "optimal"}
+        if unsure:
+            log.warning("rule %s: %d of %d solves did not end optimal (%s): their decisions rest on the "
+                        "certificates, and points the certificates cannot decide are undecided", rule,
+                        sum(unsure.values()), sum(statuses.values()),
+                        ", ".join(f"{k}: {v}" for k, v in unsure.items()))
     nonfinite = {}
     for name, value in result.items():
         if name not in outputs:

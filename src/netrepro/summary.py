@@ -17,12 +17,15 @@ import re
 
 import pandas as pd
 
-from .verdicts import SCORED_ERRATUM_KINDS, TESTABLE_VERDICTS, VERDICTS
+from .verdicts import FINDING_VERDICTS, SCORED_ERRATUM_KINDS, TESTABLE_VERDICTS, VERDICTS
 
-__all__ = ["SCORECARD_COLUMNS", "scorecard", "replication_summary", "summary_sentences", "STATUSES"]
+__all__ = ["SCORECARD_COLUMNS", "FINDING_COUNT_COLUMNS", "scorecard", "replication_summary", "summary_sentences",
+           "STATUSES"]
 
+# our findings by verdict (issue 37): a failing or retracted finding is counted, never dropped
+FINDING_COUNT_COLUMNS = [f"findings_{v}" for v in FINDING_VERDICTS]
 SCORECARD_COLUMNS = ["paper", "claims", *VERDICTS, "other", "testable", "scored_reproduced_pct", "errata",
-                     "minor_errata", "findings"]
+                     "minor_errata", "findings", *FINDING_COUNT_COLUMNS]
 STATUSES = ("replicated", "partially", "not replicated", "not testable", "no claim")
 # a group is replicated when every testable claim of it is reproduced; partially when some hold (reproduced
 # or conditional); not replicated when none does
@@ -60,7 +63,8 @@ def scorecard(claims: dict, errata: dict | None = None, findings: dict | None = 
     DataFrame
         Columns :data:`SCORECARD_COLUMNS`. Verdicts outside the vocabulary are counted in ``other``
         so that the verdict columns add up to ``claims``; ``testable`` counts reproduced, conditional,
-        differs and erratum; ``scored_reproduced_pct`` is reproduced / testable in percent.
+        differs, erratum and undecided; ``scored_reproduced_pct`` is reproduced / testable in percent;
+        ``findings_<verdict>`` counts our findings by verdict (the registered rule's verdict).
     """
     errata, findings = errata or {}, findings or {}
     rows = []
@@ -72,6 +76,8 @@ def scorecard(claims: dict, errata: dict | None = None, findings: dict | None = 
         row["errata"], row["minor_errata"] = _errata_split(errata.get(slug))
         found = findings.get(slug)
         row["findings"] = 0 if found is None else len(found)
+        found_counts = _verdicts(found).value_counts()
+        row.update({f"findings_{v}": int(found_counts.get(v, 0)) for v in FINDING_VERDICTS})
         rows.append(row)
     table = pd.DataFrame(rows, columns=[c for c in SCORECARD_COLUMNS if c not in ("testable", "scored_reproduced_pct")])
     total = {"paper": "total", **{c: int(table[c].sum()) for c in table.columns[1:]}}

@@ -18,7 +18,13 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
-    from netrepro.paperdata import DATA_FILES, load_paper_data, paper_dir, referenced_tables
+    from netrepro.paperdata import (
+        DATA_FILES,
+        LOCK_FILE,
+        load_paper_data,
+        paper_dir,
+        referenced_tables,
+    )
 except ImportError as exc:
     raise WorkflowError(
         f"cannot import the netrepro package with {sys.executable}: {exc}. "
@@ -115,9 +121,12 @@ def notebook(slug="{params.slug}"):
 
 
 def paper_data_files(slug):
-    """The data files of a paper's claims layer (claims, errata, reconstructions, findings)."""
+    """The data files of a paper's claims layer (claims, errata, reconstructions, findings, the findings' registry)."""
     root = Path("src/netrepro/papers") / slug
-    return {f"{name}_file": str(root / f"{name}.yaml") for name in DATA_FILES}
+    files = {f"{name}_file": str(root / f"{name}.yaml") for name in DATA_FILES}
+    if (root / LOCK_FILE).is_file():
+        files["registry_file"] = str(root / LOCK_FILE)
+    return files
 
 
 def paper_claim_tables(slug):

@@ -516,7 +516,9 @@ def find_dual_certificate(coeffs: LMICoefficients, route: str = "exact", box=Non
     cones = [clarabel.NonnegativeConeT(1 + n_box)]
     cones += [clarabel.PSDTriangleConeT(n) if n > 1 else clarabel.NonnegativeConeT(1) for n in sizes]
     q = np.append(np.zeros(m), -1.0)
-    st = clarabel.DefaultSettings()
+    from .cvx import clarabel_settings
+
+    st = clarabel_settings(clarabel.DefaultSettings())
     st.verbose = False
     for k, v in (settings or {}).items():
         setattr(st, k, v)
@@ -795,6 +797,34 @@ class CertifiedLMI:
 
     def certify(self, solver_status: str = "", necessary: Callable[[], tuple] | None = None,
                 coeffs: LMICoefficients | None = None) -> Verdict:
+        """Decide the system at the current parameter values (:meth:`decide`), counted for the step.
+
+        Each verdict is counted (:func:`netrepro.engines.cvx.record_decision`): a step whose
+        certificates decide nothing fails at its end naming the solver's statuses, instead of
+        writing tables that a later step would find empty.
+
+        Parameters
+        ----------
+        solver_status : str
+            As :meth:`decide`.
+        necessary : callable, optional
+            As :meth:`decide`.
+        coeffs : LMICoefficients, optional
+            As :meth:`decide`.
+
+        Returns
+        -------
+        Verdict
+            The certified verdict.
+        """
+        from .cvx import record_decision
+
+        verdict = self.decide(solver_status, necessary, coeffs)
+        record_decision(verdict.verdict)
+        return verdict
+
+    def decide(self, solver_status: str = "", necessary: Callable[[], tuple] | None = None,
+               coeffs: LMICoefficients | None = None) -> Verdict:
         """Decide the system at the current parameter values from the current variable values.
 
         Order: (1) our eigenvalue check of the point (:func:`check_point`): ``feasible``;
@@ -875,14 +905,14 @@ class CertifiedLMI:
 
         if self.problem is None:
             raise LMIError("CertifiedLMI.solve needs the problem= it was built with")
-        solve_kwargs.setdefault("solver", "CLARABEL")
+        from .cvx import solve_problem
+
         for v in self.variables:
             v.value = None
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", UserWarning)
-                self.problem.solve(**solve_kwargs)
-            status = str(self.problem.status)
+                status = solve_problem(self.problem, **solve_kwargs)
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
         return self.certify(status, necessary)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .cvx import cp
+from .cvx import cp, solve_problem
 
 __all__ = [
     "LMIOutcome",
@@ -26,7 +26,7 @@ __all__ = [
     "MareStabilizabilityLMI",
 ]
 
-SOLVER = "CLARABEL"
+from .cvx import SOLVER  # noqa: E402  (re-exported: the project's solver)
 
 
 @dataclass
@@ -477,7 +477,7 @@ class MareStabilizabilityLMI:
         self.sqrt_w.value = np.sqrt(weights)
         self.n_solves += 1
         try:
-            self.problem.solve(solver=SOLVER)
+            solve_problem(self.problem)
             status = str(self.problem.status)
         except cp.error.SolverError as exc:
             return LMIOutcome(f"solver_error: {exc}", np.nan, False, False, np.nan)

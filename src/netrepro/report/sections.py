@@ -12,7 +12,7 @@ from markupsafe import Markup
 
 from ..registry import load_registry
 from ..provenance import sidecar_path
-from ..summary import replication_summary, summary_sentences
+from ..summary import FINDING_COUNT_COLUMNS, replication_summary, summary_sentences
 from ..verdicts import TESTABLE_VERDICTS, VERDICTS
 from .markup import img, read_csv, render, rst_html
 from .notebooks import figure_captions, figure_sort_key
@@ -104,7 +104,7 @@ def claims_html(frame: pd.DataFrame, slug: str) -> str:
     str
         The table's HTML.
     """
-    names = ("claim_id", "location", "statement", "paper_value", "reproduced_value", "tolerance",
+    names = ("claim_id", "location", "statement", "paper_value", "reproduced_value", "uncertainty", "tolerance",
              "tolerance_reason", "test", "verdict", "robust", "condition", "erratum_id", "note")
     rows = []
     for _, row in frame.iterrows():
@@ -237,7 +237,8 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
     """
     total = score.iloc[-1]
     shown = list(VERDICTS)
-    counted = [*shown, "claims", "testable", "other", "errata", "minor_errata", "findings"]
+    counted = [*shown, "claims", "testable", "other", "errata", "minor_errata", "findings",
+               *(c for c in FINDING_COUNT_COLUMNS if c in score.columns)]
     rows = []
     for _, row in score.iterrows():
         slug = row["paper"]
@@ -254,7 +255,9 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
                         our_figures=sum(Path(f).stem.startswith("figS") for f in figs))
         rows.append(item)
     pct = total["scored_reproduced_pct"]
+    finding_verdicts = [c.removeprefix("findings_") for c in FINDING_COUNT_COLUMNS if c in score.columns]
     return render("scorecard.html", total={k: int(total[k]) for k in counted}, shown=shown,
+                  finding_verdicts=finding_verdicts,
                   untestable=[v for v in shown if v not in TESTABLE_VERDICTS], show_other=int(total["other"]) > 0,
                   rows=rows, pct="" if pd.isna(pct) else f"{pct:.1f} %")
 

@@ -15,12 +15,15 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from datetime import date
 from pathlib import Path
 from string import Template
 
 import yaml
 
 from ..errors import InputError
+from ..io import load_yaml
+from ..paperdata import LOCK_FILE, registry_lock_text
 from ..registry import load_registry, registry_entry_text, valid_slug
 
 __all__ = ["Plan", "plan_new_paper", "write_plan", "new_paper"]
@@ -127,6 +130,10 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
     create[f"workflow/schemas/{slug}.schema.yaml"] = _render("schema.yaml.tmpl", values)
     create[f"workflow/report/{slug}/fig1.rst"] = _render("caption.rst.tmpl", values)
     create[f"workflow/notebooks/{slug}.ipynb"] = ""  # written by the report's notebook template
+    # the example finding's rule, registered with the skeleton (issue 37): a new finding is registered
+    # with `python -m netrepro register-findings` before the runs that test it
+    create[f"src/netrepro/papers/{slug}/{LOCK_FILE}"] = registry_lock_text(
+        load_yaml(create[f"src/netrepro/papers/{slug}/findings.yaml"]) or [], "new-paper", date.today().isoformat())
     taken = [p for p in create if (root / p).exists()]
     if taken:
         raise InputError(f"new-paper: {taken[0]} already exists (paper {slug!r} is partly there); nothing written")

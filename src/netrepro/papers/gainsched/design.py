@@ -44,8 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...engines.cvx import cp
-from ...engines.lmi import SOLVER
+from ...engines.cvx import cp, solve_problem
 from .model import Gains, GainschedError, System
 
 __all__ = ["Theorem3", "Theorem3Solution", "FixedGainsVertexLMI", "zero_diagonal_blocks", "recover_gains", "recover_output_gains", "certified_cost",
@@ -456,7 +455,7 @@ class Theorem3:
         self.sigma2.value = self.sys.sigma2 if sigma2 is None else float(sigma2)
         start = time.perf_counter()
         try:
-            self.problem.solve(solver=SOLVER)
+            solve_problem(self.problem)
             status = str(self.problem.status)
         except cp.error.SolverError as exc:
             return Theorem3Solution(f"solver_error: {exc}", np.nan, np.nan, False,
@@ -885,7 +884,7 @@ class FixedGainsVertexLMI:
 
         self.sigma2.value = float(sigma2)
         try:
-            self.problem.solve(solver=SOLVER)
+            solve_problem(self.problem)
             status = str(self.problem.status)
         except cp.error.SolverError as exc:  # pragma: no cover - solver failure path
             status = f"solver_error: {exc}"

@@ -551,7 +551,7 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     """
     from ...engines.certify import CertifiedLMI
     from ...engines.cvx import cp
-    from ...engines.lmi import SOLVER
+    from ...engines.cvx import solve_problem
 
     nn = 2 * sys.n
     Q0 = cp.Variable((nn, nn), symmetric=True, name="Q0")
@@ -576,7 +576,7 @@ def theorem1_lmi(sys: System, gains: Gains, n_grid: int = 3, margin_tol: float =
     prob = cp.Problem(cp.Maximize(t), cons)
     certifier = CertifiedLMI(blocks, problem=prob, drop=(t,))
     try:
-        prob.solve(solver=SOLVER)
+        solve_problem(prob)
         status = str(prob.status)
     except cp.error.SolverError as exc:  # pragma: no cover - solver failure path
         return Theorem1Result(f"solver_error: {exc}", np.nan, False, None, None, None, len(grid) ** 2)

@@ -31,11 +31,11 @@ def _cp():
     return cp
 
 
-def _solver() -> str:
-    """The shared engine's solver (:data:`netrepro.engines.lmi.SOLVER`), imported lazily with cvxpy."""
-    from ...engines.lmi import SOLVER
+def _solve_problem(problem) -> str:
+    """Solve through the shared engine (:func:`netrepro.engines.cvx.solve_problem`), imported lazily with cvxpy."""
+    from ...engines.cvx import solve_problem as solve
 
-    return SOLVER
+    return solve(problem)
 
 
 # ----------------------------------------------------------------------------- Theorem 2 LMI (10)-(11)
@@ -189,7 +189,7 @@ class GilbertElliottLMI:
         try:
             with warnings.catch_warnings():  # "optimal_inaccurate" is kept as a status, not printed
                 warnings.simplefilter("ignore", UserWarning)
-                self.problem.solve(solver=_solver())
+                _solve_problem(self.problem)
             status = str(self.problem.status)
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
@@ -298,7 +298,7 @@ def rebuild_solve(A, C, p, q, l_o=None, margin_tol=1e-7) -> LMIResult:
     prob = cp.Problem(cp.Maximize(t), [0.5 * (lmi10 + lmi10.T) >> t * np.eye(3 * n),
                                        0.5 * (psi + psi.T) >> t * np.eye(n * (r + 1)), Y << np.eye(n)])
     try:
-        prob.solve(solver=_solver())
+        _solve_problem(prob)
         status = str(prob.status)
     except cp.error.SolverError as exc:
         status = f"solver_error: {exc}"
