@@ -186,3 +186,19 @@ def test_fused_comparisons_pair_the_targets_by_run():
     assert list(t.index) == ["evader_replay", "random"]
     assert t.loc["evader_replay", "mean_diff"] == pytest.approx(1.0) and t.loc["random", "mean_diff"] == pytest.approx(1.5)
     assert t.loc["random", "fused_a"] == pytest.approx(2.2)  # judge runs only
+
+
+def test_steering_decision_is_every_setting():
+    from netrepro.papers.hinf.evidence import _swap_rows
+
+    rows = []
+    for setting, tag in (("nominal", "holds"), ("other", "reversed")):
+        for comp, loop, design in (("fixed_paths", "pi", "pi"), ("fixed_paths", "local_loop", "pi"),
+                                   ("steering_local", "pi", "pi"), ("system", "pi", "pi")):
+            rows.append({"setting": setting, "comparison": comp, "loop": loop, "design": design, "pairing": "seed",
+                         "runs": 5, "error_a": 1.0, "error_b": 1.0, "mean_diff": 0.1, "se": 0.01, "z": 10.0,
+                         "frac_a_better": 0.5, "connected_fraction": 0.5, "topology_changes": 3.0, "z_crit": 3.0,
+                         "tag": tag if comp == "steering_local" else "holds"})
+    ev = {(r["quantity"], r.get("variant", "nominal")): r["value"] for r in _swap_rows(pd.DataFrame(rows))}
+    assert ev[("loop.steering_lowers_local", "nominal")] is False  # one setting fails: the rule fails
+    assert ev[("loop.steering_lowers_local", "setting nominal")] is True

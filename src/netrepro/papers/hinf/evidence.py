@@ -731,9 +731,16 @@ def _swap_rows(sw: pd.DataFrame) -> list[dict]:
                      **({} if nom else {"variant": f"{r.setting}: loop={r.loop}"}),
                      "note": (f"{head}. Local filters' late error in the loop {r.loop} steers, {r.error_a:.3f}, minus in the "
                               f"loop the local filters steer, {r.error_b:.3f}: {r.mean_diff:+.3f} ({r.tag}, z = {r.z:+.1f})")})
+    # F_steering_local_error's rule: significantly lower at every setting of the table (the nominal value), each
+    # setting's own decision listed as a variant
+    every = bool(all(dec["steering_lowers_local"].values()))
+    rows.append({"quantity": "loop.steering_lowers_local", "value": every,
+                 "note": "local filters' error in the PI loop minus in the local loop holds (significantly lower) at: "
+                         + ", ".join(f"{k} {'yes' if v else 'no'}" for k, v in dec["steering_lowers_local"].items())
+                         + f"; every setting: {every}"})
     for setting in settings:
-        rows.append({"quantity": "loop.steering_lowers_local", "value": dec["steering_lowers_local"][setting],
-                     **({} if setting == nominal else {"variant": setting})})
+        rows.append({"quantity": "loop.steering_lowers_local", "variant": f"setting {setting}",
+                     "value": dec["steering_lowers_local"][setting]})
     sysm = sw[sw["comparison"] == "system"]
     vs = sw[sw["comparison"] == "system_vs_pi"].set_index(["setting", "design"])
     for setting in settings:
