@@ -596,6 +596,8 @@ def _variants_note(entry, variants: dict, outcome_words: tuple) -> str:
 
 
 def _outcome_word(entry, value, outcome_words: tuple) -> str:
+    if getattr(entry, "observation", False):
+        return "measured" if compare_observed(value) else UNDECIDED
     yes, no = outcome_words
     return {AGREES: yes, DISAGREES: no, UNDECIDED: UNDECIDED}[compare(entry, value)]
 
@@ -768,6 +770,11 @@ def _judge_finding(f: FindingEntry, evidence: dict, slug: str) -> tuple:
     return judge(f, value, variants), value, value[1], variants
 
 
+def _noted(f: FindingEntry) -> FindingEntry:
+    """The rule whose outcomes the note gives for the variants: the registered one of an amended observation."""
+    return f.registered_rule if (f.observation and f.amendments) else f
+
+
 def compare_observed(value) -> bool:
     """Whether an observation's value is decided: a decided row with a real value (not NaN or empty).
 
@@ -860,8 +867,7 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
         others = "; ".join(f"{q}: {_fmt_cell(_as_cell(evidence[q].get(NOMINAL, ('', ''))))}"
                            for q in f.evidence_quantities[1:])
         shown = _fmt_cell(value) if _bare(value) != "" else ""
-        text = "; ".join(x for x in (f.evidence, shown, note,
-                                     _variants_note(f, variants, ("holds", "fails")) if not f.observation else "",
+        text = "; ".join(x for x in (f.evidence, shown, note, _variants_note(_noted(f), variants, ("holds", "fails")),
                                      f"also rests on {others}" if others else "") if x)
         control = f.cause.get("control", {})
         rows.append({"paper": data.slug, "finding_id": f.finding_id, "statement": _statement(f, evidence, data.slug),
