@@ -435,6 +435,15 @@ def _premise_rows(pe, evp, z_sig, gamma):
     return rows
 
 
+def _se_halfwidth(row, zc: float) -> dict:
+    """Half-widths ``zc x SE`` of a loop_variants.csv row's connected fraction and topology changes (0 if absent)."""
+    out = {}
+    for col in ("connected_fraction", "topology_changes"):
+        se = float(row[f"{col}_se"]) if f"{col}_se" in row.index else math.nan
+        out[col] = float(zc * se) if np.isfinite(se) else 0.0
+    return out
+
+
 def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
     """Issue 28, part 1: the closed-loop consensus variants against the evasive target (loop_variants.csv)."""
     ev = lv[lv["target"] == "evasive"].set_index(["loop", "comparison"])
@@ -494,14 +503,18 @@ def _loop_rows(lv: pd.DataFrame, horizon: int) -> list[dict]:
         label = d.split("|", 1)[1]
         rows.append({"quantity": "loop.dec_vs_local_same_paths", "variant": label, "value": float(r["z"]),
                      "note": desc(ev, d, "same_paths")})
-        rows.append({"quantity": "fig6.topology_changes", "variant": label, "value": float(r["topology_changes"])})
+        unc = _se_halfwidth(r, zc)
+        rows.append({"quantity": "fig6.topology_changes", "variant": label, "value": float(r["topology_changes"]),
+                     "uncertainty": unc["topology_changes"]})
         rows.append({"quantity": "fig6.connectivity", "variant": label, "value": float(r["connected_fraction"]),
+                     "uncertainty": unc["connected_fraction"],
                      "note": f"connected fraction of the late steps, {int(r['runs'])} closed-loop runs"})
         if label.startswith("layouts.four"):
             rows.append({"quantity": "r20.connected", "variant": f"{label} (Fig 6, late steps, {int(r['runs'])} runs)",
                          "value": bool(r["connected_fraction"] == 1.0),
                          "note": f"connected {r['connected_fraction']:.0%} of late steps"})
     rows.append({"quantity": "fig6.topology_changes", "value": float(ev.loc[("pi", "same_paths"), "topology_changes"]),
+                 "uncertainty": _se_halfwidth(ev.loc[("pi", "same_paths")], zc)["topology_changes"],
                  "note": f"mean topology changes per run ({horizon} steps) of the graph (25) against the evasive target: "
                          + ", ".join(f"{d} {ev.loc[(d, 'same_paths'), 'topology_changes']:.0f}" for d in designs + ["local_loop"])})
     return rows
@@ -928,8 +941,14 @@ def evidence_step(params, inputs, outputs):
                  "note": f"max degree {deg}, connected fraction {summ.loc[('fig2', 'local'), 'connected_fraction']:g}"})
     conn_rows, ev_frac, conn_note = _connectivity_rows(summ, pd.read_csv(inputs["connectivity"]))
     rows += conn_rows
+    net = pd.read_csv(inputs["evasive_network"])
+    # uncertainty: 1.96 SE of a mean over the Fig-6 runs of both scenarios, the per-run spread taken from the
+    # connectivity check's evasive runs (evasive_network.csv; same scenario, its own seeds and late window)
+    sd = float(net.loc[net["target"] == "evasive", "connected_fraction"].std(ddof=1))
+    n_fig6 = int(summ.loc[("evasive_hinf", "decentralized"), "n_runs"]) + int(summ.loc[("evasive_kalman", "kalman_decentralized"), "n_runs"])
     rows.append({"quantity": "fig6.connectivity", "value": ev_frac,
-                 "note": conn_note + "; " + _network_effect(pd.read_csv(inputs["evasive_network"]))})
+                 "uncertainty": float(1.96 * sd / math.sqrt(n_fig6)) if np.isfinite(sd) else 0.0,
+                 "note": conn_note + "; " + _network_effect(net)})
     # Figs 2-3
     for scen in ("fig2", "fig3"):
         rows += _fig_comparison_rows(scen, paired, summ, pa, z_sig, cfg)

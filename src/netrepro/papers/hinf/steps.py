@@ -1040,7 +1040,7 @@ def loop_variants_merge_step(params, inputs, outputs):
     """Step: the closed-loop consensus variants' comparisons (``loop_variants.csv``) from the shards.
 
     Per target and loop: the connected fraction and the number of topology changes (per run, over the
-    horizon), and two paired comparisons, each tagged ``holds`` / ``not significant`` / ``reversed`` at the
+    horizon; means and their standard errors over runs), and two paired comparisons, each tagged ``holds`` / ``not significant`` / ``reversed`` at the
     Bonferroni-corrected two-sided level ``tests.alpha`` over every comparison of the table (fixed before
     the runs):
 
@@ -1080,7 +1080,9 @@ def loop_variants_merge_step(params, inputs, outputs):
             r = g[g["loop"] == loop].set_index("run")
             common = dict(target=target, loop=loop, driver=r["driver"].iloc[0], runs=len(r),
                           connected_fraction=float(r["connected_fraction"].mean()),
+                          connected_fraction_se=float(r["connected_fraction"].std(ddof=1) / math.sqrt(len(r))),
                           topology_changes=float(r["topology_changes"].mean()),
+                          topology_changes_se=float(r["topology_changes"].std(ddof=1) / math.sqrt(len(r))),
                           topology_changes_min=int(r["topology_changes"].min()),
                           topology_changes_max=int(r["topology_changes"].max()))
             comps = [("same_paths", r["decentralized"], r["local"])]
