@@ -1166,8 +1166,9 @@ def kalman_best_shard_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame, "provenance": {"tasks": [...]}}``: one row per task, filter and run
-        (family, kind, gamma, ``W_factor``, late error, target displacement) and the task indices
-        of this shard.
+        (family, kind, gamma, ``W_factor``, late error, target displacement, ``fused_trace``: the run's
+        late-window mean of the evader's objective tr Q_fused, :func:`.evader.fused_trace_along`) and the
+        task indices of this shard.
     """
     from netrepro.engines.montecarlo import shard_blocks
 
