@@ -320,10 +320,10 @@ def test_solves_are_counted_capped_and_a_step_that_decides_nothing_stops(monkeyp
     capped = lmi.solve()
     assert capped.verdict in ("feasible", "undecided")  # never a wrong "infeasible"
     assert sum(cvx.solver_statuses().values()) == 2 and cvx.solver_statuses().get("optimal") == 1
-    _refuse_undecided_step("demo")  # one decided verdict: the step stands
-    monkeypatch.setattr(cvx, "_DECISIONS", __import__("collections").Counter({"undecided": 3}))
-    with pytest.raises(LMIError, match=r"rule demo: every one of its 3 certified decisions is undecided .*CLARABEL"):
-        _refuse_undecided_step("demo")
+    _refuse_undecided_step("demo", cvx.certified_decisions(), cvx.solver_statuses())  # one decided: it stands
+    with pytest.raises(LMIError, match=r"rule demo: every one of its 3 certified decisions is undecided "
+                                       r"\(solver CLARABEL, statuses user_limit: 3\)"):
+        _refuse_undecided_step("demo", {"undecided": 3}, {"user_limit": 3})
     monkeypatch.setenv(cvx.FAULT_MAX_ITER, "zero")
     with pytest.raises(ValueError, match="must be a positive integer"):
         cvx.solver_options()

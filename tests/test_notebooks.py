@@ -94,3 +94,52 @@ def test_the_kernel_sockets_move_to_tmp_when_tmpdir_is_too_long(tmp_path):
         assert len(fits) + socket_tail == SOCKET_PATH_MAX
         assert _socket_parent(fits) == fits
         assert _socket_parent(over) == "/tmp"
+
+
+# a 1x1 PNG
+_PIXEL = bytes.fromhex("89504e470d0a1a0a0000000d4948445200000001000000010806000000" "1f15c4890000000d49444154789c6360000002000154a24f5d0000000049454e44ae426082")
+
+
+def test_a_hostile_caption_is_inert_text_in_the_notebook_page(tmp_path):
+    """Issue 38: a caption's raw-HTML script, file inclusion and javascript: link, in the notebook page."""
+    from html.parser import HTMLParser
+
+    from netrepro.report.captions import link_allowed
+
+    from .test_captions import HOSTILE_CAPTION
+
+    (tmp_path / "workflow" / "report" / "x").mkdir(parents=True)
+    (tmp_path / "workflow" / "report" / "x" / "fig1.rst").write_text(HOSTILE_CAPTION)
+    (tmp_path / "figures" / "x").mkdir(parents=True)
+    (tmp_path / "figures" / "x" / "fig1.png").write_bytes(_PIXEL)
+    notebook = make_notebook("x", tmp_path / "x.ipynb")
+    page = execute_notebook("x", notebook, tmp_path / "x.html", root=tmp_path, timeout=60).read_text()
+
+    class Live(HTMLParser):
+        def __init__(self):
+            super().__init__()
+            self.scripts, self.hrefs, self.handlers, self.csp, self.text = [], [], [], [], []
+
+        def handle_starttag(self, tag, attrs):
+            attrs = dict(attrs)
+            if tag == "script" and attrs.get("type", "text/javascript") in ("text/javascript", "module"):
+                self.scripts.append(attrs)  # a script a browser would run (nbconvert's MathJax config is not one)
+            if tag == "a" and attrs.get("href") is not None:
+                self.hrefs.append(attrs["href"])
+            if tag == "meta" and attrs.get("http-equiv", "").lower() == "content-security-policy":
+                self.csp.append(attrs["content"])
+            self.handlers += [k for k in attrs if k.startswith("on")]
+
+        def handle_data(self, data):
+            self.text.append(data)
+
+    live = Live()
+    live.feed(page)
+    assert live.scripts == [] and live.handlers == []
+    assert [h for h in live.hrefs if not link_allowed(h)] == []
+    text = "".join(live.text)  # what the reader sees: the hostile parts as text
+    assert '<script>document.title = "PWNED"</script>' in text
+    assert ".. include:: /etc/passwd" in text and "root:x:0:0" not in page
+    assert "link <javascript:alert(document.domain)>" in text
+    assert len(live.csp) == 1 and "script-src 'none'" in live.csp[0] and "default-src 'none'" in live.csp[0]
+    assert page.index("Content-Security-Policy") < page.index("<script")  # the policy governs every script

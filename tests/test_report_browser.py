@@ -259,3 +259,26 @@ def test_snakemake_report_view(built_report):
     out = built_report / "report" / "snakemake_report.html"
     snakemake(built_report, "--report", str(out.relative_to(built_report)), "report")
     assert out.stat().st_size > 50_000
+
+
+def test_snakemakes_report_sealed_by_relocate_runs_in_chromium(built_report, browser):
+    """Issue 38: Snakemake's report, sealed by ``relocate`` as ``make report`` does, still runs under its
+    content security policy: no console error (a refused script or eval is one), the rule graph is drawn."""
+    import subprocess
+    import sys
+
+    from selenium.webdriver.common.by import By
+
+    out = built_report / "report" / "snakemake_report.html"
+    snakemake(built_report, "--report", str(out.relative_to(built_report)), "report")
+    subprocess.run([sys.executable, "-m", "netrepro.report", "relocate", str(out.relative_to(built_report))],
+                   cwd=built_report, check=True)
+    assert out.read_text().count('http-equiv="Content-Security-Policy"') == 1
+    with serve(out.parent) as base:
+        state, problems = check_page(browser, base + out.name, base)
+        browser.find_element(By.XPATH, "//span[normalize-space(.)='Workflow']/ancestor::a[1]").click()
+        time.sleep(1.5)
+        drawn = browser.execute_script("return document.querySelectorAll('#rulegraph svg, #rulegraph canvas').length")
+        problems += [f"after opening the rule graph: console {msg}" for msg in console_errors(browser)]
+    assert not problems, "\n".join(problems)
+    assert state["title"] == "Snakemake Report" and drawn > 0

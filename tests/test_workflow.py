@@ -63,6 +63,19 @@ def test_report_and_interface_tables(built):
         assert table.with_name(table.name + ".meta.json").is_file(), f"no provenance sidecar for {table}"
 
 
+def test_every_output_has_the_mode_of_a_new_file(built):
+    """Issue 41: every table, figure, sidecar and page is readable as the umask allows (0644 under
+    umask 022), not 0600 as mkstemp creates it."""
+    from netrepro.io import current_umask, new_file_mode
+
+    expected = new_file_mode(current_umask())  # the build ran in this process's umask
+    outputs = [p for folder in ("results", "figures", "report") for p in (built / folder).rglob("*") if p.is_file()]
+    assert len(outputs) > 100
+    wrong = {str(p.relative_to(built)): oct(p.stat().st_mode & 0o777) for p in outputs
+             if p.stat().st_mode & 0o777 != expected}
+    assert wrong == {}, f"expected {oct(expected)}"
+
+
 def test_second_run_does_nothing(built):
     assert jobs_planned(built, "report") == set()
 

@@ -578,7 +578,9 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
     out.mkdir(parents=True, exist_ok=True)
     clear_difference_page(out)
     failing = [d for d in figures if d.problems]
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><link rel='icon' href='data:,'>"
+    from .report.csp import csp_meta  # the difference page runs nothing either (issue 38)
+
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>{csp_meta()}<link rel='icon' href='data:,'>"
              f"<title>Regeneration differences</title><style>{_CSS}</style></head><body>",
              "<h1>Regeneration differences</h1>",
              f"<p id='summary'>{len(failing)} figure(s) and {len(tables)} table(s) differ from their "

@@ -15,29 +15,42 @@ import tempfile
 from pathlib import Path
 
 
-__all__ = ["atomic_path", "write_table", "read_table", "write_json", "sha256_file", "load_yaml"]
+__all__ = ["atomic_path", "new_file_mode", "current_umask", "write_table", "read_table", "write_json", "sha256_file",
+           "load_yaml", "yaml_loader_class"]
 
 
-def _yaml_loader():
-    """libyaml's safe loader (PyYAML's when libyaml is missing) that reads YAML 1.2 floats such as ``1.0e12``.
+def yaml_loader_class(base=None):
+    """A safe loader class (libyaml's by default) that reads YAML 1.2 floats such as ``1.0e12``.
 
     YAML 1.1, which PyYAML implements, reads a float written without a dot or without a sign in
     its exponent (``1e-5``, ``1.0e12``) as text; YAML 1.2 and every other reader take it as a
-    number. Built once per process.
+    number. The default class is built once per process.
+
+    Parameters
+    ----------
+    base : type, optional
+        The loader to extend (default: ``yaml.CSafeLoader`` when PyYAML has libyaml, else
+        ``yaml.SafeLoader``).
+
+    Returns
+    -------
+    type
+        A subclass of ``base`` with the YAML 1.2 float resolver added.
     """
     import re
 
     import yaml
 
-    if _LOADER:
+    if base is None and _LOADER:
         return _LOADER[0]
-    base = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    loader = type("NetreproLoader", (base,), {})
+    parent = base or getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    loader = type("NetreproLoader", (parent,), {})
     loader.add_implicit_resolver(
         "tag:yaml.org,2002:float",
         re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
         list("-+0123456789."))
-    _LOADER.append(loader)
+    if base is None:
+        _LOADER.append(loader)
     return loader
 
 
@@ -64,7 +77,7 @@ def load_yaml(text: str):
     """
     import yaml
 
-    return yaml.load(text, Loader=_yaml_loader())  # noqa: S506 (a safe loader)
+    return yaml.load(text, Loader=yaml_loader_class())  # noqa: S506 (a safe loader)
 
 
 @contextlib.contextmanager
@@ -72,7 +85,9 @@ def atomic_path(target: str | os.PathLike):
     """Yield a temporary path next to ``target``; rename it onto ``target`` on success.
 
     The temporary file is fsynced before the rename and the directory after it. On an
-    exception the temporary file is removed and ``target`` is untouched.
+    exception the temporary file is removed and ``target`` is untouched. Before the rename the file
+    gets the mode of any new file, ``0o666 & ~umask`` (:func:`new_file_mode`): ``mkstemp`` creates
+    it 0600, readable by its owner alone, which a shared group folder or a web server cannot read.
 
     Parameters
     ----------
@@ -90,6 +105,7 @@ def atomic_path(target: str | os.PathLike):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, new_file_mode(current_umask()))
         with open(tmp, "rb") as fh:
             os.fsync(fh.fileno())
         os.replace(tmp, target)
@@ -98,6 +114,45 @@ def atomic_path(target: str | os.PathLike):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def new_file_mode(umask: int) -> int:
+    """The permission bits ``open()`` gives a new file under ``umask``: ``0o666 & ~umask``.
+
+    Parameters
+    ----------
+    umask : int
+        The process's file mode creation mask (e.g. ``0o022``).
+
+    Returns
+    -------
+    int
+        The mode (``0o644`` under umask ``0o022``, ``0o600`` under ``0o077``).
+    """
+    return 0o666 & ~umask
+
+
+def current_umask() -> int:
+    """The process's umask, read without changing it where the system allows.
+
+    On Linux it is the ``Umask:`` line of ``/proc/self/status``; elsewhere it is set and restored
+    at once (``os.umask`` returns the previous mask only by setting a new one).
+
+    Returns
+    -------
+    int
+        The umask (e.g. ``0o022``).
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii", errors="replace") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def _fsync_dir(directory: Path) -> None:

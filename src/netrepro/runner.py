@@ -141,29 +141,33 @@ def _nonfinite(frame: pd.DataFrame) -> dict:
     return counts
 
 
-def _refuse_undecided_step(rule: str) -> None:
+def _solver_counts() -> tuple[dict, dict]:
+    """The solver statuses and certified verdicts counted so far in this process (:mod:`netrepro.engines.cvx`).
+
+    Read only when a step imported the engine: a step without LMIs does not import cvxpy for this.
+    """
+    module = sys.modules.get("netrepro.engines.cvx")
+    return (module.solver_statuses(), module.certified_decisions()) if module is not None else ({}, {})
+
+
+def _counted_since(before: dict, after: dict) -> dict:
+    """The counts of ``after`` less those of ``before`` (a step's own, when one process runs several)."""
+    return {k: v - before.get(k, 0) for k, v in after.items() if v - before.get(k, 0)}
+
+
+def _refuse_undecided_step(rule: str, decisions: dict, statuses: dict) -> None:
     """Stop a step whose certificates decided nothing, naming the solver's statuses (before any table is written).
 
     Its tables would hold no decision, and a later step would stop on a symptom (a design missing
     from a table) instead of the cause.
     """
-    module = sys.modules.get("netrepro.engines.cvx")
-    decisions = module.certified_decisions() if module is not None else {}
     if decisions and set(decisions) == {"undecided"}:
-        statuses = ", ".join(f"{k}: {v}" for k, v in module.solver_statuses().items()) or "none recorded"
+        from .engines.cvx import FAULT_MAX_ITER, SOLVER
+
+        named = ", ".join(f"{k}: {v}" for k, v in statuses.items()) or "none recorded"
         raise LMIError(f"rule {rule}: every one of its {decisions['undecided']} certified decisions is undecided "
-                        f"(solver {module.SOLVER}, statuses {statuses}): the solver did not converge, so this "
-                        "step decides nothing; check the solver's installation and settings "
-                        f"({module.FAULT_MAX_ITER} caps it when set)")
-
-
-def _solver_statuses() -> dict:
-    """The solver statuses of this process's solves (:func:`netrepro.engines.cvx.solver_statuses`); {} if none.
-
-    Read only when the step imported the engine: a step without LMIs does not import cvxpy for this.
-    """
-    module = sys.modules.get("netrepro.engines.cvx")
-    return module.solver_statuses() if module is not None else {}
+                       f"(solver {SOLVER}, statuses {named}): the solver did not converge, so this step decides "
+                       f"nothing; check the solver's installation and settings ({FAULT_MAX_ITER} caps it when set)")
 
 
 def _summarize_warnings(caught) -> list[dict]:
@@ -231,12 +235,15 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
     """Run the step, write the tables it returns, then each output's sidecar (replacing its unfinished mark)."""
     import pandas as pd  # here, not at import: `verify` (before every notebook) needs no pandas
 
+    statuses_before, decisions_before = _solver_counts()
     start = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = func(params, inputs, outputs) or {}
     elapsed = time.perf_counter() - start
-    _refuse_undecided_step(rule)
+    statuses_after, decisions_after = _solver_counts()
+    statuses = _counted_since(statuses_before, statuses_after)
+    _refuse_undecided_step(rule, _counted_since(decisions_before, decisions_after), statuses)
     extra = dict(result.pop("provenance", {}) if isinstance(result, dict) else {})
     summary = _summarize_warnings(caught)
     for item in summary:
@@ -244,7 +251,6 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
                     item["count"])
     if summary:
         extra.setdefault("warnings", summary)
-    statuses = _solver_statuses()
     if statuses:
         extra.setdefault("solver_statuses", statuses)
         unsure = {k: v for k, v in statuses.items() if k != "optimal"}

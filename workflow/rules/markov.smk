@@ -153,6 +153,27 @@ rule markov_expectations:
         step("netrepro.papers.markov.steps:expectations_step")
 
 
+rule markov_asymptote_holdout:
+    input:
+        code=code("netrepro.papers.markov.steps:asymptote_holdout_step"),
+        expectations=rules.markov_expectations.output.table,
+    output:
+        table="results/markov/asymptote_holdout.csv",
+    log:
+        "logs/markov/asymptote_holdout.log",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=4000,
+    params:
+        cfg=as_json(pick(MCFG, "examples", "paths", "expectations")),
+        rule="markov_asymptote_holdout",
+        io=io_json,
+    shell:
+        step("netrepro.papers.markov.steps:asymptote_holdout_step")
+
+
 rule markov_evidence:
     input:
         code=code("netrepro.papers.markov.evidence:evidence_step"),
@@ -163,6 +184,7 @@ rule markov_evidence:
         map=rules.markov_stability_map.output.table,
         sensitivity=rules.markov_stability_map.output.sensitivity,
         moments=rules.markov_exact_moments.output.table,
+        holdout=rules.markov_asymptote_holdout.output.table,
         claims="src/netrepro/papers/markov/claims.yaml",
         findings="src/netrepro/papers/markov/findings.yaml",
     output:
@@ -211,5 +233,6 @@ if enabled("markov"):
         rules.markov_sample_paths.output.table,
         rules.markov_sample_paths.output.check,
         rules.markov_expectations.output.table,
+        rules.markov_asymptote_holdout.output.table,
         rules.markov_evidence.output.table,
     ]

@@ -166,6 +166,8 @@ rule onebit_estimator:
         table="results/onebit/estimator_mse.csv",
         ratios="results/onebit/estimator_ratios.csv",
         crossing="results/onebit/estimator_crossing.csv",
+        coverage="results/onebit/estimator_coverage.csv",
+        edge="results/onebit/estimator_edge.csv",
     log:
         "logs/onebit/estimator.log",
     localrule: True
@@ -235,6 +237,8 @@ rule onebit_evidence:
         estimator=rules.onebit_estimator.output.table,
         estimator_ratios=rules.onebit_estimator.output.ratios,
         crossing=rules.onebit_estimator.output.crossing,
+        coverage=rules.onebit_estimator.output.coverage,
+        edge=rules.onebit_estimator.output.edge,
         alpha_threshold=rules.onebit_alpha_scan.output.threshold,
         shards=rules.onebit_estimator.input.shards,
         findings_file="src/netrepro/papers/onebit/findings.yaml",
@@ -270,6 +274,8 @@ if enabled("onebit"):
         rules.onebit_vector_check.output.table,
         rules.onebit_estimator.output.ratios,
         rules.onebit_estimator.output.crossing,
+        rules.onebit_estimator.output.coverage,
+        rules.onebit_estimator.output.edge,
         rules.onebit_alpha_scan.output.table,
         rules.onebit_alpha_scan.output.threshold,
         rules.onebit_evidence.output.table,

@@ -96,7 +96,6 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     site.write()
     with atomic_path(outputs["html"]) as tmp:
         tmp.write_text(page)
-    os.chmod(outputs["html"], 0o644)
     if outputs.get("crate") and files_dir is not None:
         crate_root = Path(outputs["crate"]).parent
         prefix = files_dir.relative_to(crate_root).as_posix() if files_dir.is_relative_to(crate_root) else "files"

@@ -1,5 +1,6 @@
 """``python -m netrepro.report``: write a paper's default notebook, execute a notebook into
-``report/<slug>.html``, or relocate pages (no path of this checkout)."""
+``report/<slug>.html``, or relocate pages (no path of this checkout; an HTML page is also sealed
+by a content security policy, :mod:`netrepro.report.csp`)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,32 @@ import argparse
 import sys
 from pathlib import Path
 
-from .markup import relocate
+from .csp import snakemake_report_policy, with_csp
+from .markup import relocate, with_empty_favicon
 from .notebooks import EXECUTION_TIMEOUT_S, NotebookError, execute_notebook, make_notebook
 
-__all__ = ["main"]
+__all__ = ["main", "relocate_page"]
+
+
+def relocate_page(page: str, root: str | Path) -> str:
+    """Snakemake's report (or another page) relocated and sealed by a content security policy.
+
+    Parameters
+    ----------
+    page : str
+        The page (``report/snakemake_report.html``).
+    root : str or Path
+        The checkout (:func:`netrepro.report.markup.relocate`).
+
+    Returns
+    -------
+    str
+        The page without paths of this checkout, asking for no favicon, with a policy that allows
+        the scripts Snakemake wrote and nothing else (:func:`netrepro.report.csp.snakemake_report_policy`;
+        hashed after relocating, which may change a script's text).
+    """
+    page = with_empty_favicon(relocate(page, root))
+    return with_csp(page, snakemake_report_policy(page))
 
 
 def main(argv=None) -> int:
@@ -27,14 +50,17 @@ def main(argv=None) -> int:
     ex.add_argument("--timeout", type=float, default=EXECUTION_TIMEOUT_S,
                     help=f"seconds one cell may run (default {EXECUTION_TIMEOUT_S})")
     rel = sub.add_parser("relocate", help="rewrite files so they name no path of this checkout "
-                                          "(e.g. Snakemake's own report, which shows the rules' commands)")
+                                          "(e.g. Snakemake's own report, which shows the rules' commands); "
+                                          "an HTML page also gets a content security policy that lets only "
+                                          "Snakemake's own scripts run")
     rel.add_argument("files", nargs="+")
     args = parser.parse_args(argv)
     if args.command == "relocate":
         for name in args.files:
             path = Path(name)
             text = path.read_text()
-            new = relocate(text, Path.cwd())
+            is_page = path.suffix.lower() in (".html", ".htm")
+            new = relocate_page(text, Path.cwd()) if is_page else relocate(text, Path.cwd())
             if new != text:
                 path.write_text(new)
         return 0

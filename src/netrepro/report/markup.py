@@ -2,7 +2,8 @@
 
 * :func:`strip_external_scripts` drops everything a page would fetch from the network.
 * :func:`relocate` / :func:`relocate_json` rewrite absolute paths of the build machine.
-* :func:`render` fills a Jinja2 template of ``netrepro/report/templates/``.
+* :func:`render` fills a Jinja2 template of ``netrepro/report/templates/``; every page template
+  sets the report's content security policy (``{{ csp }}``, :data:`netrepro.report.csp.PAGE_POLICY`).
 """
 
 from __future__ import annotations
@@ -19,10 +20,13 @@ from jinja2 import Environment, FileSystemBytecodeCache, PackageLoader
 from jinja2.ext import Extension
 from markupsafe import Markup, escape
 
+from .captions import caption_html
+from .csp import policy_attribute
+
 if TYPE_CHECKING:  # pandas is imported where a table is read: the notebook driver and relocate never need it
     import pandas as pd
 
-__all__ = ["NO_FAVICON", "strip_external_scripts", "relocate", "relocate_json", "render", "read_csv",
+__all__ = ["NO_FAVICON", "strip_external_scripts", "with_empty_favicon", "relocate", "relocate_json", "render", "read_csv",
            "rst_html", "img", "num", "fmt_value", "short", "blank"]
 
 _EXTERNAL = re.compile(r"<script[^>]*\bsrc=\"https?://[^\"]*\"[^>]*>\s*</script>|<link[^>]*\bhref=\"https?://[^\"]*\"[^>]*>",
@@ -49,10 +53,29 @@ def strip_external_scripts(text: str) -> str:
     str
         The page without network requests, with an empty favicon.
     """
-    text = _EXTERNAL.sub("", text)
-    if 'rel="icon"' not in text:  # no favicon request: a static page makes no request it cannot satisfy
-        text = re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
+    text = with_empty_favicon(_EXTERNAL.sub("", text))
     return _INLINE_SCRIPT.sub(lambda m: "" if _REMOTE_IMPORT.search(m.group(1)) else m.group(0), text)
+
+
+def with_empty_favicon(text: str) -> str:
+    """A page that asks for no favicon (``<link rel="icon" href="data:,">``), unless it names one.
+
+    A browser asks a page's server for ``/favicon.ico`` otherwise: a static page makes no request it
+    cannot satisfy (over HTTP the request fails, and the console shows the error).
+
+    Parameters
+    ----------
+    text : str
+        An HTML page.
+
+    Returns
+    -------
+    str
+        The page, with :data:`NO_FAVICON` right after ``<head>`` if it had no icon.
+    """
+    if 'rel="icon"' in text:
+        return text
+    return re.sub(r"<head>", "<head>" + NO_FAVICON, text, count=1, flags=re.I)
 
 
 _PYTHON_PATH = re.compile(r"(?<![\w.~-])/[^\s'\"<>]*/bin/(python[0-9.]*)")
@@ -214,7 +237,10 @@ def short(sha) -> str:
 
 
 def rst_html(text: str) -> Markup:
-    """Render a caption written in reStructuredText (fallback: escaped paragraphs).
+    """Render a caption written in reStructuredText, inert (:func:`netrepro.report.captions.caption_html`).
+
+    Raw HTML and file insertion are off and links go only to http(s), mailto, ``#`` and relative
+    addresses: a caption can show text, never run a script or read a file.
 
     Parameters
     ----------
@@ -226,18 +252,7 @@ def rst_html(text: str) -> Markup:
     markupsafe.Markup
         Its HTML body (``""`` for an empty caption).
     """
-    text = text.strip()
-    if not text:
-        return Markup("")
-    try:
-        from docutils.core import publish_parts
-
-        body = publish_parts(text, writer_name="html5",
-                             settings_overrides={"report_level": 5, "halt_level": 5, "syntax_highlight": "none",
-                                                 "embed_stylesheet": False, "math_output": "HTML"})["body"]
-        return Markup(body)
-    except Exception:  # noqa: BLE001 - any docutils failure falls back to plain text
-        return Markup("").join(Markup("<p>{}</p>").format(p) for p in re.split(r"\n\s*\n", text))
+    return caption_html(text)
 
 
 def img(path: Path) -> Markup:
@@ -326,6 +341,7 @@ def _bytecode_cache():
 _ENV = Environment(loader=PackageLoader("netrepro.report", "templates"), autoescape=True,
                    extensions=[_JoinLines], finalize=_finalize, keep_trailing_newline=False,
                    bytecode_cache=_bytecode_cache())
+_ENV.globals["csp"] = policy_attribute()  # <meta http-equiv="Content-Security-Policy" content="{{ csp }}">
 _ENV.filters.update(num=num, value=fmt_value, short=short, rst=rst_html,
                     css=lambda text: re.sub(r"[^a-z]+", "-", str(text).lower()).strip("-"))
 

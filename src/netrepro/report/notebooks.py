@@ -17,12 +17,16 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from markupsafe import Markup
+
 from ..errors import NetreproError
 from ..io import atomic_path
+from .captions import caption_html
+from .csp import with_csp
 from .markup import relocate, strip_external_scripts
 
 __all__ = ["EXECUTION_TIMEOUT_S", "NotebookError", "make_notebook", "figure_captions", "figure_sort_key",
-           "show_figures", "show_table", "execute_notebook"]
+           "show_figures", "figure_heading_html", "show_table", "execute_notebook"]
 
 # Seconds one cell may run. The slowest cell of the five notebooks (the figures, embedded as
 # PNG) takes about 2 s; ten minutes only stops a cell that hangs.
@@ -137,12 +141,34 @@ def show_figures(root, slug):
     slug : str
         The paper.
     """
-    from IPython.display import Image, Markdown, display
+    from IPython.display import HTML, Image, display
 
     captions = figure_captions(root, slug)
     for fig in sorted((Path(root) / "figures" / slug).glob("*.png"), key=figure_sort_key):
-        display(Markdown(f"### {fig.stem}\n{captions.get(fig.stem, '')}"))
+        display(HTML(figure_heading_html(fig.stem, captions.get(fig.stem, ""))))
         display(Image(filename=str(fig)))
+
+
+def figure_heading_html(stem: str, caption: str) -> str:
+    """A figure's heading and caption in a notebook, rendered as the report renders captions.
+
+    The caption goes through :func:`netrepro.report.captions.caption_html` (raw HTML and file
+    insertion off, links only to safe addresses), not through the notebook's Markdown, which
+    passes raw HTML through: a ``<script>`` in a caption is shown as text.
+
+    Parameters
+    ----------
+    stem : str
+        The figure's name (``fig1``).
+    caption : str
+        Its caption (reStructuredText).
+
+    Returns
+    -------
+    str
+        ``<h3 id=stem>`` with the escaped name, then the caption's HTML.
+    """
+    return str(Markup('<h3 id="{}">{}</h3>').format(stem, stem) + caption_html(caption))
 
 
 def show_table(path, max_rows=None):
@@ -179,7 +205,8 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
     notebook : str or Path
         The notebook to run.
     html_out : str or Path
-        The page to write (the executed notebook is kept beside it as ``.ipynb``).
+        The page to write (the executed notebook is kept beside it as ``.ipynb``), offline and with
+        the report's content security policy (no script runs, :data:`netrepro.report.csp.PAGE_POLICY`).
     root : str or Path, default "."
         The checkout; the kernel runs there.
     timeout : float, default :data:`EXECUTION_TIMEOUT_S`
@@ -213,8 +240,7 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
         exporter = exporter.result()
     body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
     with atomic_path(html_out) as tmp:
-        tmp.write_text(relocate(strip_external_scripts(body), root))
-    os.chmod(html_out, 0o644)
+        tmp.write_text(with_csp(relocate(strip_external_scripts(body), root)))
     return html_out
 
 

@@ -14,6 +14,7 @@ import shlex
 from pathlib import Path
 
 from ..provenance import sidecar_path
+from .confine import confine_sidecar
 from .markup import fmt_value, render
 
 __all__ = ["provenance_chain", "rule_name", "config_keys", "provenance_panel", "repo_relative"]
@@ -33,6 +34,12 @@ def provenance_chain(path: str | Path, seen=None) -> list[dict]:
     -------
     list of dict
         The sidecars, ``path``'s own first.
+
+    Raises
+    ------
+    OutsideCheckoutError
+        A sidecar of the chain names a path (its output, an input, its source file) outside the
+        checkout; the message names the sidecar, the field and the path. No file outside is read.
     """
     seen = set() if seen is None else seen
     path = Path(path)
@@ -51,9 +58,14 @@ def provenance_chain(path: str | Path, seen=None) -> list[dict]:
 @functools.lru_cache(maxsize=None)
 def _sidecar(path: str) -> dict | None:
     """The sidecar of ``path`` (``None`` if it has none), read once per report: the chains of the
-    figures share their upstream tables."""
+    figures share their upstream tables. A sidecar naming a path outside the checkout (the report
+    runs in the checkout) raises :class:`~netrepro.report.confine.OutsideCheckoutError`."""
     side = sidecar_path(path)
-    return json.loads(side.read_text()) if side.is_file() else None
+    if not side.is_file():
+        return None
+    meta = json.loads(side.read_text())
+    confine_sidecar(meta, side, Path.cwd(), source_form=repo_relative)
+    return meta
 
 
 def rule_name(meta: dict) -> str:

@@ -12,6 +12,7 @@ from pathlib import Path
 from markupsafe import Markup
 
 from ..provenance import sidecar_path
+from .confine import confined
 from .markup import relocate_json, render
 from .panel import repo_relative
 
@@ -45,8 +46,11 @@ class Site:
         self.raw: dict[str, str] = {}  # copy target under files/ -> source file (workflow, config)
 
     def source_link(self, source_file: str, line=None) -> str:
-        """Link to the page of a source file (at line ``line``), registering the page."""
-        rel = repo_relative(source_file)
+        """Link to the page of a source file (at line ``line``), registering the page.
+
+        Raises :class:`~netrepro.report.confine.OutsideCheckoutError` for a file outside the checkout.
+        """
+        rel = confined(repo_relative(source_file), self.root, "a source file linked from the report")
         if self.out_dir is None or not (self.root / rel).is_file():
             return f"../{rel}"
         if self.pages_made and not (self.out_dir / "source" / f"{rel}.html").is_file():
@@ -55,16 +59,26 @@ class Site:
         return f"files/source/{rel}.html" + (f"#L-{int(line)}" if line else "")
 
     def table_link(self, path: str) -> str:
-        """Link to the copy of a table, registering the copy."""
+        """Link to the copy of a table, registering the copy.
+
+        Raises :class:`~netrepro.report.confine.OutsideCheckoutError` for a table outside the checkout.
+        """
+        path = confined(path, self.root, "a table linked from the report")
         if self.out_dir is None or not (self.root / path).is_file():
             return f"../{path}"
         self.tables.add(str(path))
         return f"files/data/{path}"
 
     def write(self) -> None:
-        """Copy the registered tables, workflow files and source pages under ``out_dir``."""
+        """Copy the registered tables, workflow files and source pages under ``out_dir``.
+
+        Every file copied comes from inside the checkout and lands inside ``out_dir``; checked for all
+        of them before the first copy (:class:`~netrepro.report.confine.OutsideCheckoutError` names the
+        file), so a refused path leaves nothing copied.
+        """
         if self.out_dir is None:
             return
+        self._confine_copies()
         for sub in ("data", "workflow"):  # the report rule's two folder outputs, even if empty
             (self.out_dir / sub).mkdir(parents=True, exist_ok=True)
         for rel in sorted(self.tables):
@@ -86,6 +100,17 @@ class Site:
             target = self.out_dir / "source" / f"{rel}.html"
             target.parent.mkdir(parents=True, exist_ok=True)
             target.write_text(page)
+
+    def _confine_copies(self) -> None:
+        """Refuse a copy whose source is outside the checkout or whose target is outside ``out_dir``."""
+        pages = [] if self.pages_made else sorted(self.sources)
+        copies = [*((rel, f"data/{rel}") for rel in sorted(self.tables)),
+                  *((source, rel) for rel, source in sorted(self.raw.items())),
+                  *((rel, f"source/{rel}.html") for rel in pages)]
+        out = Path(self.out_dir).resolve()
+        for source, target in copies:
+            confined(source, self.root, f"the report's copy {target}")
+            confined(out / target, out, f"the report's copy of {source}")
 
 
 def source_pages_step(params: dict, inputs: dict, outputs: dict) -> dict:

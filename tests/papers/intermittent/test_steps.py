@@ -101,10 +101,17 @@ def test_heavy_tail_table_against_a_monte_carlo_of_p_k():
         g = rng.random(p.size) < lam
         p = A * A * p + R1 - g * A * A * p * p / (p + R2)
     se = 4 * np.sqrt(0.25 / p.size)
-    for level, q in ((0.5, row["q0.5"]), (0.9, row["q0.9"])):
-        assert np.mean(p <= q * (1 + 1e-12)) >= level - se
-        assert np.mean(p < q * (1 - 1e-12)) <= level + se
+    for level in (0.5, 0.9):
+        lo, hi = row[f"q{level:g}_lo"], row[f"q{level:g}_hi"]
+        assert np.mean(p <= lo * (1 + 1e-12)) >= level - se
+        assert np.mean(p < hi * (1 - 1e-12)) <= level + se
+    assert np.mean(p > row["mean_exact"]) == pytest.approx(row["p_above_mean"], abs=se)
     assert not row["variance_finite"] and row["mean_finite"]
+    # lambda = 0.9: the final arrival (probability 0.9) puts p_k below every value after a final loss, so the
+    # distribution function is flat at 0.9 and the 0.9-quantile is an interval
+    tail = table.iloc[1]
+    assert tail["flat_levels"] == "0.9" and tail["q0.9_lo"] < tail["q0.9_hi"]
+    assert tail["q0.5_lo"] == tail["q0.5_hi"]
 
 
 def test_region_closed_form_has_the_kink_exactly():

@@ -1,4 +1,5 @@
 import itertools
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -108,13 +109,60 @@ def test_moment_thresholds():
         assert tails.tail_index(tails.moment_finite_threshold(n, A), A) == pytest.approx(n)
 
 
-def test_weighted_quantiles_against_a_sorted_sample():
+def test_quantile_interval_against_a_sorted_sample():
     rng = np.random.default_rng(3)
     vals = rng.exponential(size=1000)
     w = np.full(1000, 1e-3)
-    q = tails.weighted_quantiles(vals, w, [0.1, 0.5, 0.999, 1.0])
+    # the weights are the decimal 1e-3 rounded once: relative error u
+    lo, hi = tails.quantile_interval(vals, w, [0.1, 0.5, 0.999, 0.1234], weight_rtol=1.2e-16)
     s = np.sort(vals)
-    # smallest v with P(X <= v) >= q: the ceil(q n)-th order statistic
-    np.testing.assert_array_equal(q, s[[99, 499, 998, 999]])
-    assert tails.weighted_quantiles([3.0, 1.0, 2.0], [0.2, 0.5, 0.3], [0.5, 0.51, 0.8, 0.81]).tolist() == [1.0, 2.0,
-                                                                                                         2.0, 3.0]
+    # q n an integer: F = q on [s_(qn), s_(qn+1)), so the quantile is that interval (1-based order statistics);
+    # q n not an integer: the ceil(q n)-th order statistic, lo = hi
+    np.testing.assert_array_equal(lo, s[[99, 499, 998, 123]])
+    np.testing.assert_array_equal(hi, s[[100, 500, 999, 123]])
+    lo, hi = tails.quantile_interval([3.0, 1.0, 2.0], [0.2, 0.5, 0.3], [0.5, 0.51, 0.8, 0.81], weight_rtol=1.2e-16)
+    assert lo.tolist() == [1.0, 2.0, 2.0, 3.0]
+    assert hi.tolist() == [2.0, 2.0, 3.0, 3.0]
+    with pytest.raises(InputError, match="levels"):
+        tails.quantile_interval([1.0], [1.0], [1.0])
+
+
+def _exact_law(lam_num, lam_den, k):
+    """Support of p_k and integer weights lam_num^j (lam_den - lam_num)^(k - j) over lam_den^k (j = arrivals)."""
+    _, vals, _ = exact_mean_enumeration(P0, A, R1, R2, lam_num / lam_den, k, return_distribution=True)
+    # the enumeration doubles the paths per step, arrivals in the upper half: path i has popcount(i) arrivals
+    j = np.array([bin(i).count("1") for i in range(2**k)])
+    w_int = [lam_num ** int(x) * (lam_den - lam_num) ** (k - int(x)) for x in j]
+    return vals, w_int, lam_den**k
+
+
+def test_quantile_interval_against_the_exact_rational_law():
+    # lambda = 9/10 exactly in rationals: the exact CDF in integers gives the exact Q^- and Q^+; the float
+    # computation must enclose them, and here (no weight within the rounding of a level) hit them exactly
+    k = 12
+    vals, w_int, den = _exact_law(9, 10, k)
+    order = np.argsort(vals, kind="stable")
+    cum = np.cumsum(np.array([w_int[i] for i in order], dtype=object))
+    levels = [0.5, 0.9, 0.99, 0.999]
+    w = vals * 0 + np.array([x / den for x in w_int])
+    lo, hi = tails.quantile_interval(vals, w, levels, weight_rtol=(k + 1) * 1.2e-16)
+    for q, qn, x, y in zip(levels, [(1, 2), (9, 10), (99, 100), (999, 1000)], lo, hi):
+        target = qn[0] * den // qn[1]
+        first_ge = next(i for i, c in enumerate(cum) if c >= target)
+        first_gt = next(i for i, c in enumerate(cum) if c > target)
+        assert x == vals[order][first_ge] and y == vals[order][first_gt], q
+    # P(p_k <= v) = 0.9 exactly on a stretch: the quantile at 0.9 is an interval of positive length
+    assert hi[1] > lo[1] and hi[0] == lo[0]
+
+
+def test_exceedance_probability_against_the_exact_rational_law():
+    k = 10
+    vals, w_int, den = _exact_law(3, 5, k)
+    w = np.array([x / den for x in w_int])
+    mean = float(sum(Fraction(x, den) * Fraction(v) for x, v in zip(w_int, vals)))
+    exact = Fraction(sum(x for x, v in zip(w_int, vals) if v > mean), den)
+    p, err = tails.exceedance_probability(vals, w, mean, 1e-14, (k + 1) * 1.2e-16)
+    assert abs(p - float(exact)) <= err + 1e-16 and err < 1e-13
+    # a level on a support point: its weight enters the error bound, not the probability
+    p, err = tails.exceedance_probability([1.0, 2.0, 3.0], [0.25, 0.5, 0.25], 2.0, 1e-12)
+    assert p == 0.25 and err == pytest.approx(0.5)

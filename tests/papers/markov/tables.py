@@ -13,7 +13,7 @@ __all__ = ["tiny_config", "run_all", "NAMES"]
 ROOT = Path(__file__).resolve().parents[3]
 PKG = ROOT / "src" / "netrepro" / "papers" / "markov"
 NAMES = ("curves", "bench", "checks", "tight", "iid", "moments", "map", "sensitivity", "paths", "check", "evidence",
-         "expectations")
+         "expectations", "holdout")
 
 
 def tiny_config() -> dict:
@@ -47,8 +47,10 @@ def run_all(cfg: dict, tmp: Path) -> dict:
     _run(steps.stability_map_step, cfg, {"moments": t["moments"]}, {"table": t["map"], "sensitivity": t["sensitivity"]})
     _run(steps.sample_paths_step, cfg, {"moments": t["moments"]}, {"table": t["paths"], "check": t["check"]})
     _run(steps.expectations_step, cfg, {"moments": t["moments"]}, {"table": t["expectations"]})
+    _run(steps.asymptote_holdout_step, cfg, {"expectations": t["expectations"]}, {"table": t["holdout"]})
     _run(evidence.evidence_step, cfg, {"checks": t["checks"], "tight": t["tight"], "curves": t["curves"], "iid": t["iid"],
                                        "map": t["map"], "sensitivity": t["sensitivity"], "moments": t["moments"],
+                                       "holdout": t["holdout"],
                                        "claims": PKG / "claims.yaml", "findings": PKG / "findings.yaml"},
          {"table": t["evidence"]})
     return t

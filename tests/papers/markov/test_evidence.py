@@ -129,6 +129,8 @@ def test_evidence_step_feeds_every_claim(markov_tables):
     assert claims.loc["exII_p0465_certified", "verdict"] == "erratum"
     assert claims.loc["exII_fig6_diverges", "robust"] == "yes"
     assert claims.loc["ref16_p004", "verdict"] == "not_checkable"
+    assert claims.loc["thm3_peak_implies_ms", "verdict"] == "reproduced"
+    assert "U = " in claims.loc["thm3_peak_implies_ms", "note"]
     errata = errata_table(data, ev).set_index("erratum_id")
     assert float(errata.loc["E10_prop2_signed_measure", "residual_printed"]) > 0
     assert float(errata.loc["E10_prop2_signed_measure", "residual_corrected"]) == 0
@@ -198,7 +200,8 @@ def test_claim_settings_reach_the_evidence_from_the_yaml(markov_cfg, markov_tabl
     at = evidence.claim_settings(claims, PKG / "findings.yaml")
     assert at["exI_loss_rate_004"]["at"] == {"p": 0.1, "q": 0.4}
     assert at["prop1_is_thm1_K0"]["at"] == {"q": 0.65}
-    inputs = {k: markov_tables[k] for k in ("checks", "tight", "curves", "iid", "map", "sensitivity", "moments")}
+    inputs = {k: markov_tables[k] for k in ("checks", "tight", "curves", "iid", "map", "sensitivity", "moments",
+                                            "holdout")}
     out = evidence.evidence_step(markov_cfg, dict(inputs, claims=claims, findings=PKG / "findings.yaml"), {})["table"]
     row = out[(out.quantity == "exI.loss_rate_p004") & (out.variant == "nominal")]
     assert float(row.value.iloc[0]) == pytest.approx(0.1 / (0.1 + 0.4), rel=1e-12)
@@ -230,3 +233,31 @@ def test_configured_points_are_the_claims_settings():
                        ("fig6", "exII_fig6_diverges")):
         assert figs[fig] == (at[claim]["at"]["p"], at[claim]["at"]["q"]), (fig, claim)
     assert {t["q"] for t in cfg["checks"]["tight"] if t["example"] == "II"} == {at["exII_thm5_q05"]["at"]["q"]}
+
+
+def test_undecided_certificates_make_undecided_verdicts_never_differs(markov_cfg, markov_tables, tmp_path):
+    """An LMI point the certificate leaves undecided and a wide bisection bracket (as from a solver stopped after a
+    few iterations) give evidence rows with decided False or a wide uncertainty, and the verdicts read undecided,
+    never differs (issue 37); a certified-infeasible point stays decided."""
+    checks = pd.read_csv(markov_tables["checks"])
+    fig3 = checks.check == "exI_fig3_p05"
+    checks.loc[fig3, ["verdict", "certified"]] = ["undecided", False]
+    lower = checks.check == "exII_q05_tight_lower"
+    checks.loc[lower, "p"] = 0.4167  # a short bisection: the bracket [0.4167, 0.46451] straddles 0.4645
+    tight = pd.read_csv(markov_tables["tight"])
+    tight.loc[tight.check == "exII_q05", "p_lower"] = 0.4167
+    checks.to_csv(tmp_path / "checks.csv", index=False)
+    tight.to_csv(tmp_path / "tight.csv", index=False)
+    inputs = {k: markov_tables[k] for k in ("curves", "iid", "map", "sensitivity", "moments", "holdout")}
+    out = evidence.evidence_step(markov_cfg, dict(inputs, checks=tmp_path / "checks.csv", tight=tmp_path / "tight.csv",
+                                                  claims=PKG / "claims.yaml", findings=PKG / "findings.yaml"), {})
+    out["table"].to_csv(tmp_path / "evidence.csv", index=False)
+    ev = read_evidence(tmp_path / "evidence.csv")
+    assert ev["exI.fig3_certified"]["nominal"].decided is False
+    assert ev["exII.lmi_p1_infeasible"]["nominal"].decided is True
+    assert ev["exII.p_thm5_q05"]["nominal"].uncertainty > 0.02
+    claims = claims_table(load_paper_data("markov"), {}, ev).set_index("claim_id")
+    assert claims.loc["exI_fig3_stable", "verdict"] == "undecided"
+    assert claims.loc["exII_thm5_q05", "verdict"] == "undecided"
+    assert claims.loc["exII_lmi_p1_infeasible", "verdict"] == "reproduced"
+    assert not (claims.verdict == "differs").any()

@@ -210,3 +210,20 @@ def test_parity_ceiling_against_a_numerical_maximisation():
     assert got["p_max"] == pytest.approx(0.5609, abs=5e-5) and got["p_at_q1"] == pytest.approx(0.4823, abs=5e-5)
     with pytest.raises(ValueError, match=r"needs \|lambda\| > 1"):
         model.parity_ceiling(0.9)
+
+
+def test_defective_unit_circle_eigenvalues_on_jordan_blocks():
+    """Definition 4 on matrices whose Jordan structure is known by construction (similarity by a random T)."""
+    rng = np.random.default_rng(5)
+    T = rng.standard_normal((3, 3)) + 3 * np.eye(3)
+    Ti = np.linalg.inv(T)
+    jordan_on = np.array([[1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.5]])  # defective eigenvalue 1
+    semisimple = np.diag([1.0, 1.0, 0.5])  # eigenvalue 1 twice, two eigenvectors
+    jordan_off = np.array([[1.2, 1.0, 0.0], [0.0, 1.2, 0.0], [0.0, 0.0, -1.0]])  # defective, but off the circle
+    rotation = np.array([[0.0, -1.0], [1.0, 0.0]])  # eigenvalues +-i, simple
+    assert model.defective_unit_circle_eigenvalues(T @ jordan_on @ Ti) == 1
+    assert model.defective_unit_circle_eigenvalues(T @ semisimple @ Ti) == 0
+    assert model.defective_unit_circle_eigenvalues(T @ jordan_off @ Ti) == 0
+    assert model.defective_unit_circle_eigenvalues(rotation) == 0
+    # the paper's examples have no eigenvalue on the unit circle
+    assert model.defective_unit_circle_eigenvalues(A1) == model.defective_unit_circle_eigenvalues(A2) == 0

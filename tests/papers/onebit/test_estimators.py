@@ -221,3 +221,56 @@ def test_pooled_se_ratio_against_chi_square_by_simulation():
     assert 175 <= inside <= 200
     with pytest.raises(InputError, match="n_blocks >= 2"):
         estimators.pooled_se_ratio([1.0], [1])
+
+
+def test_paired_db_contrasts_equal_a_direct_gather():
+    rng = np.random.default_rng(3)
+    n = 300
+    v = {k: rng.gamma(2.0, size=n) + 0.1 for k in ("a", "b", "c", "d")}
+    contrasts = [[("a", "b", 1.0), ("c", "d", -1.0)], [("a", "c", 1.0)]]
+    got = estimators.paired_db_contrasts(v, contrasts, 500, 11)
+    idx = np.random.default_rng(11).integers(0, n, size=(500, n))
+    m = {k: x[idx].mean(axis=1) for k, x in v.items()}
+    rep = 10 * np.log10(m["a"] / m["b"]) - 10 * np.log10(m["c"] / m["d"])
+    est = 10 * np.log10(v["a"].mean() / v["b"].mean()) - 10 * np.log10(v["c"].mean() / v["d"].mean())
+    assert got[0][0] == pytest.approx(est, rel=1e-12)
+    np.testing.assert_allclose(got[0][1:], np.percentile(rep, [2.5, 97.5]), rtol=1e-12)
+    assert got[1][0] == pytest.approx(10 * np.log10(v["a"].mean() / v["c"].mean()), rel=1e-12)
+    with pytest.raises(InputError):
+        estimators.paired_db_contrasts({"a": np.ones(3), "b": np.ones(4)}, [[("a", "b", 1.0)]], 10, 0)
+
+
+def test_replicate_coverage_matches_a_loop_and_the_nominal_rate():
+    rng = np.random.default_rng(5)
+    v = rng.normal(2.0, 1.0, size=103)
+    got = estimators.replicate_coverage(v, 5)
+    parts = np.array_split(v, 5)
+    for r, p in enumerate(parts):
+        o = np.concatenate([q for j, q in enumerate(parts) if j != r])
+        z = (p.mean() - o.mean()) / np.hypot(p.std(ddof=1) / np.sqrt(len(p)), o.std(ddof=1) / np.sqrt(len(o)))
+        assert got["z"][r] == pytest.approx(z, rel=1e-10)
+        assert got["covered"][r] == (abs(z) <= 1.959963984540054)
+    # normal runs against the exact mean: about 95 % of 4000 replicates cover (fixed seed)
+    w = rng.normal(2.0, 1.0, size=4000 * 50)
+    cov = estimators.replicate_coverage(w, 4000, reference=2.0)["covered"].mean()
+    assert 0.935 < cov < 0.965
+    # heavy tails (lognormal, sigma 2.5: kurtosis ~ 1e10), small replicates: the normal interval under-covers
+    h = rng.lognormal(0.0, 2.5, size=2000 * 50)
+    cov_h = estimators.replicate_coverage(h, 2000, reference=float(np.exp(2.5**2 / 2)))["covered"].mean()
+    assert cov_h < 0.85
+    with pytest.raises(InputError):
+        estimators.replicate_coverage(np.ones(5), 3)
+
+
+def test_binomial_coverage_against_scipy_binomtest():
+    from scipy import stats
+
+    for k, n in ((190, 200), (180, 200), (200, 200), (0, 5)):
+        got = estimators.binomial_coverage(k, n)
+        ref = stats.binomtest(k, n, 0.95, alternative="less")
+        ci = stats.binomtest(k, n).proportion_ci(confidence_level=0.95, method="exact")
+        assert got["p_under"] == pytest.approx(ref.pvalue, rel=1e-9)
+        assert (got["lo"], got["hi"]) == pytest.approx((ci.low, ci.high), abs=1e-9)
+    assert estimators.binomial_coverage(180, 200)["p_under"] < 0.05 < estimators.binomial_coverage(190, 200)["p_under"]
+    with pytest.raises(InputError):
+        estimators.binomial_coverage(3, 2)

@@ -87,7 +87,8 @@ def tables(cfg, tmp_path_factory):
         shards.append(tmp / f"shard{i}.npz")
         steps.estimator_shard_step(dict(c, shard=i, n_shards=2), {}, {"runs": shards[-1]})
     est = steps.estimator_step(c, {"shards": shards}, {})
-    for name, key in (("estimator", "table"), ("estimator_ratios", "ratios"), ("crossing", "crossing")):
+    for name, key in (("estimator", "table"), ("estimator_ratios", "ratios"), ("crossing", "crossing"),
+                      ("coverage", "coverage"), ("edge", "edge")):
         paths[name] = tmp / f"{name}.csv"
         est[key].to_csv(paths[name], index=False)
     root = ROOT / "src" / "netrepro" / "papers" / "onebit"
@@ -134,9 +135,12 @@ def test_evidence_values(tables):
                 # a declared range (<key>: / <key>=) or the counterfactual a finding's cause names
                 assert label.split(":")[0].split("=")[0] in keys | {"cause"}, (q, label)
     causes = [(f.quantity, f.cause["variant"]) for f in load_paper_data("onebit").findings if f.cause]
-    assert causes
     for q, label in causes:  # the cause variant is a variant of the judged quantity
         assert label in ev[q], (q, label)
+    # the counterfactual of finite_alpha_low_snr (an observation since issue 37) stays in the evidence: without the
+    # mean reversion rho_SL stays near the -0.98 dB asymptote at -60 dB
+    cf = ev["finite_alpha_low_snr"]["cause: alpha = 1 in (24)/(27), same sigma_z^2, E[F_q]"][0]
+    assert cf == pytest.approx(-0.98, abs=0.01) and ev["finite_alpha_low_snr"][NOMINAL][0] > -0.5
     # the break-even lag exists exactly where rho_S > 0 (why it is no separate claim)
     assert ev["break_even_lag"][NOMINAL][0] is True
     # run halves: n = 20 of 40 runs each
@@ -145,17 +149,48 @@ def test_evidence_values(tables):
     assert claims.loc["same_loss", "verdict"] == "conditional"
     assert "alpha -> 1" in claims.loc["same_loss", "condition"].split("; not for")[0]
     assert claims.loc["rho_s_gt_rho_f", "verdict"] == "reproduced"
-    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 7
+    assert isinstance(out["findings"], pd.DataFrame) and len(out["findings"]) == 8
     # the crossing: a local fit on the crossing SNRs, the former straight line and the bound beside it
     assert "local fit, crossing SNRs" in ev["rho_s_crossing"][NOMINAL][1]
 
 
 def test_findings_are_judged_like_claims():
-    """Every finding has a rule, evidence quantities, depends_on naming reconstructions, and prior work (issue 27)."""
+    """Every judged finding has a rule (an observation none), every finding evidence quantities, depends_on naming
+    reconstructions, and prior work (issues 27 and 37)."""
     data = load_paper_data("onebit")
     keys = {r["key"] for r in data.reconstructions}
     for f in data.findings:
-        assert f.rule_reason, f.finding_id
+        assert bool(f.rule_reason) == (f.kind != "observation"), f.finding_id
         assert f.evidence_quantities and f.quantity in f.evidence_quantities, f.finding_id
         assert set(f.depends_on) <= keys, f.finding_id
         assert f.prior_work, f.finding_id
+
+
+def _crossing_table(est, lo, hi, bound, alpha=0.999):
+    rows = [dict(alpha=alpha, curve=c, snr_db_crossing=v, method="local fit, crossing SNRs", fit_snr_lo=1.0,
+                 fit_snr_hi=2.5, n_points=7, n_runs=4000, n_boot=4000, fit_residual_rms=0.05,
+                 slope_db_per_db=-0.5 if c == "estimate" else np.nan)
+            for c, v in (("estimate", est), ("lo", lo), ("hi", hi))]
+    rows += [dict(alpha=alpha, curve="grid_linear", snr_db_crossing=est), dict(alpha=alpha, curve="bound",
+                                                                               snr_db_crossing=bound)]
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("est,lo,hi,bound,value,decided", [
+    (2.0, 1.8, 2.3, 7.0, True, True),      # gap [4.7, 5.2] > 3 dB: holds
+    (2.0, 1.8, 2.3, 5.0, False, False),    # gap [2.7, 3.2] straddles 3 dB: undecided
+    (2.0, 1.8, 2.3, 4.0, False, True),     # gap [1.7, 2.2] < 3 dB: fails, decided
+])
+def test_crossing_test_is_undecided_while_the_interval_straddles_the_effect_size(cfg, est, lo, hi, bound, value,
+                                                                                decided):
+    at = {"rho_s_crossing": {"one_minus_alpha": 1e-3, "effect_size_db": 3.0}}
+    edge = pd.DataFrame([dict(alpha=0.999, snr_db=2.0, quantity="edge_bias_db.rho_S", estimate=-0.1, lo=-0.2, hi=0.0,
+                              extra_taus=20.0, n_runs=100)])
+    rows = evidence._crossing_evidence(dict(cfg, _at=at), _crossing_table(est, lo, hi, bound), edge)
+    test = next(r for r in rows if r["quantity"] == "rho_s_crossing_far_below_bound")
+    assert (test["value"], test["decided"]) == (value, decided)
+    q = {r["quantity"]: r for r in rows}
+    assert q["rho_s_crossing"]["uncertainty"] == pytest.approx(0.3)       # the larger side of the interval
+    # the edge bias -0.1 dB on a slope of -0.5 dB/dB moves the crossing by -0.2 dB (+- 0.1 / 0.5)
+    assert q["rho_s_crossing_edge_shift_db"]["value"] == pytest.approx(-0.2)
+    assert q["rho_s_crossing_edge_shift_db"]["uncertainty"] == pytest.approx(0.2)

@@ -130,3 +130,56 @@ def test_alpha_scan_threshold_is_where_rho_s_changes_sign(cfg):
         assert (sub.loc[sub["one_minus_alpha"] < row["one_minus_alpha_max"], "rho_s_db"] > 0).all()
         assert (sub.loc[sub["one_minus_alpha"] > row["one_minus_alpha_max"], "rho_s_db"] <= 0).all()
     assert thr["single_sign_change"].all()
+
+
+def test_edge_simulator_runs_the_standard_record_inside_the_long_one(cfg):
+    """The edge case's short estimates are those of the standard record cut out of the long one (steps extra..extra+K,
+    started from the stationary prior), its long estimates those of the whole record at the same states; checked
+    with the numpy Kalman/RTS reference on the cut records and with the grid smoother called directly."""
+    from netrepro.papers.onebit.estimators import _kalman_rts_numpy, grid_smoother_at, simulate_block, window_mse
+
+    c = copy.deepcopy(cfg)
+    eps, snr = 1e-2, 2.0
+    fn = steps._edge_simulator(c, eps, snr)
+    got = fn(np.random.default_rng(7), 6)
+    s, _, d = steps._estimator_design(c, eps, snr)
+    ev, K = d["eval_idx"], d["horizon"]
+    extra = int(np.ceil(c["estimator"]["edge"]["extra_taus"] * d["tau"]))
+    theta, y, r = simulate_block(np.random.default_rng(7), 6, K + 2 * extra, eps, s, c["sigma_eta"])
+    th = theta[:, ev + extra]
+    kf_s, rts_s = _kalman_rts_numpy(y[:, extra:extra + K], eps, s, c["sigma_eta"])
+    kf_l, rts_l = _kalman_rts_numpy(y, eps, s, c["sigma_eta"])
+    np.testing.assert_allclose(got["kalman_filter"], window_mse(kf_s[:, ev], th), rtol=1e-10)
+    np.testing.assert_allclose(got["rts_smoother_long"], window_mse(rts_l[:, ev + extra], th), rtol=1e-10)
+    e = c["estimator"]
+    _, sm_s = grid_smoother_at(r[:, extra:extra + K], eps, s, c["sigma_eta"], ev, e["grid_half_width"],
+                               e["points_per_sigma_z"], None)   # dense transition: another code path
+    np.testing.assert_allclose(got["smoother_1bit"], window_mse(sm_s, th), rtol=1e-6)
+    assert not np.allclose(got["smoother_1bit"], got["smoother_1bit_long"])
+
+
+def test_estimator_step_writes_coverage_and_edge_tables(cfg):
+    out = steps.run_estimator(copy.deepcopy(cfg))
+    cov, edge = out["coverage"], out["edge"]
+    n_rep = cfg["estimator"]["n_replicates"]
+    assert set(cov["replicate"]) == set(range(-1, n_rep)) and cov["covered"].dtype == bool
+    # the ratio band against its exact value: the Kalman filter's MSE over the RTS smoother's, per case
+    rat = cov[cov["kind"] == "ratio_db:kalman_filter/rts_smoother"]
+    mse_all = out["table"].set_index(["alpha", "snr_db", "kind", "case_set"])["bound"]
+    for r in rat.itertuples():
+        exact_db = 10 * np.log10(mse_all[(r.alpha, r.snr_db, "kalman_filter", r.case_set)]
+                                 / mse_all[(r.alpha, r.snr_db, "rts_smoother", r.case_set)])
+        assert r.reference == pytest.approx(exact_db, rel=1e-12) and r.replicate == -1
+    assert len(rat) == len(out["table"]) // 4
+    assert (out["ratios"]["se_rep_db"] > 0).all() and (out["ratios"]["se_boot_db"] > 0).all()
+    cov = cov[cov["replicate"] >= 0]
+    exact = cov[cov["kind"].isin(["kalman_filter", "rts_smoother"])]
+    assert (exact["reference_se"] == 0).all() and (cov[cov["kind"] == "smoother_1bit"]["reference_se"] > 0).all()
+    # the Kalman reference is the finite-record bound of the MSE table
+    mse = out["table"].set_index(["alpha", "snr_db", "kind", "case_set"])["bound"]
+    for r in exact.itertuples():
+        assert r.reference == pytest.approx(mse[(r.alpha, r.snr_db, r.kind, r.case_set)], rel=1e-12)
+    assert {"edge_bias_db.rho_S", "mse_edge_bias_db.smoother_1bit"} <= set(edge["quantity"])
+    assert (edge["lo"] <= edge["estimate"]).all() and (edge["estimate"] <= edge["hi"]).all()
+    cr = out["crossing"].set_index("curve")
+    assert {"replicate_se", "bootstrap_se"} <= set(cr.index)

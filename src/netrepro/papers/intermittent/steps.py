@@ -18,7 +18,12 @@ status_at_threshold, statuses_seen`` (both bracket ends certified: see two_senso
 r_limit, tail_index, variance_finite, report_setting`` (lambda in (lambda_c, 1], with 1 - 1/a^4 and the report's
 stable lambdas as grid points).
 ``results/intermittent/heavy_tail.csv``: ``lam, lam_label, tail_index, mean_finite, variance_finite, k, mean,
-mean_exact, std, q0.5, q0.9, q0.99, q0.999, q0.9999, p_max, stationary_mean`` (law of p_k by enumeration).
+mean_exact, std``, per level ``q`` the two ends ``q<q>_lo, q<q>_hi`` of the quantile interval, ``flat_levels``,
+``p_above_mean, p_above_mean_err, p_max, stationary_mean`` (law of p_k by enumeration). Quantile convention
+(tails.quantile_interval): ``q<q>_lo = min{v : P(p_k <= v) >= q}``, ``q<q>_hi = inf{v : P(p_k <= v) > q}``; every
+value in between is a q-quantile, and the two differ where the distribution function is flat at q (``flat_levels``
+lists those levels: at lambda = 0.9, P(p_k <= v) = 0.9 on a whole stretch). ``p_above_mean`` = P(p_k > E p_k),
+summed over the 2^k arrival sequences, with its rounding bound ``p_above_mean_err``.
 ``results/intermittent/region_closed_form.csv``: ``lambda1, lambda2c_lower`` on a dense grid with the kink.
 ``results/intermittent/two_sensor_simulation.csv``: ``lambda1, lambda2, side, k, mean, mean_lo, mean_hi,
 predicted_growth`` (mean exact) plus ``mean_method, mean_rel_error_bound, stationary_mean, mc_mean, mc_lo, mc_hi,
@@ -39,7 +44,7 @@ from .estimators import conditional_mean_paths
 from .exact import exact_mean, stationary_mean
 from .model import (critical_probability, exact_mean_enumeration, lower_bound_limit, lower_bound_sequence,
                     mare_fixed_point, report_estimate_sequence, upper_bound_sequence)
-from .tails import moment_finite_threshold, tail_index, weighted_quantiles
+from .tails import exceedance_probability, moment_finite_threshold, quantile_interval, tail_index
 from .two_sensor import two_sensor_lower_bound, two_sensor_upper_bound
 
 __all__ = [
@@ -448,8 +453,13 @@ def stationary_curve_step(params, inputs, outputs):
 
 def heavy_tail_step(params, inputs, outputs):
     """Step: the law of p_k at k = horizon by enumeration of all 2^k arrival sequences (model.exact_mean_enumeration):
-    quantiles, mean and standard deviation, beside the tail index of the stationary law; at the report's lambdas
-    (lambda_c + the scalar offsets) and at the extra ``lambdas``.
+    the quantile intervals (tails.quantile_interval), P(p_k > E p_k) (tails.exceedance_probability), mean and
+    standard deviation, beside the tail index of the stationary law; at the report's lambdas (lambda_c + the scalar
+    offsets) and at the extra ``lambdas``.
+
+    Each enumerated weight is a product of k rounded factors lambda or 1 - lambda (relative error gamma_{k+1},
+    1 - lambda counted as one more rounding); E p_k is the exact mean of exact.exact_mean with its rigorous relative
+    error bound.
 
     Parameters
     ----------
@@ -465,23 +475,32 @@ def heavy_tail_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame}``, one row per lambda: tail index, whether the mean and the variance
-        are finite, the mean (by enumeration and exact), the standard deviation, the quantiles
-        ``q<prob>``, the largest p_k and the stationary mean.
+        are finite, the mean (by enumeration and exact), the standard deviation, the quantile intervals
+        ``q<prob>_lo, q<prob>_hi`` and the levels where they differ, P(p_k > E p_k) with its error bound,
+        the largest p_k and the stationary mean.
     """
     a, R1, R2, p0, k = params["a"], params["R1"], params["R2"], params["Ep0"], params["horizon"]
     lam_c = critical_probability(a)
     probs = [float(q) for q in params["quantiles"]]
+    u = np.finfo(float).eps / 2
+    weight_rtol = (k + 1) * u / (1 - (k + 1) * u)
     rows = []
     cases = [(lam_c + off, f"lambda_c{off:+g}") for off in params["lambda_offsets"]]
     cases += [(float(x), f"lambda={x:g}") for x in params.get("lambdas", [])]
     for lam, label in cases:
         _, vals, w = exact_mean_enumeration(p0, a, R1, R2, lam, k, return_distribution=True)
         mean = float(w @ vals)
+        exact = exact_mean(p0, a, R1, [R2], [lam], k)
+        mean_exact = float(exact.mean[-1])
         row = {"lam": lam, "lam_label": label, "tail_index": tail_index(lam, a),
                "mean_finite": bool(lam > lam_c), "variance_finite": bool(lam > moment_finite_threshold(2, a)), "k": k,
-               "mean": mean, "mean_exact": float(exact_mean(p0, a, R1, [R2], [lam], k).mean[-1]),
-               "std": float(np.sqrt(max(w @ (vals - mean) ** 2, 0.0)))}
-        row.update({f"q{q:g}": v for q, v in zip(probs, weighted_quantiles(vals, w, probs))})
+               "mean": mean, "mean_exact": mean_exact, "std": float(np.sqrt(max(w @ (vals - mean) ** 2, 0.0)))}
+        lo, hi = quantile_interval(vals, w, probs, weight_rtol)
+        for q, x, y in zip(probs, lo, hi):
+            row.update({f"q{q:g}_lo": x, f"q{q:g}_hi": y})
+        row["flat_levels"] = "|".join(f"{q:g}" for q, x, y in zip(probs, lo, hi) if x < y)
+        row["p_above_mean"], row["p_above_mean_err"] = exceedance_probability(
+            vals, w, mean_exact, float(exact.rel_error_bound[-1]), weight_rtol)
         row["p_max"] = float(vals.max())
         row["stationary_mean"] = stationary_mean(a, R1, [R2], [lam], p0=p0)["mean"] if lam > lam_c else np.inf
         rows.append(row)

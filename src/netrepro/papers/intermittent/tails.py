@@ -22,7 +22,9 @@ __all__ = [
     "loss_run_probability_recursion",
     "tail_index",
     "moment_finite_threshold",
-    "weighted_quantiles",
+    "sum_rounding_bound",
+    "quantile_interval",
+    "exceedance_probability",
 ]
 
 
@@ -263,23 +265,125 @@ def moment_finite_threshold(n, a) -> float:
     return float(1.0 - abs(a) ** (-2.0 * n))
 
 
-def weighted_quantiles(values, weights, probs) -> np.ndarray:
-    """Quantiles of a discrete law: the smallest support point v with P(X <= v) >= q, for each q.
+def sum_rounding_bound(n_terms: int, weight_rtol: float = 0.0) -> float:
+    """Relative error bound of a prefix sum of ``n_terms`` nonnegative weights formed in extended precision.
+
+    Recursive summation of ``n`` nonnegative terms carries ``|s_hat - s| <= gamma_n sum w`` with
+    ``gamma_n = n u / (1 - n u)`` (Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., eq. (4.4)),
+    ``u`` the unit roundoff of ``numpy.longdouble`` (the precision the sums are formed in). If each weight
+    itself carries a relative error ``rho = weight_rtol`` (a product of ``k`` rounded factors: ``rho = gamma_k``
+    of float64), the computed prefix sum ``F_hat`` and the true one ``F`` satisfy
+    ``|F_hat - F| <= (rho + gamma_n (1 + rho)) F``, and ``F <= F_hat / (1 - rho - gamma_n (1 + rho))``.
+
+    Parameters
+    ----------
+    n_terms : int
+        Number of summed terms, >= 0.
+    weight_rtol : float
+        Relative error bound of each weight, >= 0.
+
+    Returns
+    -------
+    float
+        ``c`` with ``|F_hat - F| <= c F_hat`` for every prefix sum.
+
+    Raises
+    ------
+    InputError
+        For a negative ``n_terms`` or ``weight_rtol``, or a bound that is not below 1.
+    """
+    if n_terms < 0 or weight_rtol < 0:
+        raise InputError(f"n_terms = {n_terms} and weight_rtol = {weight_rtol} must be >= 0")
+    u = float(np.finfo(np.longdouble).eps) / 2.0
+    gamma = n_terms * u / (1.0 - n_terms * u)
+    total = weight_rtol + gamma * (1.0 + weight_rtol)
+    if not total < 0.5:
+        raise InputError(f"rounding bound {total:g} of {n_terms} terms is not small")
+    return total / (1.0 - total)
+
+
+def _sorted_cdf(values, weights):
+    values, weights = np.asarray(values, dtype=float), np.asarray(weights, dtype=float)
+    if values.shape != weights.shape or values.ndim != 1 or values.size == 0:
+        raise InputError(f"values {values.shape} and weights {weights.shape} must be 1-d arrays of one length")
+    if np.any(weights < 0) or not np.all(np.isfinite(weights)):
+        raise InputError("weights must be finite and >= 0")
+    order = np.argsort(values, kind="stable")
+    return values[order], np.cumsum(weights[order].astype(np.longdouble))
+
+
+def quantile_interval(values, weights, probs, weight_rtol: float = 0.0):
+    """The q-quantiles of a discrete law as an interval ``[Q^-(q), Q^+(q)]``, enclosing the rounding of the CDF.
+
+    Convention: ``Q^-(q) = min{v : F(v) >= q}`` (the lower quantile, numpy's ``inverted_cdf``) and
+    ``Q^+(q) = inf{v : F(v) > q}`` (the upper quantile); every ``v`` in between has ``P(X < v) <= q <= P(X <= v)``,
+    i.e. is a q-quantile. They differ exactly where the distribution function is flat at the level,
+    ``F = q`` on ``[Q^-, Q^+)``: then the quantile is an interval, not a number. (The law of p_k at lambda = 0.9 has
+    ``F = 0.9`` exactly on a stretch: the event {arrival at step k} has probability 0.9 and puts p_k below every
+    value reached after a final loss.) ``F`` is summed in extended precision with the rounding bound ``eps_i`` of
+    :func:`sum_rounding_bound`; the returned ``lo = min{v_i : F_hat_i >= q - eps_i} <= Q^-`` and
+    ``hi = min{v_i : F_hat_i - eps_i > q} >= Q^+`` enclose the exact interval, and ``lo == hi`` proves
+    ``Q^- = Q^+``. A level within the rounding of a flat stretch reads as flat (both ends reported).
 
     Parameters
     ----------
     values, weights : array_like (n,)
-        Support and probabilities (summing to 1).
+        Support points and their probabilities (summing to 1 up to their rounding; not renormalised).
     probs : array_like (k,)
-        Levels q in (0, 1].
+        Levels q in (0, 1).
+    weight_rtol : float
+        Relative error bound of each weight (see :func:`sum_rounding_bound`).
 
     Returns
     -------
-    ndarray (k,)
+    (lo, hi) : tuple of ndarray (k,)
+        Lower and upper ends; ``hi`` is the largest support point if no prefix sum exceeds q with certainty.
+
+    Raises
+    ------
+    InputError
+        For a level outside (0, 1), or malformed values or weights.
+    """
+    probs = np.atleast_1d(np.asarray(probs, dtype=float))
+    if np.any((probs <= 0) | (probs >= 1)):
+        raise InputError(f"quantile levels {probs.tolist()} must lie in (0, 1)")
+    v, F = _sorted_cdf(values, weights)
+    eps = F * np.longdouble(sum_rounding_bound(len(v), weight_rtol))
+    q = probs.astype(np.longdouble)[:, None]
+    reach = F[None, :] >= q - eps[None, :]
+    above = F[None, :] - eps[None, :] > q
+    lo = v[np.where(reach.any(axis=1), reach.argmax(axis=1), len(v) - 1)]
+    hi = v[np.where(above.any(axis=1), above.argmax(axis=1), len(v) - 1)]
+    return lo, hi
+
+
+def exceedance_probability(values, weights, level: float, level_rtol: float = 0.0, weight_rtol: float = 0.0):
+    """``P(X > level)`` of a discrete law, with a bound on its error.
+
+    Summed in extended precision (:func:`sum_rounding_bound`); a support point within ``level_rtol |level|`` of
+    the level (known to that relative accuracy) could lie on either side, so its weight is added to the bound.
+
+    Parameters
+    ----------
+    values, weights : array_like (n,)
+        Support points and probabilities.
+    level : float
+        The level (e.g. the mean E X).
+    level_rtol : float
+        Relative error bound of ``level``.
+    weight_rtol : float
+        Relative error bound of each weight.
+
+    Returns
+    -------
+    (p, err) : (float, float)
+        The probability of the points above the level, and a bound on ``|p - P(X > level)|``.
     """
     values, weights = np.asarray(values, dtype=float), np.asarray(weights, dtype=float)
-    order = np.argsort(values, kind="stable")
-    cdf = np.cumsum(weights[order])
-    cdf /= cdf[-1]
-    idx = np.searchsorted(cdf, np.asarray(probs, dtype=float) * (1 - 1e-15), side="left")
-    return values[order][np.minimum(idx, len(values) - 1)]
+    if values.shape != weights.shape or values.ndim != 1:
+        raise InputError(f"values {values.shape} and weights {weights.shape} must be 1-d arrays of one length")
+    above = values > level
+    near = np.abs(values - level) <= level_rtol * abs(level)
+    p = np.sum(weights[above].astype(np.longdouble))
+    ambiguous = float(np.sum(weights[near].astype(np.longdouble)))
+    return float(p), float(p) * sum_rounding_bound(len(values), weight_rtol) + ambiguous

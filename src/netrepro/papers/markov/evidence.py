@@ -17,11 +17,12 @@ import yaml
 
 from ...paperdata import load_claims
 from ...verdicts import erratum_evidence, evidence_frame
-from .certificates import parity_growth, parity_structure
+from .certificates import parity_growth, parity_structure, two_reception_bound
 from .enumeration import enumerate_norms, mean_norms_enumerated, monotonicity_violation
 from .lmis import schur_residual
 from .model import (
-    H_matrix, L_operator, LinearSystem, gilbert_elliott_stationary_loss, h_radius, observability_index,
+    H_matrix, L_operator, LinearSystem, defective_unit_circle_eigenvalues, gilbert_elliott_stationary_loss, h_radius,
+    observability_index,
     parity_bound_example2, parity_ceiling, phi_lyapunov, prop1_bound, prop1_closed_form, spectral_abs,
 )
 from .stability import single_transition
@@ -90,7 +91,8 @@ def _section51_rows(ex1, checks, curves, at):
             note += f"; Theorem 5 bound at q = {q_p1:g} (uncapped, interpolated) ~ {pth:.3f} > 1, so every eps works"
         if check == "exI_fig3_p05":
             note += f"; Proposition 1 bound at q = {q51:g} is {p_prop1:.4f} < {r.p:g} (it does not cover Fig 3)"
-        rows.append(dict(quantity=name, value=bool(r.certified and r.verdict == "feasible"), note=note))
+        rows.append(dict(quantity=name, value=bool(r.verdict == "feasible"), decided=bool(r.verdict != "undecided"),
+                         note=note))
     return rows
 
 
@@ -100,27 +102,39 @@ def _section52_rows(ex2, checks, tight, moments, growth_margins, growth_margin, 
     lo2 = observability_index(A2, C2)
     ck = checks
     lower, upper = float(ck.loc["exII_q05_tight_lower", "p"]), float(ck.loc["exII_q05_tight_upper", "p"])
+    bracket = dict(uncertainty=upper - lower if np.isfinite(upper) else np.inf,
+                   decided=bool(ck.loc["exII_q05_tight_lower", "verdict"] == "feasible"
+                                and ck.loc["exII_q05_tight_upper", "verdict"] == "infeasible" and np.isfinite(upper)))
     q52 = at["exII_thm5_q05"]["at"]["q"]
     analytic = float(parity_bound_example2(lam2, q52))
     rows = [
         dict(quantity="exII.not_one_step_observable", value=bool(lo2 > 1),
              note=f"observability index l_o = {lo2} (Definition 2); |lambda_i| = {np.abs(np.linalg.eigvals(A2)).round(6)}"),
-        dict(quantity="exII.p_thm5_q05", value=lower,
+        dict(quantity="exII.p_thm5_q05", value=0.5 * (lower + upper) if bracket["decided"] else lower,
+             uncertainty=0.5 * bracket["uncertainty"], decided=bracket["decided"],
              note=f"certified bisection bracket [{lower:.9f}, {upper:.9f}] at q = {q52:g} (lower end: "
                   f"{ck.loc['exII_q05_tight_lower', 'evidence']}; upper end: {ck.loc['exII_q05_tight_upper', 'evidence']}); "
                   f"closed form of the true critical value (1 - (|l|^2 (1-q))^2) / (|l|^4 q) = {analytic:.9f} lies "
                   f"{'inside' if lower <= analytic <= upper else 'OUTSIDE'} the bracket"),
     ]
     for t in tight[tight.check == "exII_q05"].itertuples():
-        rows.append(dict(quantity="exII.p_thm5_q05", variant=f"checks.tight_tol={t.tol:g}", value=float(t.p_lower)))
+        # the certified bracket [p_lower, p_upper] holds p_underline: its midpoint, uncertain by its half-width
+        width = float(t.p_upper - t.p_lower) if np.isfinite(t.p_upper) else np.inf
+        done = bool(t.certified and np.isfinite(width))
+        rows.append(dict(quantity="exII.p_thm5_q05", variant=f"checks.tight_tol={t.tol:g}",
+                         value=float(t.p_lower + 0.5 * width) if done else float(t.p_lower),
+                         uncertainty=0.5 * width, decided=done))
     r = ck.loc["exII_thm5_p0465"]
-    rows.append(dict(quantity="exII.p0465_certified", value=bool(r.certified and r.verdict == "feasible"),
+    rows.append(dict(quantity="exII.p0465_certified", value=bool(r.verdict == "feasible"),
+                     decided=bool(r.verdict != "undecided"),
                      note=f"at p = {r.p:g} the LMI is certified {r.verdict} ({r.evidence}); p_underline = {lower:.6f}"))
     r = ck.loc["exII_thm2_p1"]
     rows.append(dict(quantity="exII.lmi_p1_infeasible", value=bool(r.verdict == "infeasible"),
+                     decided=bool(r.verdict != "undecided"),
                      note=f"{r.evidence}; solver status {r.status} (information only)"))
     r = ck.loc["exII_fig5_p045"]
-    rows.append(dict(quantity="exII.fig5_certified", value=bool(r.certified and r.verdict == "feasible"),
+    rows.append(dict(quantity="exII.fig5_certified", value=bool(r.verdict == "feasible"),
+                     decided=bool(r.verdict != "undecided"),
                      note=f"{r.evidence}; {r.p:g} < p_underline = {lower:.6f}"))
     f6 = at["exII_fig6_diverges"]["at"]
     st = parity_structure(ex2["A"], ex2["C"], ex2["Q"])
@@ -133,7 +147,64 @@ def _section52_rows(ex2, checks, tight, moments, growth_margins, growth_margin, 
     rows.append(dict(quantity="exII.fig6_diverges", value=bool(rate > growth_margin), note=note))
     for m in growth_margins:
         rows.append(dict(quantity="exII.fig6_diverges", variant=f"map.certify.growth_margin={m:g}", value=bool(rate > m)))
-    return rows, lower, analytic
+    return rows, lower, analytic, bracket
+
+
+def _theorem3_rows(ex1, checks, moments, params, at):
+    """Claim thm3_peak_implies_ms: at Example I's check points where Theorem 2 certifies peak-covariance stability,
+    sup_k E||P_k|| is finite (a certified upper bound) and the exact E||P_k|| stays below it."""
+    A1 = np.asarray(ex1["A"], float)
+    system, S0 = LinearSystem.from_config(ex1), np.asarray(ex1["Sigma0"], float)
+    q3 = at["thm3_peak_implies_ms"]["at"]["q"]
+    names = [c["name"] for c in params["checks"]["points"] if c["example"] == "I" and float(c["q"]) == q3]
+    em = load_moments(moments, "I")
+    defective = defective_unit_circle_eigenvalues(A1)
+    parts, ok, premises, undecided, sup_exact = [], defective == 0, 0, 0, 0.0
+    for name in names:
+        r = checks.loc[name]
+        if r.verdict == "undecided":
+            undecided += 1
+            parts.append(f"(p, q) = ({r.p:g}, {r.q:g}): LMI undecided ({r.status}), no premise")
+            continue
+        if r.verdict != "feasible":
+            parts.append(f"(p, q) = ({r.p:g}, {r.q:g}): LMI certified infeasible, no premise")
+            continue
+        premises += 1
+        U = float(two_reception_bound(system, S0, np.array([r.p]), np.array([r.q]), params["map"]["certify"]["n_gaps"])[0])
+        exact = em.mean(float(r.p), float(r.q), "norm")
+        sup_exact = max(sup_exact, float(exact.max()))
+        ok &= bool(np.isfinite(U) and exact.max() <= U * (1 + 1e-12))
+        parts.append(f"(p, q) = ({r.p:g}, {r.q:g}): peak-covariance stable (Theorem 2 LMI certified: {r.evidence}); "
+                     f"sup_k E||P_k|| <= U = {U:.4g} (two-reception estimator, certified); exact max_(k <= {len(exact)}) "
+                     f"E||P_k|| = {exact.max():.4f} at k = {int(np.argmax(exact)) + 1} (E||P_k|| at the last three k: "
+                     f"{', '.join(f'{x:.4f}' for x in exact[-3:])})")
+    note = (f"Theorem 3's assumption: A = {A1.tolist()} has {defective} defective eigenvalues on the unit circle "
+            f"(eigenvalue moduli {np.round(np.abs(np.linalg.eigvals(A1)), 6).tolist()}); " + "; ".join(parts))
+    return [dict(quantity="thm3.exI_sup_bounded", value=bool(ok and premises > 0),
+                 decided=bool(undecided == 0 and premises > 0), note=note),
+            dict(quantity="thm3.exI_sup_exact", value=sup_exact,
+                 note="largest exact E||P_k|| (all channel paths, k <= depth + 1) over the premise points")]
+
+
+def _holdout_rows(holdout):
+    """Finding asymptote_holdout: the exact E||P_k|| past the exact range against the asymptote's bracket."""
+    h = holdout
+    if h.empty:
+        return [dict(quantity="asymptote.holdout_inside", value="no asymptote rows", decided=False,
+                     note="no figure setting was continued by the asymptote: nothing to test"),
+                dict(quantity="asymptote.holdout_position", value=np.nan, decided=False, note="")]
+    inside = h.inside.astype(str).str.lower().eq("true")
+    # where each held-out value sits in its bracket: 0 at lo, 1 at hi (outside: below 0 or above 1)
+    pos = (h.exact_mean - h.asym_lo) / (h.asym_hi - h.asym_lo)
+    note = "; ".join(f"{r.figure} (p, q) = ({r.p:g}, {r.q:g}), k = {r.k}: exact {r.exact_mean:.10g} in "
+                     f"[{r.asym_lo:.10g}, {r.asym_hi:.10g}]: {'inside' if ok else 'OUTSIDE'}"
+                     for r, ok in zip(h.itertuples(), inside))
+    return [dict(quantity="asymptote.holdout_inside", value=bool(inside.all()),
+                 note=f"{int(inside.sum())} of {len(h)} held-out exact values inside the asymptote's bracket "
+                      f"(built from k <= {int(h.k.min()) - 1} only): {note}"),
+            dict(quantity="asymptote.holdout_position", value=float(pos.max()),
+                 note=f"position of the held-out values in their brackets (0 = lower end, 1 = upper end): from "
+                      f"{float(pos.min()):.3f} to {float(pos.max()):.3f}")]
 
 
 def _ceiling_rows(ex2, curves, smap):
@@ -169,15 +240,30 @@ def _ceiling_rows(ex2, curves, smap):
     ]
 
 
+def _certified(column) -> np.ndarray:
+    """A boolean column of a table read back from CSV (True / False / text)."""
+    return column.astype(str).str.lower().eq("true").to_numpy()
+
+
 def _curve_rows(curves, params):
     rows = []
     c = curves
+    tol = params["curves"]["bisection_tol"]
+    cert = _certified(c.thm5_certified)
+    # the bisection's bracket [p_thm5, p_thm5_upper] at each q (saturated: feasible at the search cap, no upper end)
+    width = (c.p_thm5_upper - c.p_thm5_uncapped).where(~_certified(c.thm5_saturated), 0.0).to_numpy(float)
+    width = np.where(np.isnan(width), np.inf, width)  # no certified-infeasible end: the bracket is open
     less = float((c.p_thm5_uncapped - c.p_prop1_uncapped).min())
     worst = c.loc[(c.p_thm5_uncapped - c.p_prop1_uncapped).idxmin()]
-    rows.append(dict(quantity="thm2_vs_prop1.min_gap", value=bool(less >= 0.0),
+    # a negative gap is real only where the certified-infeasible end lies at or below Proposition 1's bound; a
+    # feasible end below it with the bracket reaching above it (a short or undecided bisection) decides nothing
+    below = (c.p_thm5_uncapped < c.p_prop1_uncapped).to_numpy()
+    real = cert & (c.p_thm5_upper <= c.p_prop1_uncapped).to_numpy()
+    rows.append(dict(quantity="thm2_vs_prop1.min_gap", value=bool(less >= 0.0), decided=bool(np.all(real[below])),
                      note=f"consistency check (holds by construction: Proposition 1 is Theorem 1 with K = 0, finding "
                           f"prop1_is_thm1_K0): min over {len(c)} (example, q) of p_thm5 (certified-feasible end) - "
-                          f"p_prop1 = {less:.4g} (Example {worst.example}, q = {worst.q:.4f})"))
+                          f"p_prop1 = {less:.4g} (Example {worst.example}, q = {worst.q:.4f}); undecided where a "
+                          f"feasible end below p_prop1 has its bracket reaching above it"))
     gap = c.p_reference - c.p_thm5
     bad = int((gap < 0).sum())
     c2, c1 = c[c.example == "II"], c[c.example == "I"]
@@ -193,23 +279,39 @@ def _curve_rows(curves, params):
                           + (f"; at the other {len(open1)} the gap is {g1.min():.3g} to {g1.max():.3g}" if len(open1)
                              else "")))
     inside = (c2.p_reference >= c2.p_thm5) & (c2.p_reference <= c2.p_thm5_upper)
-    all_cert = bool(c2.thm5_certified.astype(str).str.lower().eq("true").all())
+    ex2 = (c.example == "II").to_numpy()
+    all_cert = bool(cert[ex2].all())
+    w2 = float(np.max(width[ex2])) if ex2.any() else np.nan
     dev = float((c2.p_reference - c2.p_thm5).abs().max())
     bracket = (f"over {len(c2)} q in ({c2.q.min():.4f}, {c2.q.max():.4f}): p_c lies inside the certified bracket "
                f"[p_thm5, p_thm5_upper] at {int(inside.sum())} of {len(c2)} q (bracket width <= "
                f"{float((c2.p_thm5_upper - c2.p_thm5).max()):.2g}, bisection tolerance "
                f"{params['curves']['bisection_tol']:g}); all brackets certified: {all_cert}")
-    rows.append(dict(quantity="thm5.exII_equals_reference", value=dev, note=f"max |p_c - p_thm5| {bracket}"))
-    rows.append(dict(quantity="thm5.exII_reference_inside", value=bool(all_cert and inside.all()), note=bracket))
+    rows.append(dict(quantity="thm5.exII_equals_reference", value=dev, uncertainty=w2, decided=all_cert,
+                     note=f"max |p_c - p_thm5| {bracket}"))
+    # exactness to the bisection's resolution needs every bracket certified and no wider than the tolerance (a
+    # short bisection, e.g. an unconverged solver, leaves it undecided; a certified bracket missing p_c refutes it)
+    narrow = bool(np.all(width[ex2] <= tol * (1 + 1e-9)))
+    refuted = bool(np.any(cert[ex2] & ~inside.to_numpy()))
+    rows.append(dict(quantity="thm5.exII_reference_inside", value=bool(all_cert and inside.all()),
+                     decided=bool(refuted or (all_cert and narrow)), note=bracket))
     q_full = c1[c1.p_thm5_uncapped >= 1].q
     gap1 = float((1.0 - c1.p_thm5).max())
+    at = int(np.argmax((1.0 - c1.p_thm5).to_numpy()))
+    ex1 = (c.example == "I").to_numpy()
+    w1, cert1 = float(width[ex1][at]), bool(cert[ex1][at])
+    # a certified gap: the infeasible end itself lies below 1 by more than the tolerance
+    certain = float(np.max(np.where(cert[ex1], 1.0 - c1.p_thm5_upper.fillna(np.inf).to_numpy(float), -np.inf)))
     gap_note = (f"Example I (p_c = 1 for q > q_necessary): Theorem 5 below 1 for q < "
                 f"{float(q_full.min()) if len(q_full) else float('nan'):.4f} (largest gap {gap1:.4g} at q = "
                 f"{float(c1.loc[(1.0 - c1.p_thm5).idxmax()].q):.4f})")
-    rows.append(dict(quantity="thm5.exI_gap", value=gap1, note=gap_note))
-    rows.append(dict(quantity="thm5.exI_conservative", value=bool(gap1 > params["curves"]["bisection_tol"]),
-                     note=gap_note + f"; conservative = largest gap above the bisection tolerance "
-                                     f"{params['curves']['bisection_tol']:g}"))
+    rows.append(dict(quantity="thm5.exI_gap", value=gap1, uncertainty=w1 if np.isfinite(w1) else np.inf,
+                     decided=cert1, note=gap_note))
+    conservative = bool(gap1 > tol)
+    rows.append(dict(quantity="thm5.exI_conservative", value=conservative,
+                     decided=bool(not conservative or certain > tol),
+                     note=gap_note + f"; conservative = largest gap above the bisection tolerance {tol:g}; certified "
+                                     f"gap (1 - the certified-infeasible end) {certain:.4g}"))
     return rows
 
 
@@ -226,8 +328,21 @@ def _iid_rows(iid, tol):
                 f"Theorem 5 certifies {r.lambda_lmi_upper - r.q_thm5_on_iid_line:+.6f} more")
     note = "; ".join(part(n, r) for n, r in (("I", r1), ("II", r2))) + f"; bisection tolerance iid.tol = {tol:g}"
     both_exact = all(abs(v - r2.lambda_c_reference) <= 2 * tol for v in (r2.lambda_lmi_upper, r2.q_thm5_on_iid_line))
-    return [dict(quantity="iid.sinopoli_minus_thm5", value=d1, note=note),
+
+    def bracket(r):
+        """Widths and certification of the two bisections of one example."""
+        sin = float(r.lambda_lmi_upper - r.lambda_lmi_infeasible_certified_end)
+        thm5 = float(r.q_thm5_on_iid_line - r.q_thm5_infeasible_end)
+        cert = str(r.lambda_lmi_certified).lower() == "true" and str(r.q_thm5_certified).lower() == "true"
+        return sin, thm5, bool(cert and np.isfinite(sin) and np.isfinite(thm5))
+
+    s1, t1, c1 = bracket(r1)
+    s2, t2, c2 = bracket(r2)
+    narrow = all(w <= tol * (1 + 1e-9) for w in (s1, t1, s2, t2))
+    return [dict(quantity="iid.sinopoli_minus_thm5", value=d1, uncertainty=s1 + t1 if c1 else np.inf, decided=c1,
+                 note=note),
             dict(quantity="iid.thm5_more_exI_equal_exII", value=bool(d1 > tol and both_exact),
+                 decided=bool(c1 and c2 and narrow),
                  note=f"Example I: Theorem 5 certifies {d1:.6f} more (> tol {tol:g}); Example II: both within 2 tol of "
                       f"lambda_c = {r2.lambda_c_reference:.6f}: {both_exact}")]
 
@@ -313,7 +428,7 @@ def _prop2_rows(params, moments):
     return rows
 
 
-def _errata_rows(ex1, lower, analytic, seed, printed_p, at):
+def _errata_rows(ex1, lower, analytic, seed, printed_p, at, bracket):
     A1, C1 = np.asarray(ex1["A"], float), np.asarray(ex1["C"], float)
     rng = np.random.default_rng(seed)
     pt = at["exI_fig3_stable"]["at"]  # a setting of the paper's Example I (any point tests the identities)
@@ -330,8 +445,10 @@ def _errata_rows(ex1, lower, analytic, seed, printed_p, at):
         dict(quantity="E1_C_i_undefined.residual_corrected", value=max(schur, adj),
              note=f"Schur residual {schur:.1e}, adjoint residual {adj:.1e}"),
         *erratum_evidence("E2_eq11_last_block", float(m), 0.0, f"row mismatch of the printed block: m = {m}"),
-        *erratum_evidence("E3_exII_0465", printed_p - lower, abs(analytic - lower),
-                          f"{printed_p:g} - certified p_underline; closed form {analytic:.9f}"),
+        *(dict(r, **bracket) for r in erratum_evidence(
+            "E3_exII_0465", printed_p - lower, abs(analytic - lower),
+            f"{printed_p:g} - certified p_underline (the feasible end of its certified bracket; uncertainty: the "
+            f"bracket's width); closed form {analytic:.9f}")),
         *erratum_evidence("E7_phi_definite", float(np.linalg.eigvalsh(phi0)[0]), None,
                           f"smallest eigenvalue of Phi_X at X = 0 (Example I, q = {q51:g}): not positive definite"),
     ]
@@ -382,7 +499,7 @@ def evidence_step(params, inputs, outputs):
         The ``markov`` configuration (examples, checks, curves, iid, paths, exact, expectations, map,
         estimator, prop2, errata_seed).
     inputs : dict
-        ``checks, tight, curves, iid, map, sensitivity, moments`` (result tables) and ``claims``,
+        ``checks, tight, curves, iid, map, sensitivity, moments, holdout`` (result tables) and ``claims``,
         ``findings`` (the data files whose ``at:`` fields give the paper's settings).
     outputs : dict
         ``table``.
@@ -401,8 +518,10 @@ def evidence_step(params, inputs, outputs):
     sens = pd.read_csv(inputs["sensitivity"])
     moments = pd.read_csv(inputs["moments"])
     rows = _section51_rows(ex1, checks, curves, at)
+    rows += _theorem3_rows(ex1, checks, moments, params, at)
+    rows += _holdout_rows(pd.read_csv(inputs["holdout"]))
     tight = pd.read_csv(inputs["tight"])
-    r52, lower, analytic = _section52_rows(ex2, checks, tight, moments, params["map"]["sensitivity"]["growth_margin"],
+    r52, lower, analytic, bracket = _section52_rows(ex2, checks, tight, moments, params["map"]["sensitivity"]["growth_margin"],
                                            params["map"]["certify"]["growth_margin"], at)
     rows += r52
     rows += _ceiling_rows(ex2, curves, smap)
@@ -411,6 +530,7 @@ def evidence_step(params, inputs, outputs):
     rows += _map_rows(smap, curves, sens, params)
     rows += _prop2_rows(params, moments)
     # the printed p_underline(0.5) is the configured check point exII_thm5_p0465 (not typed here)
-    rows += _errata_rows(ex1, lower, analytic, params["errata_seed"], float(checks.loc["exII_thm5_p0465", "p"]), at)
+    rows += _errata_rows(ex1, lower, analytic, params["errata_seed"], float(checks.loc["exII_thm5_p0465", "p"]), at,
+                         bracket)
     rows += _reconstruction_rows(params, sens, tight)
     return {"table": evidence_frame(rows)}

@@ -21,7 +21,7 @@ __all__ = [
     "LinearSystem", "spectral_abs", "observability_index", "stacked_output", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm", "batched_trace",
     "gilbert_elliott_stationary_loss", "parity_bound_example2", "parity_ceiling", "norm_relaxation_bound",
-    "prop1_closed_form",
+    "prop1_closed_form", "defective_unit_circle_eigenvalues",
 ]
 
 
@@ -95,6 +95,47 @@ def spectral_abs(A) -> float:
         ``max_i |lambda_i(A)|``.
     """
     return float(np.max(np.abs(np.linalg.eigvals(np.atleast_2d(A)))))
+
+
+def defective_unit_circle_eigenvalues(A, tol: float = 1e-6) -> int:
+    """Number of distinct defective eigenvalues of ``A`` on the unit circle (Definition 4; Theorem 3's assumption).
+
+    An eigenvalue is defective when its algebraic multiplicity exceeds its geometric multiplicity
+    ``n - rank(A - lambda I)``. Computed eigenvalues of a Jordan block of size ``m`` scatter by about
+    ``eps^(1/m)`` around the true one, so eigenvalues within ``tol`` form one cluster (the algebraic multiplicity
+    is its size, ``lambda`` its mean) and the rank is taken with the same tolerance.
+
+    Parameters
+    ----------
+    A : array_like
+        Square matrix.
+    tol : float
+        Cluster radius, distance of ``|lambda|`` from 1, and rank tolerance (relative to ``max(1, ||A||)``);
+        the default covers Jordan blocks up to size 2 (scatter ~1.5e-8) and 3 (~6e-6) of well-scaled matrices.
+
+    Returns
+    -------
+    int
+        How many eigenvalue clusters with ``||lambda| - 1| <= tol`` are defective (0: Theorem 3 applies).
+    """
+    A = np.atleast_2d(np.asarray(A, dtype=complex))
+    n = A.shape[0]
+    eig = np.linalg.eigvals(A)
+    clusters, left = [], list(eig)
+    while left:
+        seed = left.pop(0)
+        members = [seed] + [x for x in left if abs(x - seed) <= tol]
+        left = [x for x in left if abs(x - seed) > tol]
+        clusters.append(members)
+    scale = max(1.0, float(np.linalg.norm(A, 2)))
+    count = 0
+    for members in clusters:
+        lam = np.mean(members)
+        if abs(abs(lam) - 1.0) > tol:
+            continue
+        geometric = n - int(np.linalg.matrix_rank(A - lam * np.eye(n), tol=tol * scale))
+        count += len(members) > geometric
+    return count
 
 
 def observability_index(A, C) -> int:

@@ -18,11 +18,12 @@ Tables (``results/markov/``)
     ``p_reference`` and ``reference`` (the known critical value where theory gives it:
     Example I non-degenerate => p_c = 1 [18]; Example II => our parity renewal formula).
 ``lmi_checks.csv``
-    point checks of Theorem 2 / 5: ``check, example, p, q, status, margin, solver_feasible,
-    certified, rho_H, lyap_margin``.
+    point checks of Theorem 2 / 5: ``check, example, p, q, status, verdict, evidence, margin, solver_feasible,
+    certified, rho_H, lyap_margin``; ``certified`` is True when the verdict rests on a certificate, feasible
+    (eigenvalue check and ``rho(H(K)) < 1``) or infeasible (a necessary condition or a checked dual certificate).
 ``tight_variants.csv``
     the tight Theorem 5 bisections repeated at each ``checks.tight_tol_variants``: ``check, example,
-    q, tol, p_lower, p_upper, certified, n_solves``.
+    q, tol, p_lower, p_upper, certified, n_solves, n_undecided, statuses`` (solver statuses seen).
 ``lmi_benchmark.csv``
     ``mode`` (parametrised / rebuilt), ``n_solves, seconds, solves_per_second``.
 ``iid_line.csv``
@@ -42,7 +43,9 @@ Tables (``results/markov/``)
     ``growth_rate_exact`` (extrapolated from the exact E||P_k||), ``growth_rate_last`` (raw rate over
     the last two exact steps), ``mean_norm_last`` (exact E||P_K||), ``growth_rate_long`` and
     ``rel_halfwidth_long`` (long-horizon conditional estimator, only for points the exact horizon
-    left undecided), ``method`` (which computation decided).
+    left undecided), ``method`` (which computation decided), ``p_thm1`` (``1 / rho(H_1(K))``: Theorem 1 certifies
+    every ``p < p_thm1`` at that ``q``) and ``p_thm1_above_cap`` (``p_thm1 > 1``: above the cap ``p <= 1`` of a
+    failure rate, so the number is no failure rate; it says that every ``p < 1`` is certified).
 ``sample_paths.csv``
     for each of Figs 3-6: ``figure, example, p, q, k, gamma`` (one sample path; gamma_k),
     ``norm_path`` (||P_k|| along it), ``q05, q50, q95`` (Monte Carlo quantiles of ||P_k||),
@@ -61,6 +64,16 @@ Tables (``results/markov/``)
     by a backtest on the exact range) or ``not_trustworthy`` (empty mean); on ``asymptote`` rows
     ``limit, limit_lo, limit_hi``: ``lim_k E||P_k||`` of the asymptote and its bracket (``inf`` when it
     diverges; :func:`.expectations.asymptote_limit`), empty elsewhere.
+``asymptote_holdout.csv``
+    out-of-sample test of the asymptote: for every figure setting continued by the asymptote, the exact
+    ``E||P_k||`` at the ``expectations.holdout`` steps after the exact range (computed here, from a deeper tree
+    than the asymptote saw) against the asymptote's bracket: ``figure, example, p, q, k, exact_mean, asym_mean,
+    asym_lo, asym_hi, inside``.
+
+Every step that solves LMIs fails, naming itself and the solver statuses, when none of its LMI questions was
+decided by a certificate (:func:`_require_decisions`): a table of undecided answers only would be no result. The
+runner stops such a step too, from the engine's count of certified verdicts; this check counts the paper's own
+final verdicts (a point the engine certifies feasible but whose gain has ``rho(H(K)) >= 1`` is undecided here).
 """
 
 from __future__ import annotations
@@ -70,6 +83,7 @@ import time
 import numpy as np
 import pandas as pd
 
+from ...errors import ModelError
 from . import estimators as est
 from . import expectations as xp
 from .exact import ExactMoments, exact_moments_auto, find_split
@@ -83,8 +97,31 @@ from .stability import classify_growth, decide_estimator, refine_long_horizon
 
 __all__ = [
     "critical_curves_step", "lmi_checks_step", "iid_line_step", "exact_moments_step", "stability_map_step",
-    "sample_paths_step", "expectations_step", "load_moments", "tight_variants_step",
+    "sample_paths_step", "expectations_step", "load_moments", "tight_variants_step", "asymptote_holdout_step",
 ]
+
+
+def _require_decisions(step: str, n_decided: int, n_total: int, statuses) -> None:
+    """Stop a step none of whose LMI questions a certificate decided (a capped or failing solver).
+
+    Parameters
+    ----------
+    step : str
+        The step's name, for the message.
+    n_decided, n_total : int
+        LMI questions decided (feasible or infeasible, certified) and asked.
+    statuses : iterable of str
+        The solver statuses met.
+
+    Raises
+    ------
+    ModelError
+        When ``n_total > 0`` and ``n_decided == 0``.
+    """
+    if n_total > 0 and n_decided == 0:
+        seen = ", ".join(sorted({str(x).split(":")[0] for x in statuses})) or "none"
+        raise ModelError(f"markov step {step}: all {n_total} LMI decisions are undecided (solver statuses: {seen}); "
+                         "no certificate decided any point, so the step has no result")
 
 
 def _verdict(r):
@@ -184,8 +221,10 @@ def critical_curves_step(params, inputs, outputs):
             {"example": name, "mode": "theorem-5 sweep (parametrised)", "n_solves": lmi.n_solves - nb,
              "seconds": elapsed, "solves_per_second": (lmi.n_solves - nb) / elapsed},
         ]
-    return {"table": pd.DataFrame(rows), "benchmark": pd.DataFrame(bench),
-            "provenance": {"n_solves": int(sum(r["thm5_n_solves"] for r in rows))}}
+    n_solves = int(sum(r["thm5_n_solves"] for r in rows))
+    _require_decisions("critical_curves", n_solves - int(sum(r["thm5_n_undecided"] for r in rows)), n_solves,
+                       [x for r in rows for x in r["thm5_statuses"].split("|")])
+    return {"table": pd.DataFrame(rows), "benchmark": pd.DataFrame(bench), "provenance": {"n_solves": n_solves}}
 
 
 def lmi_checks_step(params, inputs, outputs):
@@ -216,9 +255,10 @@ def lmi_checks_step(params, inputs, outputs):
         lmi = GilbertElliottLMI(A, C)
         p = float(item["p"])
         r = lmi.solve(p, float(item["q"]))
+        verdict = _verdict(r)
         rows.append({"check": item["name"], "example": item["example"], "p": p, "q": item["q"], "status": r.status,
-                     "verdict": _verdict(r), "evidence": r.evidence,
-                     "margin": r.margin, "solver_feasible": r.solver_feasible, "certified": r.certified,
+                     "verdict": verdict, "evidence": r.evidence,
+                     "margin": r.margin, "solver_feasible": r.solver_feasible, "certified": verdict != "undecided",
                      "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
     for item in ck["tight"]:
         ex = params["examples"][item["example"]]
@@ -227,18 +267,20 @@ def lmi_checks_step(params, inputs, outputs):
         res = thm5_lower_bound(lmi, float(item["q"]), 1.0, ck["tight_tol"])
         for label, p in (("tight_lower", res["p_lower"]), ("tight_upper", res["p_upper"])):
             r = lmi.solve(float(p), float(item["q"]))
+            verdict = _verdict(r)
             rows.append({"check": f"{item['name']}_{label}", "example": item["example"], "p": p, "q": item["q"],
-                         "status": r.status, "verdict": _verdict(r), "evidence": r.evidence,
+                         "status": r.status, "verdict": verdict, "evidence": r.evidence,
                          "margin": r.margin, "solver_feasible": r.solver_feasible,
-                         "certified": r.certified, "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
+                         "certified": verdict != "undecided", "rho_H": r.rho_H, "lyap_margin": r.lyap_margin})
+    _require_decisions("lmi_checks", sum(r["certified"] for r in rows), len(rows), [r["status"] for r in rows])
     return {"table": pd.DataFrame(rows)}
 
 
 def tight_variants_step(params, inputs, outputs):
     """The tight Theorem 5 bisections (eq. 12) repeated at every tolerance of ``checks.tight_tol_variants``.
 
-    Table ``tight_variants.csv``: ``check, example, q, tol, p_lower, p_upper, certified, n_solves``; the
-    claims on ``p_underline`` are re-judged across these tolerances.
+    Table ``tight_variants.csv``: ``check, example, q, tol, p_lower, p_upper, certified, n_solves, n_undecided,
+    statuses``; the claims on ``p_underline`` are re-judged across these tolerances.
 
     Parameters
     ----------
@@ -264,7 +306,10 @@ def tight_variants_step(params, inputs, outputs):
             res = thm5_lower_bound(lmi, float(item["q"]), 1.0, float(tol))
             rows.append({"check": item["name"], "example": item["example"], "q": item["q"], "tol": float(tol),
                          "p_lower": res["p_lower"], "p_upper": res["p_upper"], "certified": res["certified"],
-                         "n_solves": res["n_solves"]})
+                         "n_solves": res["n_solves"], "n_undecided": res["n_undecided"],
+                         "statuses": "|".join(res["statuses"])})
+    _require_decisions("tight_variants", sum(r["n_solves"] - r["n_undecided"] for r in rows),
+                       sum(r["n_solves"] for r in rows), [x for r in rows for x in r["statuses"].split("|")])
     return {"table": pd.DataFrame(rows)}
 
 
@@ -294,7 +339,7 @@ def iid_line_step(params, inputs, outputs):
     from ...engines.certify import bisect_certified  # scipy.sparse: only the LMI steps need the engine
 
     tol = params["iid"]["tol"]
-    rows = []
+    rows, brackets = [], []
     for name, ex in params["examples"].items():
         A, C = np.asarray(ex["A"], float), np.asarray(ex["C"], float)
         lam = spectral_abs(A)
@@ -307,6 +352,7 @@ def iid_line_step(params, inputs, outputs):
         # feasibility at (p, q) = (1 - q, q) is monotone in q: p falls while p_underline(q) rises
         res = bisect_certified(lambda q: as_verdict(lmi.solve(1.0 - q, q)), lower + 1e-6, 1.0 - 1e-6, tol=tol,
                                feasible_above=True)
+        brackets += [sin_br, res]
         kind = ex.get("reference", "none")
         if kind == "nondegenerate":
             ref, text = lower, "non-degenerate: lambda_c = 1 - 1/|lambda|^2 (Mo & Sinopoli)"
@@ -323,6 +369,9 @@ def iid_line_step(params, inputs, outputs):
                      "q_thm5_on_iid_line": res.feasible_end, "q_thm5_infeasible_end": res.infeasible_end,
                      "q_thm5_certified": res.certified, "lambda_c_reference": ref, "reference": text,
                      "consistent": bool(lower - tol <= ref <= min(upper, res.feasible_end) + tol)})
+    verdicts = [v for br in brackets for v in br.verdicts.values()]
+    _require_decisions("iid_line", sum(v.verdict != "undecided" for v in verdicts), len(verdicts),
+                       [v.solver_status for v in verdicts])
     return {"table": pd.DataFrame(rows)}
 
 
@@ -501,6 +550,7 @@ def stability_map_step(params, inputs, outputs):
             p_thm1 = 1.0 / facts["rho1"]
         f = pd.DataFrame({"example": name, "p": P.ravel(), "q": Qg.ravel(), "verdict": verdict.ravel(),
                           "method": method.ravel(), "dist_critical": dist.ravel(), "p_thm1": p_thm1.ravel(),
+                          "p_thm1_above_cap": p_thm1.ravel() > 1.0,
                           "upper_bound": facts["upper"].ravel(), "growth_rate": growth.ravel()})
         f = pd.concat([f, est], axis=1)
         f.insert(3, "bounded", f.verdict.map({"bounded": "True", "unbounded": "False"}).fillna(""))
@@ -679,4 +729,63 @@ def expectations_step(params, inputs, outputs):
         rows += _expectation_rows(case, exact, k_max, cond, asym)
         prov[case["figure"]] = info
     cols = ["example", "p", "q", "k", "mean_norm", "lo", "hi", "method", "limit", "limit_lo", "limit_hi"]
+    return {"table": pd.DataFrame(rows, columns=cols), "provenance": prov}
+
+
+def asymptote_holdout_step(params, inputs, outputs):
+    """Out-of-sample test of the asymptote of ``expectations.csv``: exact ``E||P_k||`` beyond the range it saw.
+
+    For each figure setting whose values beyond the exact range ``k <= K`` come from the asymptote
+    (:func:`.expectations.asymptote_extrapolation`, built from the exact values at ``k <= K`` only), the exact
+    tree is grown by ``expectations.holdout`` levels (:func:`.exact.exact_moments_auto`, depth ``K - 1 +
+    holdout``) and the exact ``E||P_k||`` at ``k = K+1 .. K+holdout`` is held against the asymptote's bracket
+    ``[lo, hi]`` of the table (slack ``1e-12`` relative, the rounding of both sums). The bracket claims to hold
+    every later value; a value outside refutes it.
+
+    Parameters
+    ----------
+    params : dict
+        The ``markov`` configuration's ``examples``, ``paths`` (``cases``: figure, example, p, q) and
+        ``expectations`` (``holdout``: the number of held-out steps).
+    inputs : dict
+        ``expectations`` (``results/markov/expectations.csv``).
+    outputs : dict
+        ``table`` (``results/markov/asymptote_holdout.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": dict}``: one row per held-out ``(figure, k)`` with columns
+        ``figure, example, p, q, k, exact_mean, asym_mean, asym_lo, asym_hi, inside``; the provenance gives,
+        per example, the depth and the largest relative difference of the deeper tree from the table's exact
+        values on the common range (the two computations must agree).
+    """
+    hold = int(params["expectations"]["holdout"])
+    table = pd.read_csv(inputs["expectations"])
+    rows, prov, deep = [], {}, {}
+    for case in params["paths"]["cases"]:
+        name, p, q = case["example"], float(case["p"]), float(case["q"])
+        sub = table[(table.example == name) & np.isclose(table.p, p, rtol=0, atol=1e-12)
+                    & np.isclose(table.q, q, rtol=0, atol=1e-12)].sort_values("k")
+        asym = sub[sub.method == "asymptote"].set_index("k")
+        if asym.empty:
+            continue
+        exact_seen = sub[sub.method == "exact"].mean_norm.to_numpy(float)
+        K = len(exact_seen)
+        depth = K - 1 + hold
+        if (name, depth) not in deep:
+            ex = params["examples"][name]
+            deep[(name, depth)] = exact_moments_auto(_system(ex), np.asarray(ex["Sigma0"], float), depth)
+        exact = deep[(name, depth)].mean(p, q, "norm")
+        prov[case["figure"]] = {"depth": depth, "k_seen": K, "max_rel_diff_seen": float(
+            np.max(np.abs(exact[:K] / exact_seen - 1.0)))}
+        for k in range(K + 1, K + hold + 1):
+            if k not in asym.index:
+                continue
+            a = asym.loc[k]
+            value = float(exact[k - 1])
+            rows.append({"figure": case["figure"], "example": name, "p": p, "q": q, "k": k, "exact_mean": value,
+                         "asym_mean": float(a.mean_norm), "asym_lo": float(a.lo), "asym_hi": float(a.hi),
+                         "inside": bool(a.lo * (1 - 1e-12) <= value <= a.hi * (1 + 1e-12))})
+    cols = ["figure", "example", "p", "q", "k", "exact_mean", "asym_mean", "asym_lo", "asym_hi", "inside"]
     return {"table": pd.DataFrame(rows, columns=cols), "provenance": prov}

@@ -32,6 +32,9 @@ __all__ = [
     "local_crossing_fit",
     "run_tail_statistics",
     "pooled_se_ratio",
+    "paired_db_contrasts",
+    "replicate_coverage",
+    "binomial_coverage",
 ]
 
 
@@ -766,3 +769,150 @@ def pooled_se_ratio(se_ratio, n_blocks) -> tuple:
     dof = float((b - 1).sum())
     band = np.sqrt(stats.chi2.ppf([0.025, 0.975], dof) / dof)
     return math.sqrt(float(((r**2) * (b - 1)).sum()) / dof), int(dof), float(band[0]), float(band[1])
+
+
+def paired_db_contrasts(values, contrasts, n_boot: int, seed: int, level: float = 0.95):
+    r"""Contrasts of log ratios of mean per-run values, with one paired percentile bootstrap over runs.
+
+    Contrast :math:`c` is :math:`\sum_t w_t\, 10\log_{10}(\bar a_t/\bar b_t)` over its terms
+    ``(a_t, b_t, w_t)``: e.g. ``[("kf_short", "sm_short", 1), ("kf_long", "sm_long", -1)]`` is the
+    bias of rho_S on short records against long ones of the same runs. Every replicate resamples the
+    runs with replacement and uses the same run indices for every array (the arrays are paired by
+    run), as :func:`paired_ratio_intervals` does (same generator, same draw of indices).
+
+    Parameters
+    ----------
+    values : dict of ndarray (n_runs,)
+        Per-run values, paired by run.
+    contrasts : sequence of sequence of tuple
+        Per contrast its terms ``(num, den, weight)`` (keys of ``values``, float).
+    n_boot : int
+        Bootstrap replicates.
+    seed : int
+        Seed of the resampling generator.
+    level : float
+        Coverage of the percentile interval.
+
+    Returns
+    -------
+    list of tuple of float
+        ``(estimate, lo, hi)`` per contrast, in dB.
+
+    Raises
+    ------
+    InputError
+        If the arrays differ in length or are empty.
+    """
+    keys = sorted({k for c in contrasts for a, b, _ in c for k in (a, b)})
+    arrs = {k: np.asarray(values[k], dtype=float) for k in keys}
+    shapes = {a.shape for a in arrs.values()}
+    if len(shapes) != 1 or next(iter(shapes)) == (0,) or len(next(iter(shapes))) != 1:
+        raise InputError(f"values must be 1-D of the same length, got {sorted(shapes)}")
+    n = len(arrs[keys[0]])
+    rng = np.random.default_rng(seed)
+    idx = rng.integers(0, n, size=(n_boot, n))
+    boot = _bootstrap_means(arrs, idx)
+    q = 100.0 * (1.0 - level) / 2.0
+    out = []
+    for c in contrasts:
+        est = sum(w * 10.0 * math.log10(arrs[a].mean() / arrs[b].mean()) for a, b, w in c)
+        rep = sum(w * 10.0 * np.log10(boot[a] / boot[b]) for a, b, w in c)
+        lo, hi = np.percentile(rep, [q, 100.0 - q])
+        out.append((float(est), float(lo), float(hi)))
+    return out
+
+
+def replicate_coverage(values, n_replicates: int, reference=None, level: float = 0.95) -> dict:
+    r"""Coverage of the normal interval of a mean, tested on disjoint replicates of the runs.
+
+    The runs (independent, in block order) are cut into ``n_replicates`` contiguous disjoint
+    replicates. Replicate :math:`r` has mean :math:`\bar v_r` and normal standard error
+    :math:`s_r/\sqrt{n_r}`. Its reference is ``reference`` (an exact value, standard error 0) or,
+    without one, the mean of the other replicates' runs with its own normal standard error
+    (independent of replicate :math:`r`: disjoint runs). The replicate's interval covers when
+    :math:`|z_r| \le z_{(1+\text{level})/2}`, :math:`z_r = (\bar v_r - \text{ref}_r)/\sqrt{se_r^2 + se_{\text{ref}}^2}`;
+    with correct standard errors and a normal mean, :math:`z_r \sim N(0, 1)` and the coverage is
+    ``level``. Heavy tails show as under-coverage: most replicates miss the rare large runs, so
+    their mean and their :math:`s_r` are both too small.
+
+    Parameters
+    ----------
+    values : ndarray (n,)
+        Per-run values.
+    n_replicates : int
+        Number of disjoint replicates (at least 2, at most n/2).
+    reference : float, optional
+        The exact mean, if known.
+    level : float
+        Nominal coverage of the normal interval.
+
+    Returns
+    -------
+    dict of ndarray (n_replicates,)
+        ``n, mean, se, reference, reference_se, z`` (float) and ``covered`` (bool).
+
+    Raises
+    ------
+    InputError
+        If there are fewer than two replicates or fewer than two runs per replicate.
+    """
+    from scipy.special import ndtri
+
+    v = np.asarray(values, dtype=float)
+    R = int(n_replicates)
+    if R < 2 or v.ndim != 1 or len(v) < 2 * R:
+        raise InputError(f"need at least 2 replicates of at least 2 runs; got {R} replicates of {v.shape} runs")
+    parts = np.array_split(v, R)
+    n = np.array([len(p) for p in parts], dtype=float)
+    sums = np.array([p.sum() for p in parts])
+    sq = np.array([np.sum((p - p.mean()) ** 2) for p in parts])
+    mean = sums / n
+    se = np.sqrt(sq / (n - 1.0) / n)
+    if reference is not None:
+        ref = np.full(R, float(reference))
+        ref_se = np.zeros(R)
+    else:
+        others = [np.concatenate(parts[:r] + parts[r + 1:]) for r in range(R)]
+        ref = np.array([o.mean() for o in others])
+        ref_se = np.array([o.std(ddof=1) / math.sqrt(len(o)) for o in others])
+    z = (mean - ref) / np.sqrt(se**2 + ref_se**2)
+    return dict(n=n, mean=mean, se=se, reference=ref, reference_se=ref_se, z=z,
+                covered=np.abs(z) <= float(ndtri(0.5 + level / 2.0)))
+
+
+def binomial_coverage(covered: int, total: int, nominal: float = 0.95, level: float = 0.95) -> dict:
+    r"""Observed coverage of ``total`` intervals against their nominal level: Clopper-Pearson interval and test.
+
+    ``covered`` of ``total`` independent intervals hold their reference; under correct intervals
+    the count is :math:`\mathrm{Bin}(\text{total}, \text{nominal})`. The one-sided p-value of
+    under-coverage is :math:`P(X \le \text{covered})`; the Clopper-Pearson interval of the coverage
+    at ``level`` comes from the beta quantiles.
+
+    Parameters
+    ----------
+    covered, total : int
+        Intervals that cover, and all intervals (``0 <= covered <= total``, ``total >= 1``).
+    nominal : float
+        The intervals' nominal coverage.
+    level : float
+        Level of the Clopper-Pearson interval.
+
+    Returns
+    -------
+    dict
+        ``fraction, lo, hi, p_under`` (float).
+
+    Raises
+    ------
+    InputError
+        If the counts are inconsistent.
+    """
+    from scipy import stats
+
+    k, n = int(covered), int(total)
+    if n < 1 or not 0 <= k <= n:
+        raise InputError(f"need 0 <= covered <= total, total >= 1; got {k} of {n}")
+    a = (1.0 - level) / 2.0
+    lo = float(stats.beta.ppf(a, k, n - k + 1)) if k > 0 else 0.0
+    hi = float(stats.beta.ppf(1.0 - a, k + 1, n - k)) if k < n else 1.0
+    return dict(fraction=k / n, lo=lo, hi=hi, p_under=float(stats.binom.cdf(k, n, nominal)))

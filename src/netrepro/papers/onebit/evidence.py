@@ -35,8 +35,14 @@ from scipy.special import ndtri
 
 from ...paperdata import load_paper_data
 from ...verdicts import erratum_evidence, evidence_frame
-from .estimators import paired_ratio_interval, pooled_se_ratio
-from .fisher import expected_fisher_1bit, rho_s_zero_crossing_limit
+from .estimators import binomial_coverage, paired_ratio_interval, pooled_se_ratio
+from .fisher import (
+    ACHIEVABLE_LIMIT_SNR_MAX_DB,
+    achievable_rho_s_crossing_limit,
+    achievable_rho_s_limit_db,
+    expected_fisher_1bit,
+    rho_s_zero_crossing_limit,
+)
 from .model import axis_shift_db, prior_check, sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
 from .randomwalk import (
     ratio_window,
@@ -305,23 +311,25 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
         sub = rs_all[np.isclose(rs_all["alpha"], 1.0 - eps, rtol=0, atol=1e-15) & (rs_all["snr_db"] <= smax)]
         sub = sub.sort_values(["snr_db", "n_runs"])
         value = bool(len(sub) > 0 and (sub["lo_db"] > 0).all())
+        # decided: every interval above 0 (true), or one entirely below 0 (false); else some interval straddles 0
+        decided = bool(len(sub) > 0 and (value or (sub["hi_db"] < 0).any()))
         note = "; ".join(f"{r.snr_db:g} dB: {r.estimate_db:.2f} [{r.lo_db:.2f}, {r.hi_db:.2f}] (bound {r.bound_db:.2f}, "
                          f"n = {r.n_runs})" for r in sub.itertuples())
-        return value, note
+        return value, note, decided
 
     rows, outside = [], []
     for i, eps in enumerate(est["one_minus_alpha"]):
-        value, note = judged(float(eps), med_ends[0])
+        value, note, decided = judged(float(eps), med_ends[0])
         if i > 0 and not eps < eps_max:
             outside.append(f"{alpha_label(eps)} (outside 'alpha close to one', 1 - alpha >= {eps_max:.3g}): "
                            f"{'significant' if value else 'not significant'} at every SNR <= {med_ends[0]:g} dB; {note}")
             continue
-        rows.append(dict(quantity="achievable_rho_s_positive", value=value, note=note,
+        rows.append(dict(quantity="achievable_rho_s_positive", value=value, note=note, decided=decided,
                          variant="nominal" if i == 0 else variant_label("estimator", alpha_label(eps))))
     for smax in med_ends[1:]:
-        value, note = judged(eps0, smax)
+        value, note, decided = judged(eps0, smax)
         rows.append(dict(quantity="achievable_rho_s_positive", variant=f"medium_snr_regime={smax:g} dB", value=value,
-                         note=note))
+                         note=note, decided=decided))
     if outside:
         rows[0]["note"] += ". Not judged: " + " | ".join(outside)
     # the two halves of the runs at the nominal alpha: other seeds' blocks, half the sample size
@@ -340,11 +348,12 @@ def _achievable_rows(params, est_ratios: pd.DataFrame, shards, eps_max: float) -
             continue
         label = variant_label("estimator", f"{alpha_label(eps0)}, runs {'first' if h == 0 else 'second'} half "
                                            f"(n = {res[0][4]})")
-        rows.append(dict(quantity="achievable_rho_s_positive", variant=label, value=all(r[2] > 0 for r in res)))
+        rows.append(dict(quantity="achievable_rho_s_positive", variant=label, value=all(r[2] > 0 for r in res),
+                         decided=all(r[2] > 0 for r in res) or any(r[3] < 0 for r in res)))
     return rows
 
 
-def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.DataFrame, crossing) -> list:
+def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.DataFrame) -> list:
     """Evidence of our own findings (settings: the ``at:`` fields of findings.yaml)."""
     se, ev = params["sigma_eta"], params["evidence"]
     at = params["_at"]
@@ -368,31 +377,15 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
         g = g[g["snr_db"] >= lo_snr].sort_values("snr_db")
         lower = g["mse_lo"] / g["bound"]
         value = bool(len(g) > 1 and (lower > 1).all() and (np.diff(g["mse_over_bound"].to_numpy()) > 0).all())
+        # decided: each SNR's interval clear of the bound, and each step's change significant (independent cases)
+        ratio, half = g["mse_over_bound"].to_numpy(), ((g["mse_hi"] - g["mse"]) / g["bound"]).to_numpy()
+        clear = ((g["mse_lo"] / g["bound"] > 1) | (g["mse_hi"] / g["bound"] < 1)).all()
+        steps_sig = (np.abs(np.diff(ratio)) > np.hypot(half[1:], half[:-1])).all()
+        decided = bool(len(g) > 1 and clear and steps_sig)
         note = (f"1-bit smoother MSE/BCRB at {alpha_label(1.0 - alpha)}: " + ", ".join(
             f"{r.snr_db:g} dB: {r.mse_over_bound:.2f} (lower 95 % end {r.mse_lo / r.bound:.2f})" for r in g.itertuples()))
-        rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note,
+        rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note, decided=decided,
                          variant="nominal" if i == 0 else variant_label("alpha_to_1", alpha_label(1.0 - alpha))))
-    # heavy tails of the per-run MSEs, and the normal standard error against independent seed blocks
-    heavy_min = float(at["mse_standard_errors_valid"]["kurtosis_heavy"])
-    sm = est_mse[est_mse["kind"].isin(["smoother_1bit", "filter_1bit"])]
-    ref = est_mse[est_mse["kind"].isin(["kalman_filter", "rts_smoother"])]
-    one = est_mse[est_mse["kind"] == "smoother_1bit"]   # one row per case: independent replicates across rows
-    pooled, df, b_lo, b_hi = pooled_se_ratio(one["se_ratio"], one["n_blocks"])
-    heavy = one[one["kurtosis"] > heavy_min]
-    hp = pooled_se_ratio(heavy["se_ratio"], heavy["n_blocks"]) if len(heavy) else (float("nan"), 0, float("nan"), float("nan"))
-    a0 = est_mse["alpha"].max()
-    top = sm[(sm["alpha"] == a0) & (sm["snr_db"] >= 0)]
-    rows.append(dict(
-        quantity="mse_standard_errors_valid", value=bool(b_lo <= pooled <= b_hi),
-        note=f"1-bit smoother, {len(one)} cases: replicate (seed-block batch-means) / normal standard error pooled "
-             f"{pooled:.3f} on {df} df (95 % chi-square band [{b_lo:.3f}, {b_hi:.3f}]); the {len(heavy)} cases with "
-             f"kurtosis > {heavy_min:g}: {hp[0]:.3f} on {hp[1]} df [{hp[2]:.3f}, {hp[3]:.3f}]. Per-run kurtosis at "
-             f"alpha = {a0:g}, SNR >= 0 dB (1-bit filter/smoother): {top['kurtosis'].min():.0f} to "
-             f"{top['kurtosis'].max():.0f}, largest run {top['max_over_mean'].min():.0f} to "
-             f"{top['max_over_mean'].max():.0f} times the mean; Kalman/RTS everywhere: kurtosis <= "
-             f"{ref['kurtosis'].max():.1f}. Window {int(top['window_stop'].sub(top['window_start']).min())} to "
-             f"{int(top['window_stop'].sub(top['window_start']).max())} steps against the correlation time "
-             f"1/(1 - alpha) = {1.0 / (1.0 - a0):.0f} steps"))
     # the break-even lag exists exactly where rho_S > 0 (so it is no separate claim), and how long it is
     merged = lag.merge(ratios[["alpha", "snr_db", "rho_s_db"]], on=["alpha", "snr_db"])
     same = (merged["delta_break_even"].notna() == (merged["rho_s_db"] > 0))
@@ -440,44 +433,236 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
                      note="without the prior information (1 - alpha^2)/sigma_z^2: " + ", ".join(
                          f"{x:g} dB: rho_SL {a:.3f}, rho_F {b:.3f}" for x, a, b in
                          zip(very_low, nr["rho_sl_db"], nr["rho_f_db"]))))
-    # where the achievable rho_S crosses 0 dB (local fit, bootstrap over runs), against the bound
+    return rows
+
+
+def _half_width(estimate: float, lo: float, hi: float) -> float:
+    """Half-width of an interval around its estimate: the larger side (a percentile interval is not symmetric)."""
+    return float(max(estimate - lo, hi - estimate))
+
+
+def _crossing_evidence(params, crossing: pd.DataFrame, edge: pd.DataFrame) -> list:
+    """Where the achievable rho_S crosses 0 dB (local fit, bootstrap over runs), against the bound (49), the
+    alpha -> 1 achievable limit, and the bias of the 5-tau record edges (issue 37).
+
+    Every Monte Carlo value carries its uncertainty: the half-width of its 95 % interval.
+    """
     cr = crossing.set_index(["alpha", "curve"])
-    # the finding states the crossing at its own alpha (findings.yaml 'at'), whatever else is simulated
-    a_nom = 1.0 - float(params["_at"]["rho_s_crossing"]["one_minus_alpha"])
+    at = params["_at"]["rho_s_crossing"]
+    effect = float(at["effect_size_db"])
+    a_nom = 1.0 - float(at["one_minus_alpha"])
     stated = a_nom in set(crossing["alpha"])
     if not stated:  # a small configuration (config/test.yaml): the simulated alpha closest to one stands in
         a_nom = float(crossing["alpha"].max())
-    parts = []
+    limit = achievable_rho_s_crossing_limit()
+    edge_at = {}
+    if len(edge):
+        e_rs = edge[edge["quantity"] == "edge_bias_db.rho_S"]
+        for a, g in e_rs.groupby("alpha"):
+            edge_at[float(a)] = g
+    rows, parts = [], []
+    first = {}
     for a in sorted(crossing["alpha"].unique(), reverse=True):
         e = cr.loc[(a, "estimate")]
-        if not np.isfinite(e["n_points"]):
-            parts.append(f"alpha = {a:g}: achievable: no sign change on the simulated SNRs; bound "
-                         f"{cr.loc[(a, 'bound'), 'snr_db_crossing']:.2f} dB")
+        bound = float(cr.loc[(a, "bound"), "snr_db_crossing"])
+        label = "nominal" if a == a_nom else variant_label("estimator", alpha_label(1.0 - a))
+        if not np.isfinite(e["snr_db_crossing"]):
+            parts.append(f"alpha = {a:g}: achievable: no sign change on the simulated SNRs; bound {bound:.2f} dB")
+            rows.append(dict(quantity="rho_s_crossing_far_below_bound", variant=label, value=False, decided=False,
+                             note="no achievable crossing on the simulated SNRs" if a == a_nom else ""))
+            if a == a_nom:
+                rows += [dict(quantity=q, value=np.nan, uncertainty=math.inf, decided=False)
+                         for q in ("rho_s_crossing", "rho_s_crossing_gap")]
+                rows.append(dict(quantity="rho_s_crossing_bound", value=round(bound, 4), uncertainty=0.0))
             continue
-        parts.append(f"alpha = {a:g}: achievable {e['snr_db_crossing']:.2f} dB [{cr.loc[(a, 'lo'), 'snr_db_crossing']:.2f}, "
-                     f"{cr.loc[(a, 'hi'), 'snr_db_crossing']:.2f}] ({e['method']}, {e['fit_snr_lo']:g} to "
-                     f"{e['fit_snr_hi']:g} dB, {int(e['n_points'])} SNRs x {int(e['n_runs'])} runs, {int(e['n_boot'])} "
-                     f"bootstrap refits, fit residual {e['fit_residual_rms']:.3f} dB; sensitivity: " + ", ".join(
-                         f"{c.replace('_', ' ')} {cr.loc[(a, c), 'snr_db_crossing']:.2f}" for c in
+        est, lo, hi = (float(cr.loc[(a, c), "snr_db_crossing"]) for c in ("estimate", "lo", "hi"))
+        u = _half_width(est, lo, hi)
+        sens = ", ".join(f"{c.replace('_', ' ')} {cr.loc[(a, c), 'snr_db_crossing']:.2f}" for c in
                          ("fit_degree_1", "fit_degree_3", "runs_first_half", "runs_second_half") if (a, c) in cr.index)
-                     + f"), bound "
-                     f"{cr.loc[(a, 'bound'), 'snr_db_crossing']:.2f} dB; former straight line across the grid "
+        band = ""
+        if (a, "replicate_se") in cr.index:
+            rse, bse = float(cr.loc[(a, "replicate_se"), "snr_db_crossing"]), float(cr.loc[(a, "bootstrap_se"),
+                                                                                          "snr_db_crossing"])
+            band = (f"; band check: standard error {bse:.3f} dB from the bootstrap, {rse:.3f} dB from "
+                    f"{int(cr.loc[(a, 'replicate_se'), 'n_replicates'])} disjoint replicates (ratio {rse / bse:.2f})")
+        shift = ""
+        slope = float(e["slope_db_per_db"]) if "slope_db_per_db" in e else float("nan")
+        g = edge_at.get(float(a))
+        if g is not None and np.isfinite(slope) and slope < 0:
+            r = g.iloc[int(np.argmin(np.abs(g["snr_db"].to_numpy() - est)))]
+            b, bu = float(r["estimate"]), _half_width(float(r["estimate"]), float(r["lo"]), float(r["hi"]))
+            first.setdefault(a, dict(bias=b, bias_u=bu, shift=-b / slope, shift_u=bu / abs(slope), snr=float(r["snr_db"]),
+                                     extra=float(r["extra_taus"]), n=int(r["n_runs"])))
+            shift = (f"; record edges: rho_S on the standard record minus a record {r['extra_taus']:g} time constants "
+                     f"longer at each end, {r['snr_db']:g} dB: {b:+.3f} dB [{r['lo']:+.3f}, {r['hi']:+.3f}] "
+                     f"({int(r['n_runs'])} paired runs), so the crossing is moved by {-b / slope:+.3f} dB "
+                     f"(+- {bu / abs(slope):.3f}; fit slope {slope:.2f} dB/dB)")
+        parts.append(f"alpha = {a:g}: achievable {est:.2f} dB [{lo:.2f}, {hi:.2f}] ({e['method']}, {e['fit_snr_lo']:g} to "
+                     f"{e['fit_snr_hi']:g} dB, {int(e['n_points'])} SNRs x {int(e['n_runs'])} runs, "
+                     f"{int(e['n_boot'])} bootstrap refits, fit residual {e['fit_residual_rms']:.3f} dB; sensitivity: "
+                     f"{sens}{band}{shift}), bound {bound:.2f} dB; former straight line across the grid "
                      f"{cr.loc[(a, 'grid_linear'), 'snr_db_crossing']:.2f} dB")
-    rows.append(dict(quantity="rho_s_crossing", value=round(float(cr.loc[(a_nom, "estimate"), "snr_db_crossing"]), 4),
-                     note=("" if stated else f"the stated alpha is not simulated here; nominal alpha = {a_nom:g}; ")
-                     + "; ".join(parts) + f"; alpha -> 1 bound {rho_s_zero_crossing_limit():.2f} dB "
-                                          "(sigma_eta^2 E[F_q] = 1/4)"))
+        # the test: the achievable crossing lies below the bound's by more than the pre-set effect size;
+        # decided only when the whole interval is on one side of the threshold
+        gap_lo, gap_hi = bound - hi, bound - lo
+        rows.append(dict(quantity="rho_s_crossing_far_below_bound", variant=label, value=bool(gap_lo > effect),
+                         decided=bool(gap_lo > effect or gap_hi < effect),
+                         note=f"bound minus achievable crossing {bound - est:.2f} dB [{gap_lo:.2f}, {gap_hi:.2f}] "
+                              f"against the effect size {effect:g} dB" if a == a_nom else ""))
+        if a == a_nom:
+            rows += [dict(quantity="rho_s_crossing", value=round(est, 4), uncertainty=round(u, 4)),
+                     dict(quantity="rho_s_crossing_bound", value=round(bound, 4), uncertainty=0.0,
+                          note="the bound (49)'s crossing at the same alpha (Brent's method, exact)"),
+                     dict(quantity="rho_s_crossing_gap", value=round(bound - est, 4), uncertainty=round(u, 4))]
+    nom_rows = [r for r in rows if r["quantity"] == "rho_s_crossing"]
+    nom_rows[0]["note"] = (("" if stated else f"the stated alpha is not simulated here; nominal alpha = {a_nom:g}; ")
+                           + "; ".join(parts) + f"; alpha -> 1 bound {rho_s_zero_crossing_limit():.2f} dB (sigma_eta^2 "
+                           f"E[F_q] = 1/4), alpha -> 1 achievable {limit:.2f} dB (2/E[(sigma_eta^2 F_q)^(-1/2)] = 1)")
+    rows.append(dict(quantity="rho_s_crossing_limit", value=round(limit, 4), uncertainty=0.0,
+                     note="the alpha -> 1 limit of the achievable crossing, 2/E[(sigma_eta^2 F_q)^(-1/2)] = 1 "
+                          "(quadrature, exact to 1e-8)"))
+    ed = first.get(a_nom)
+    rows.append(dict(quantity="rho_s_edge_bias_db", value=round(ed["bias"], 4) if ed else np.nan,
+                     uncertainty=round(ed["bias_u"], 4) if ed else math.inf, decided=ed is not None,
+                     note=(f"{alpha_label(1.0 - a_nom)}, {ed['snr']:g} dB (the edge SNR nearest the crossing): rho_S on "
+                           f"the standard record (5 time constants before and after the window) minus rho_S on a record "
+                           f"{ed['extra']:g} time constants longer at each end, same {ed['n']} runs; 95 % paired "
+                           "bootstrap half-width" if ed else "no edge case at the nominal alpha in this configuration")))
+    rows.append(dict(quantity="rho_s_crossing_edge_shift_db", value=round(ed["shift"], 4) if ed else np.nan,
+                     uncertainty=round(ed["shift_u"], 4) if ed else math.inf, decided=ed is not None,
+                     note="the edge bias over the fit's slope at the crossing: how far the 5-tau records move the "
+                          "crossing (negative: too low)"))
     # at Fig 1's alpha, where simulated (config/paper-scale.yaml): context for the verdicts by scale
     a_fig1 = 1.0 - float(params["fig1_one_minus_alpha"])
     fig1 = cr.loc[(a_fig1, "estimate")] if (a_fig1, "estimate") in cr.index else None
     simulated = fig1 is not None and np.isfinite(fig1["snr_db_crossing"])
+    lo1, hi1 = ((float(cr.loc[(a_fig1, c), "snr_db_crossing"]) for c in ("lo", "hi")) if simulated else (np.nan, np.nan))
     rows.append(dict(quantity="rho_s_crossing_fig1_alpha",
                      value=round(float(fig1["snr_db_crossing"]), 4) if simulated else np.nan,
+                     uncertainty=round(_half_width(float(fig1["snr_db_crossing"]), lo1, hi1), 4) if simulated else math.inf,
+                     decided=bool(simulated),
                      note=(f"{alpha_label(1.0 - a_fig1)} (Fig 1): achievable {fig1['snr_db_crossing']:.2f} dB "
-                           f"[{cr.loc[(a_fig1, 'lo'), 'snr_db_crossing']:.2f}, {cr.loc[(a_fig1, 'hi'), 'snr_db_crossing']:.2f}]"
-                           f", bound {cr.loc[(a_fig1, 'bound'), 'snr_db_crossing']:.2f} dB" if simulated else
-                           f"{alpha_label(1.0 - a_fig1)} (Fig 1) not simulated by this configuration "
+                           f"[{lo1:.2f}, {hi1:.2f}], bound {cr.loc[(a_fig1, 'bound'), 'snr_db_crossing']:.2f} dB"
+                           if simulated else f"{alpha_label(1.0 - a_fig1)} (Fig 1) not simulated by this configuration "
                            "(config/paper-scale.yaml simulates it)")))
+    return rows
+
+
+def _limit_evidence(params, crossing: pd.DataFrame, est_ratios: pd.DataFrame) -> list:
+    """The alpha -> 1 limit of the achievable rho_S, 2/E[(sigma_eta^2 F_q)^(-1/2)] (beyond the paper, issue 37),
+    against the bound's limit 2 sqrt(sigma_eta^2 E[F_q]) and the simulated rho_S of the alpha closest to one."""
+    snrs = [float(x) for x in params["_at"]["achievable_limit"]["snr_db"]]
+    lim = achievable_rho_s_limit_db(snrs)
+    blim = 10.0 * np.log10(2.0 * np.sqrt(expected_fisher_1bit(10.0 ** (np.asarray(snrs) / 10.0))))
+    rs = est_ratios[(est_ratios["quantity"] == "rho_S")]
+    a_top = float(rs["alpha"].max())
+    top = rs[rs["alpha"] == a_top].sort_values(["snr_db", "n_runs"]).drop_duplicates("snr_db", keep="last")
+    top_lim = achievable_rho_s_limit_db(top["snr_db"].to_numpy())
+    sim = "; ".join(f"{r.snr_db:g} dB: {r.estimate_db:.2f} [{r.lo_db:.2f}, {r.hi_db:.2f}] (limit {lv:.2f})"
+                    for r, lv in zip(top.itertuples(), top_lim) if -10.0 <= r.snr_db <= 5.0)
+    cr = crossing[crossing["curve"] == "estimate"].dropna(subset=["snr_db_crossing"])
+    limit = achievable_rho_s_crossing_limit()
+    rows = [dict(quantity="achievable_limit_crossing_db", value=round(limit, 4), uncertainty=0.0,
+                 note="SNR where 2/E[(sigma_eta^2 F_q)^(-1/2)] = 1 (trapezoid rule on the product-Gaussian form, checked "
+                      "against adaptive quadrature to 1e-8); simulated crossings: " + ", ".join(
+                          f"{alpha_label(1.0 - a)}: {v:.2f} dB" for a, v in zip(cr["alpha"], cr["snr_db_crossing"]))),
+            dict(quantity="achievable_limit_snr_max_db", value=round(ACHIEVABLE_LIMIT_SNR_MAX_DB, 4), uncertainty=0.0,
+                 note="from Var[theta]/sigma_eta^2 = 2 on, E[F_q^(-1/2)] diverges: the limit is -inf dB"),
+            dict(quantity="bound_limit_crossing_db", value=round(rho_s_zero_crossing_limit(), 4), uncertainty=0.0,
+                 note="the alpha -> 1 limit of the bound (49), 2 sqrt(sigma_eta^2 E[F_q]), crosses 0 dB here")]
+    for x, lv, bv in zip(snrs, lim, blim):
+        rows.append(dict(quantity=f"achievable_limit_db.{x:g}dB", value=round(float(lv), 4), uncertainty=0.0,
+                         note=f"bound's limit 2 sqrt(sigma_eta^2 E[F_q]) there: {bv:.2f} dB"))
+    rows[0]["note"] += f"; simulated rho_S at {alpha_label(1.0 - a_top)}: {sim}"
+    return rows
+
+
+def _coverage_evidence(params, coverage: pd.DataFrame, est_mse: pd.DataFrame, est_ratios: pd.DataFrame) -> list:
+    """Whether the normal 95 % intervals of the MSEs cover: disjoint replicates against exact values (Kalman/RTS:
+    the finite-record BCRB they attain) or against the other replicates (1-bit), per simulated alpha (issue 37).
+
+    Per alpha, true iff no estimator's replicate intervals cover significantly less than 95 % (one-sided
+    binomial test, Bonferroni over the four estimators); decided when a test rejects or every Clopper-Pearson
+    interval of the coverage lies above the pre-set floor (``at: coverage_floor``).
+    """
+    est = params["estimator"]
+    at = params["_at"]["mse_standard_errors_valid"]
+    floor = float(at["coverage_floor"])
+    heavy_min = float(at["kurtosis_heavy"])
+    rows = []
+    if not len(coverage):
+        return [dict(quantity="mse_standard_errors_valid", value=False, decided=False,
+                     note="no case has enough runs for the replicates"),
+                dict(quantity="mse_interval_coverage", value=np.nan, uncertainty=math.inf, decided=False)]
+    kinds = ("smoother_1bit", "filter_1bit", "kalman_filter", "rts_smoother")
+    level = 0.05 / len(kinds)   # one-sided, Bonferroni over the estimators (each kind's replicates are independent)
+    for i, eps in enumerate(est["one_minus_alpha"]):
+        a = 1.0 - float(eps)
+        sub = coverage[np.isclose(coverage["alpha"], a, rtol=0, atol=1e-15)]
+        tests, parts = [], []
+        for kind in kinds:
+            c = sub[sub["kind"] == kind]
+            if not len(c):
+                continue
+            t = binomial_coverage(int(c["covered"].sum()), len(c))
+            tests.append(t)
+            hv = c[c["kurtosis"] > heavy_min]
+            heavy = ""
+            if len(hv):
+                th = binomial_coverage(int(hv["covered"].sum()), len(hv))
+                heavy = f"; kurtosis > {heavy_min:g}: {th['fraction']:.3f} [{th['lo']:.3f}, {th['hi']:.3f}] of {len(hv)}"
+            parts.append(f"{kind} (against {c['reference_kind'].iloc[0]}): {t['fraction']:.3f} [{t['lo']:.3f}, "
+                         f"{t['hi']:.3f}] of {len(c)} replicate intervals, p(under) = {t['p_under']:.2g}{heavy}")
+            if kind == "smoother_1bit" and i == 0:
+                rows.append(dict(quantity="mse_interval_coverage", value=round(t["fraction"], 4),
+                                 uncertainty=round(_half_width(t["fraction"], t["lo"], t["hi"]), 4),
+                                 note=f"{alpha_label(float(eps))}, 1-bit smoother: fraction of the normal 95 % "
+                                      "intervals of disjoint replicates that cover the other replicates' mean (Clopper-"
+                                      "Pearson 95 % half-width)"))
+        value = bool(tests) and all(t["p_under"] >= level for t in tests)
+        decided = bool(tests) and (not value or all(t["lo"] >= floor for t in tests))
+        n_rep = int(sub["replicate"].max()) + 1 if len(sub) else 0
+        rows.append(dict(quantity="mse_standard_errors_valid", value=bool(value), decided=bool(decided and n_rep >= 5),
+                         variant="nominal" if i == 0 else variant_label("estimator", alpha_label(float(eps))),
+                         note=f"{alpha_label(float(eps))}, {n_rep} disjoint replicates per case, one-sided binomial "
+                              f"test at {level:g} per estimator, decided when rejected or when every Clopper-Pearson "
+                              f"lower end >= {floor:g}: " + "; ".join(parts)))
+    # the ratios' paired bootstrap band: against an exact ratio (Kalman filter over RTS smoother), and, for the
+    # heavy-tailed rho_S, against the spread of the ratio over disjoint replicates
+    rat = coverage[coverage["kind"].astype(str).str.startswith("ratio_db:")]
+    if len(rat):
+        t = binomial_coverage(int(rat["covered"].sum()), len(rat))
+        rows.append(dict(quantity="ratio_band_exact_coverage", value=round(t["fraction"], 4),
+                         uncertainty=round(_half_width(t["fraction"], t["lo"], t["hi"]), 4),
+                         note=f"paired bootstrap 95 % intervals of the Kalman filter's MSE over the RTS smoother's (dB), "
+                              f"one per case, against the exact ratio of their finite-record bounds: {int(rat['covered'].sum())}"
+                              f" of {len(rat)} cover (Clopper-Pearson [{t['lo']:.3f}, {t['hi']:.3f}], p(under) = "
+                              f"{t['p_under']:.2g}); largest |z| = {rat['z'].abs().max():.2f}"))
+    if "se_rep_db" in est_ratios:
+        rs = est_ratios[(est_ratios["quantity"] == "rho_S") & (est_ratios["se_boot_db"] > 0)]
+        n_rep = int(est.get("n_replicates", 8))
+        pooled, df, b_lo, b_hi = pooled_se_ratio(rs["se_rep_db"] / rs["se_boot_db"], np.full(len(rs), n_rep))
+        rows.append(dict(quantity="rho_s_band_ratio", value=round(pooled, 4),
+                         uncertainty=round(max(pooled - b_lo, b_hi - pooled), 4),
+                         note=f"rho_S: standard error from {n_rep} disjoint replicates over that of the paired bootstrap, "
+                              f"pooled over {len(rs)} cases on {df} df: {pooled:.3f} (95 % chi-square band for a correct "
+                              f"bootstrap [{b_lo:.3f}, {b_hi:.3f}]; largest case {(rs['se_rep_db'] / rs['se_boot_db']).max():.2f})"))
+    # context: the former batch-means check (seed blocks as replicates; same runs, so it shows independence only)
+    one = est_mse[est_mse["kind"] == "smoother_1bit"]
+    pooled, df, b_lo, b_hi = pooled_se_ratio(one["se_ratio"], one["n_blocks"])
+    sm = est_mse[est_mse["kind"].isin(["smoother_1bit", "filter_1bit"])]
+    ref = est_mse[est_mse["kind"].isin(["kalman_filter", "rts_smoother"])]
+    a0 = est_mse["alpha"].max()
+    top = sm[(sm["alpha"] == a0) & (sm["snr_db"] >= 0)]
+    nominal = next(r for r in rows if r["quantity"] == "mse_standard_errors_valid")
+    nominal["note"] += (f". Per-run kurtosis at alpha = {a0:g}, SNR >= 0 dB (1-bit filter/smoother): "
+                        f"{top['kurtosis'].min():.0f} to {top['kurtosis'].max():.0f}, largest run "
+                        f"{top['max_over_mean'].min():.0f} to {top['max_over_mean'].max():.0f} times the mean; Kalman/RTS "
+                        f"everywhere: kurtosis <= {ref['kurtosis'].max():.1f}. Window "
+                        f"{int(top['window_stop'].sub(top['window_start']).min())} to "
+                        f"{int(top['window_stop'].sub(top['window_start']).max())} steps against the correlation time "
+                        f"1/(1 - alpha) = {1.0 / (1.0 - a0):.0f} steps. Batch means over seed blocks (the same runs: "
+                        f"independence, not coverage): pooled ratio {pooled:.3f} on {df} df [{b_lo:.3f}, {b_hi:.3f}]")
     return rows
 
 
@@ -557,7 +742,7 @@ def evidence_step(params, inputs, outputs):
     """Step of rule ``onebit_evidence``: table ``results/evidence/onebit.csv``.
 
     Inputs: ``ratios``, ``efq``, ``lag``, ``estimator`` (MSEs), ``estimator_ratios``, ``crossing``,
-    ``alpha_threshold``, the estimator ``shards`` and (optional) ``findings_file``, whose entries'
+    ``coverage``, ``edge`` (:func:`.steps.estimator_step`), ``alpha_threshold``, the estimator ``shards`` and (optional) ``findings_file``, whose entries'
     ``at:`` fields (and those of ``claims.yaml`` beside it) give the settings the evidence quotes.
     Low-SNR values are recomputed at each case from (29), (34)/(36) and (47)-(49)
     (:func:`.randomwalk.ratios_at`), the same functions as ``ratios.csv``.
@@ -626,8 +811,12 @@ def evidence_step(params, inputs, outputs):
     _, med_ends = _regimes(params)
     eps_max = float(threshold[threshold["snr_db"] <= med_ends[0]]["one_minus_alpha_max"].min())
     rows += _achievable_rows(params, pd.read_csv(inputs["estimator_ratios"]), shards, eps_max)
-    rows += _finding_rows(params, pd.read_csv(inputs["estimator"]), pd.read_csv(inputs["lag"]), ratios,
-                          pd.read_csv(inputs["crossing"]))
+    est_mse, crossing = pd.read_csv(inputs["estimator"]), pd.read_csv(inputs["crossing"])
+    est_ratios = pd.read_csv(inputs["estimator_ratios"])
+    rows += _finding_rows(params, est_mse, pd.read_csv(inputs["lag"]), ratios)
+    rows += _crossing_evidence(params, crossing, pd.read_csv(inputs["edge"]))
+    rows += _limit_evidence(params, crossing, est_ratios)
+    rows += _coverage_evidence(params, pd.read_csv(inputs["coverage"]), est_mse, est_ratios)
     rows += errata_rows(params)
     rows += _reconstruction_rows(params)
     return {"table": evidence_frame(rows)}

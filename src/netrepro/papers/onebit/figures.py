@@ -138,9 +138,20 @@ def figure_lag(params, inputs, outputs):
         if "delta_break_even" in g:
             ax.semilogy(g["snr_db"], g["delta_break_even"], ls="--", color=f"C{i}",
                         label=rf"break-even $\Delta$ ($J_{{k|k+\Delta,q}} > J_{{k|k,\infty}}$), {_alpha_label(alpha)}")
+    if "crossing" in inputs:   # where the real smoother no longer breaks even: its rho_S = 0 dB crossing (issue 37)
+        cr = pd.read_csv(inputs["crossing"]).set_index(["alpha", "curve"])["snr_db_crossing"]
+        for i, (alpha, _) in enumerate(lag.groupby("alpha")):
+            if (alpha, "estimate") not in cr.index or not np.isfinite(cr[(alpha, "estimate")]):
+                continue
+            e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
+            ax.axvspan(lo, hi, color=f"C{i}", alpha=0.15, lw=0)
+            ax.axvline(e, color=f"C{i}", lw=1.2, ls="-.",
+                       label=rf"real 1-bit smoother no longer breaks even: {e:.2f} dB [{lo:.2f}, {hi:.2f}], "
+                             rf"{_alpha_label(alpha)}")
     ax.set_xlabel("SNR [dB]")
     ax.set_ylabel(r"lag $\Delta$ for %g dB" % lag["tol_db"].iloc[0])
-    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed (solid) and break-even lag (dashed)", fontsize=10)
+    ax.set_title(r"Fig S3: smoothing delay $\Delta$ needed (solid), break-even lag of the bound (dashed), "
+                 "where the real smoother stops breaking even (dash-dot, 95 % band)", fontsize=9)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)   # outside: covers no curve
     save_figure(fig, outputs["figure"])
     return {}
@@ -149,8 +160,10 @@ def figure_lag(params, inputs, outputs):
 def figure_estimator_ratios(params, inputs, outputs):
     """Fig S4: rho_F, rho_S, rho_SL from the estimators' MSEs (paired-bootstrap 95 % intervals) next to the bound.
 
-    The crossing SNRs' rho_S are crosses; the achievable rho_S = 0 dB crossing (local fit, bootstrap
-    interval) is a diamond with its interval on the 0 dB line, the bound's crossing a vertical tick.
+    The crossing SNRs' rho_S are crosses, their local fit a dashed curve; the achievable rho_S = 0 dB
+    crossing (local fit, bootstrap interval) is a diamond with its interval on the 0 dB line, the
+    bound's crossing a vertical tick. With ``bounds`` (``ratios.csv``), the alpha -> 1 limit of the
+    achievable rho_S, 2/E[(sigma_eta^2 F_q)^(-1/2)], is the black dash-dot curve (issue 37).
     """
     allrat = pd.read_csv(inputs["ratios"])
     cross_pts = allrat[allrat["case_set"] == "crossing"] if "case_set" in allrat else allrat.iloc[:0]
@@ -177,6 +190,24 @@ def figure_estimator_ratios(params, inputs, outputs):
         ax.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
                     color=col, marker="x", ls="none", ms=5,
                     label=rf"$\rho_S$ at the crossing SNRs, $\alpha = {alpha:g}$ ({int(g['n_runs'].min())} runs)")
+    fits = {}
+    if "crossing" in inputs:
+        crt = pd.read_csv(inputs["crossing"])
+        if "coefs" in crt:
+            for r in crt[(crt["curve"] == "estimate") & crt["coefs"].notna()].itertuples():
+                xs = np.linspace(r.fit_snr_lo, r.fit_snr_hi, 60)
+                fits[r.alpha] = (xs, np.polyval([float(c) for c in str(r.coefs).split()], xs))
+        for alpha, (xs, ys) in fits.items():
+            col = "C0" if alpha == a_main else "C4"
+            ax.plot(xs, ys, color=col, lw=1.0, ls="--", label=rf"local fit of $\rho_S$, $\alpha = {alpha:g}$")
+    lim = None
+    if "bounds" in inputs:
+        b = pd.read_csv(inputs["bounds"])
+        if "rho_s_achievable_db" in b:
+            lim = b[(b["alpha"] == 1.0) & np.isfinite(b["rho_s_achievable_db"])].sort_values("snr_db")
+            lim = lim[lim["rho_s_achievable_db"] > -12.0]
+            ax.plot(lim["snr_db"], lim["rho_s_achievable_db"], color="k", lw=1.4, ls="-.",
+                    label=r"$\alpha \to 1$ achievable limit $2/E[F_q^{-1/2}]$ ($\sigma_\eta = 1$)")
     if "crossing" in inputs:
         cr = pd.read_csv(inputs["crossing"]).set_index(["alpha", "curve"])["snr_db_crossing"]
         for alpha in sorted({a for a, _ in cr.index}, reverse=True):
@@ -200,6 +231,13 @@ def figure_estimator_ratios(params, inputs, outputs):
             if "crossing" in inputs:
                 e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
                 ins.errorbar([e], [0.0], xerr=[[e - lo], [hi - e]], color=col, marker="D", ms=5, capsize=3)
+            if alpha in fits:
+                ins.plot(*fits[alpha], color=col, lw=0.8, ls="--")
+        if lim is not None:
+            near = lim[(lim["snr_db"] >= lo_x) & (lim["snr_db"] <= hi_x)]
+            ins.plot(near["snr_db"], near["rho_s_achievable_db"], color="k", lw=1.0, ls="-.")
+        if len(rs):   # the data decide the range; the limit's plunge towards 3 dB leaves the inset
+            ins.set_ylim(min(rs["lo_db"].min(), 0.0) - 0.3, rs["hi_db"].max() + 0.3)
         ins.axhline(0.0, color="k", lw=0.6)
         ins.set_xlim(lo_x, hi_x)
         ins.tick_params(labelsize=6)

@@ -19,7 +19,14 @@ __all__ = [
     "expected_fisher_1bit_quad",
     "expected_fisher_interpolator",
     "rho_s_zero_crossing_limit",
+    "expected_inverse_sqrt_fisher_1bit",
+    "achievable_rho_s_limit_db",
+    "achievable_rho_s_crossing_limit",
+    "ACHIEVABLE_LIMIT_SNR_MAX_DB",
 ]
+
+#: The stationary SNR (dB) from which E[F_q^(-1/2)] diverges: Var[theta]/sigma_eta^2 = 2.
+ACHIEVABLE_LIMIT_SNR_MAX_DB = 10.0 * math.log10(2.0)
 
 _LOG_SQRT_2PI = 0.5 * math.log(2.0 * math.pi)
 
@@ -191,3 +198,108 @@ def rho_s_zero_crossing_limit():
 
     return float(optimize.brentq(lambda d: float(expected_fisher_1bit(10 ** (d / 10))) - 0.25, -10.0, 40.0, xtol=1e-10))
 
+
+
+def expected_inverse_sqrt_fisher_1bit(var_ratio, half_width: float = 12.0, step: float = 0.1):
+    r"""Expected inverse square root of the 1-bit Fisher information, :math:`E[(\sigma_\eta^2 F_q(\theta))^{-1/2}]`.
+
+    Beyond the paper: with :math:`\theta \sim N(0, v\sigma_\eta^2)`, :math:`x = \theta/\sigma_\eta` and
+    (30) written :math:`\sigma_\eta^2 F_q = \varphi(x) h(x)`, :math:`h = \varphi/(\Phi(x)\Phi(-x))`,
+
+    .. math::
+
+        E[(\sigma_\eta^2 F_q)^{-1/2}] = (2\pi)^{1/4} \sqrt{w/v}\; E_{x \sim N(0, w)}[h(x)^{-1/2}],
+        \qquad w = \frac{2v}{2 - v},
+
+    because :math:`N(x; 0, v)\,\varphi(x)^{-1/2} = (2\pi)^{1/4}\sqrt{w/v}\,N(x; 0, w)`; the last
+    expectation is of a smooth function decaying like :math:`|x|^{-1/2}` and is taken by the
+    trapezoid rule on ``[-half_width, half_width]`` standard deviations. For :math:`v \ge 2` the
+    expectation diverges (:math:`F_q^{-1/2}` grows like :math:`e^{x^2/4}`) and ``inf`` is returned.
+    Limit :math:`\sqrt{\pi/2}` as :math:`v \to 0` (:math:`\sigma_\eta^2 F_q(0) = 2/\pi`).
+
+    Parameters
+    ----------
+    var_ratio : array_like
+        :math:`v = \mathrm{Var}[\theta]/\sigma_\eta^2` (the stationary SNR as a ratio), >= 0.
+    half_width, step : float
+        Trapezoid range (standard deviations of :math:`N(0, w)`) and spacing.
+
+    Returns
+    -------
+    ndarray
+        :math:`E[(\sigma_\eta^2 F_q)^{-1/2}]`, shape of ``var_ratio`` (``inf`` where ``v >= 2``).
+
+    Raises
+    ------
+    InputError
+        If ``var_ratio`` is negative.
+    """
+    v = np.asarray(var_ratio, dtype=float)
+    if np.any(v < 0):
+        raise InputError("expected_inverse_sqrt_fisher_1bit: var_ratio must be >= 0")
+    finite = v < 2.0
+    vf = np.where(finite, v, 1.0)
+    w = 2.0 * vf / (2.0 - vf)
+    u = np.arange(-half_width, half_width + step / 2, step)
+    weights = np.exp(-0.5 * u * u - _LOG_SQRT_2PI) * step
+    inner = np.exp(-0.5 * _log_h(np.sqrt(w)[..., None] * u)) @ weights
+    # sqrt(w / v) -> 1 as v -> 0 (w = 2v/(2 - v))
+    ratio = np.sqrt(2.0 / (2.0 - vf))
+    out = (2.0 * math.pi) ** 0.25 * ratio * inner
+    return np.where(finite, out, np.inf)
+
+
+def achievable_rho_s_limit_db(snr_db):
+    r"""The alpha -> 1 limit of the achievable rho_S (dB): :math:`2/E[(\sigma_\eta^2 F_q)^{-1/2}]`.
+
+    Beyond the paper. As :math:`\alpha \to 1` at fixed stationary SNR, :math:`\sigma_z \to 0` and the
+    filter's time constant :math:`1/(\sigma_z\sqrt{F})` becomes short against the state's
+    correlation time :math:`1/(1-\alpha)`: the state is locally constant, and the MMSE smoother
+    around :math:`\theta` is the random-walk smoother with information :math:`F_q(\theta)` per
+    step, of variance :math:`\sigma_z/(2\sqrt{F_q(\theta)})` (the :math:`\alpha \to 1` fixed
+    points of (34)/(36)). Averaged over the stationary law, against the unquantized Kalman filter's
+    :math:`\sigma_z\sigma_\eta` ((24), same limit),
+
+    .. math::
+
+        \rho_S^{\mathrm{ach}} \to \frac{2}{E[(\sigma_\eta^2 F_q(\theta))^{-1/2}]}
+        \le 2\sqrt{\sigma_\eta^2 E[F_q]} \quad\text{(Jensen; the bound's limit of (49))}.
+
+    It tends to :math:`2\sqrt{2/\pi}` (+2.03 dB) as SNR -> 0 and to 0 (-inf dB) as the SNR
+    reaches :data:`ACHIEVABLE_LIMIT_SNR_MAX_DB` (3.01 dB).
+
+    Parameters
+    ----------
+    snr_db : array_like
+        Stationary SNR :math:`10\log_{10}(\mathrm{Var}[\theta]/\sigma_\eta^2)` in dB.
+
+    Returns
+    -------
+    ndarray
+        The limit in dB (``-inf`` from 3.01 dB on).
+    """
+    e = expected_inverse_sqrt_fisher_1bit(10.0 ** (np.asarray(snr_db, dtype=float) / 10.0))
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(2.0 / e)
+
+
+def achievable_rho_s_crossing_limit(xtol: float = 1e-10) -> float:
+    r"""SNR (dB) where the alpha -> 1 achievable rho_S crosses 0 dB: :math:`E[(\sigma_\eta^2 F_q)^{-1/2}] = 2`.
+
+    Beyond the paper (:func:`achievable_rho_s_limit_db`); Brent's method between -10 dB and just
+    below :data:`ACHIEVABLE_LIMIT_SNR_MAX_DB`.
+
+    Parameters
+    ----------
+    xtol : float
+        Absolute tolerance of the root in dB.
+
+    Returns
+    -------
+    float
+        The SNR in dB (stationary definition).
+    """
+    from scipy import optimize
+
+    hi = ACHIEVABLE_LIMIT_SNR_MAX_DB - 1e-6
+    return float(optimize.brentq(lambda d: float(achievable_rho_s_limit_db(d)), -10.0, hi, xtol=xtol))

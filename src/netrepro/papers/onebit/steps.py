@@ -9,9 +9,9 @@ Tables written (``results/onebit/``)
     by adaptive quadrature; ``rel_err`` is their relative difference.
 ``ratios.csv``
     ``alpha, snr_db, efq_db, rho_sl_db, rho_f_db, rho_s_db`` then
-    ``one_minus_alpha, sigma_z2, j_f_inf, j_f_q, j_s_inf, j_s_q`` -- steady-state
+    ``one_minus_alpha, sigma_z2, j_f_inf, j_f_q, j_s_inf, j_s_q, rho_s_achievable_db`` -- steady-state
     fixed points; ``alpha = 1.0`` rows are the alpha -> 1 limit
-    (``one_minus_alpha = 0``, BIM columns empty).
+    (``one_minus_alpha = 0``, BIM columns empty), with the limit of the achievable rho_S.
 ``lag.csv``
     ``alpha, snr_db, delta_needed`` then ``delta_q, delta_inf, delta_q_iterated,
     delta_inf_iterated, tol_db, delta_scaled, delta_break_even`` -- smallest smoothing lag at which
@@ -48,6 +48,13 @@ Tables written (``results/onebit/``)
     the steady-state bound (47)-(49).
 ``estimator_crossing.csv``
     ``alpha, curve, snr_db_crossing`` -- where rho_S crosses 0 dB (estimate, lo, hi, bound).
+``estimator_coverage.csv``
+    ``alpha, snr_db, kind, case_set, replicate, reference_kind, kurtosis, n, mean, se, reference,
+    reference_se, z, covered`` -- the normal 95 % interval of each MSE on disjoint replicates against
+    the exact value (Kalman/RTS) or the other replicates (1-bit estimators).
+``estimator_edge.csv``
+    ``alpha, snr_db, quantity, estimate, lo, hi, unit, n_runs, extra_taus, tau`` -- the bias of the
+    5-tau record edges, standard record minus a long record around it (same runs), in dB.
 ``alpha_scan.csv``, ``alpha_threshold.csv``
     rho_S and the break-even lag over alpha; the largest 1 - alpha with rho_S > 0 per SNR.
 ``vector_check.csv``
@@ -67,17 +74,20 @@ from scipy.special import ndtri
 from .estimators import (
     db_zero_crossing,
     downward_root,
+    downward_roots,
     grid_smoother_at,
     kalman_rts,
     local_crossing_fit,
+    paired_db_contrasts,
     paired_ratio_intervals,
+    replicate_coverage,
     run_tail_statistics,
     simulate_block,
     window_mse,
 )
-from .fisher import expected_fisher_1bit, expected_fisher_1bit_quad
+from .fisher import achievable_rho_s_limit_db, expected_fisher_1bit, expected_fisher_1bit_quad
 from .model import sigma_z2_from_snr, snr_grid, stationary_variance, vector_check
-from .shards import ESTIMATOR_KINDS, RATIO_DEFS, estimator_cases, merged_runs
+from .shards import EDGE_KINDS, ESTIMATOR_KINDS, RATIO_DEFS, estimator_cases, merged_runs
 from .randomwalk import (
     bound_paths,
     estimator_design,
@@ -155,7 +165,9 @@ def ratios_step(params, inputs, outputs):
     1-bit (34)/(36), with E[F_q] (29) under the stationary law of theta (mean 0, variance (33)), and
     their ratios rho_SL (47), rho_F (48), rho_S (49) in dB (:func:`.randomwalk.information_ratios`).
     With the stationary SNR definition the alpha -> 1 limit is added (``alpha = 1``,
-    :func:`.randomwalk.information_ratios_limit`; its BIM columns are NaN).
+    :func:`.randomwalk.information_ratios_limit`; its BIM columns are NaN), with the alpha -> 1 limit of
+    the achievable rho_S, ``rho_s_achievable_db`` (:func:`.fisher.achievable_rho_s_limit_db`; -inf from
+    3.01 dB on; NaN on the finite-alpha rows).
 
     Parameters
     ----------
@@ -173,7 +185,8 @@ def ratios_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame}``: one row per alpha and SNR, columns ``alpha, snr_db, efq_db,
-        rho_sl_db, rho_f_db, rho_s_db, one_minus_alpha, sigma_z2, j_f_inf, j_f_q, j_s_inf, j_s_q``.
+        rho_sl_db, rho_f_db, rho_s_db, one_minus_alpha, sigma_z2, j_f_inf, j_f_q, j_s_inf, j_s_q,
+        rho_s_achievable_db``.
     """
     snr_db = snr_grid(**params["snr_grid_db"])
     q = params["quadrature"]
@@ -192,7 +205,7 @@ def ratios_step(params, inputs, outputs):
         frames.append(pd.DataFrame(dict(
             alpha=1.0, snr_db=snr_db, efq_db=_db(lim["efq"]), rho_sl_db=lim["rho_sl_db"], rho_f_db=lim["rho_f_db"],
             rho_s_db=lim["rho_s_db"], one_minus_alpha=0.0, sigma_z2=0.0, j_f_inf=np.nan, j_f_q=np.nan,
-            j_s_inf=np.nan, j_s_q=np.nan)))
+            j_s_inf=np.nan, j_s_q=np.nan, rho_s_achievable_db=achievable_rho_s_limit_db(snr_db))))
     return {"table": pd.concat(frames, ignore_index=True)}
 
 
@@ -346,6 +359,36 @@ def _estimator_simulator(params, eps, snr):
     return fn
 
 
+def _edge_simulator(params, eps, snr):
+    """``fn(rng, n)``: per-run MSEs of the four estimators on the standard record and on a long record around it.
+
+    The long record adds ``estimator.edge.extra_taus`` time constants before and after the standard
+    record (:func:`.randomwalk.estimator_design`); the standard record is its middle part, started
+    from the stationary prior (theta there is stationary), so both see the same states and noise
+    at the same evaluation steps and differ only in the data beyond the 5-tau edges.
+    """
+    est, se = params["estimator"], params["sigma_eta"]
+    s, _, design = _estimator_design(params, eps, snr)
+    ev, K = design["eval_idx"], design["horizon"]
+    extra = int(math.ceil(float(est["edge"]["extra_taus"]) * design["tau"]))
+    grid = (est["grid_half_width"], est["points_per_sigma_z"], est["band_sigmas"])
+
+    def fn(rng, n):
+        theta, y, r = simulate_block(rng, n, K + 2 * extra, eps, s, se)
+        th = theta[:, ev + extra]
+        out = {}
+        for suffix, yy, rr, idx in (("", y[:, extra:extra + K], r[:, extra:extra + K], ev),
+                                    ("_long", y, r, ev + extra)):
+            filt, smooth = grid_smoother_at(rr, eps, s, se, idx, *grid)
+            kf, rts = kalman_rts(yy, eps, s, se)
+            out.update({f"filter_1bit{suffix}": window_mse(filt, th), f"smoother_1bit{suffix}": window_mse(smooth, th),
+                        f"kalman_filter{suffix}": window_mse(kf[:, idx], th),
+                        f"rts_smoother{suffix}": window_mse(rts[:, idx], th)})
+        return out
+
+    return fn
+
+
 def estimator_shard_step(params, inputs, outputs):
     """Step: per-run window MSEs of one shard's blocks, for every case; block ``b`` has its own generator.
 
@@ -368,7 +411,8 @@ def estimator_shard_step(params, inputs, outputs):
     outputs : dict
         ``runs``: ``results/onebit/shards/estimator_<shard>.npz``, written by the step (atomically):
         per case key ``<key>|blocks`` and ``<key>|counts`` (block indices and their run counts) and
-        ``<key>|<kind>`` (per-run MSEs) for each kind of :data:`.shards.ESTIMATOR_KINDS`.
+        ``<key>|<kind>`` (per-run MSEs) for each kind of :data:`.shards.ESTIMATOR_KINDS` (of
+        :data:`.shards.EDGE_KINDS` for an edge case: :func:`_edge_simulator`).
 
     Returns
     -------
@@ -384,12 +428,13 @@ def estimator_shard_step(params, inputs, outputs):
     for case in estimator_cases(params):
         blocks = shard_blocks(case.n_runs, est["block_size"], params["n_shards"], params["shard"])
         sizes = [min(est["block_size"], case.n_runs - b * est["block_size"]) for b in blocks]
-        fn = _estimator_simulator(params, case.eps, case.snr_db)
+        edge = case.case_set == "edge"
+        fn = (_edge_simulator if edge else _estimator_simulator)(params, case.eps, case.snr_db)
         per_block = [fn(block_rng(case.seed, b), n) for b, n in zip(blocks, sizes)]
         arrays[f"{case.key}|blocks"] = np.asarray(blocks, dtype=np.int64)
         arrays[f"{case.key}|counts"] = np.asarray(sizes, dtype=np.int64)
         used[case.key] = [int(b) for b in blocks]
-        for kind in ESTIMATOR_KINDS:
+        for kind in EDGE_KINDS if edge else ESTIMATOR_KINDS:
             arrays[f"{case.key}|{kind}"] = np.concatenate([v[kind] for v in per_block]) if per_block else np.empty(0)
     with atomic_path(outputs["runs"]) as tmp:
         with open(tmp, "wb") as fh:
@@ -404,6 +449,13 @@ def _half_ratios_db(num, den) -> tuple:
     return tuple(float(10.0 * np.log10(num[sl].mean() / den[sl].mean())) for sl in (slice(0, n), slice(n, 2 * n)))
 
 
+def _replicate_ratios_db(num, den, n_replicates: int) -> np.ndarray:
+    """The MSE ratio (dB) on each of ``n_replicates`` disjoint contiguous replicates of the runs."""
+    return np.array([10.0 * np.log10(a.mean() / b.mean())
+                     for a, b in zip(np.array_split(np.asarray(num), n_replicates),
+                                     np.array_split(np.asarray(den), n_replicates))])
+
+
 def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
     """Rows of ``estimator_crossing.csv`` for every simulated alpha: local fit with a bootstrap interval, and the bound.
 
@@ -411,7 +463,10 @@ def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
     the grid points around the first sign change of the grid estimate (one on each side of the
     two bracketing points, when they exist). ``fit_degree_<d>`` and ``runs_first_half`` /
     ``runs_second_half`` are point estimates of the same fit with another degree or on half the runs
-    (sensitivity). ``grid_linear`` is the straight line between the two bracketing grid estimates
+    (sensitivity). ``replicate_se`` checks the bootstrap interval (``bootstrap_se``: its width over
+    2 x 1.96) against an independent estimate of the same standard error: the standard deviation of
+    the crossings fitted on ``estimator.n_replicates`` disjoint replicates of the runs, over
+    sqrt(replicates). ``grid_linear`` is the straight line between the two bracketing grid estimates
     (the former estimate, for comparison only).
     """
     est, se = params["estimator"], params["sigma_eta"]
@@ -443,8 +498,13 @@ def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
             info = dict(fit_snr_lo=float(x.min()), fit_snr_hi=float(x.max()), n_points=len(x),
                         n_runs=int(min(r["n_runs"] for r in pts)), n_boot=int(yb.shape[0]),
                         boot_fail_frac=fit["fail_frac"], fit_residual_rms=fit["residual_rms"])
+            slope = float(np.polyval(np.polyder(fit["coefs"]), fit["estimate"])) if np.isfinite(fit["estimate"]) \
+                else float("nan")
             for curve in ("estimate", "lo", "hi"):
                 rows.append(dict(base, curve=curve, snr_db_crossing=fit[curve], **info))
+            rows[-3]["slope_db_per_db"] = slope
+            # the fitted curve itself (Fig S4): its coefficients, highest power first
+            rows[-3]["coefs"] = " ".join(f"{c:.12g}" for c in fit["coefs"])
             # sensitivity (point estimates): the fit's degree, and each half of the runs at the configured degree
             for deg in sorted({1, 3} - {degree}):
                 if len(x) > deg:
@@ -454,6 +514,18 @@ def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
                 yh = np.array([r["half_db"][h] for r in pts])
                 rows.append(dict(base, curve=name, **dict(info, n_runs=info["n_runs"] // 2),
                                  snr_db_crossing=downward_root(np.polyfit(x, yh, degree), x.min(), x.max())))
+            # the bootstrap band checked against disjoint replicates: the spread of the replicates' crossings
+            # over sqrt(R) is an estimate of the full-sample standard error independent of the bootstrap
+            yr = np.column_stack([r["rep_db"] for r in pts])          # (R, points)
+            rep_roots = downward_roots(np.polyfit(x, yr.T, degree).T, x.min(), x.max())
+            n_rep = yr.shape[0]
+            ok = np.isfinite(rep_roots)   # a replicate whose fit has no root in the window is left out (counted)
+            se_rep = float(np.std(rep_roots[ok], ddof=1) / math.sqrt(n_rep)) if ok.sum() > 2 else float("nan")
+            rows.append(dict(base, curve="replicate_se", **dict(info, n_runs=info["n_runs"] // n_rep),
+                             snr_db_crossing=se_rep, n_replicates=n_rep,
+                             n_replicates_crossing=int(np.isfinite(rep_roots).sum())))
+            rows.append(dict(base, curve="bootstrap_se", **info, n_replicates=n_rep,
+                             snr_db_crossing=(fit["hi"] - fit["lo"]) / (2.0 * float(ndtri(0.975)))))
         else:
             for curve in ("estimate", "lo", "hi"):
                 rows.append(dict(base, curve=curve, snr_db_crossing=float("nan")))
@@ -462,7 +534,8 @@ def _crossing_rows(params, ratio_rows, boot) -> pd.DataFrame:
         rows.append(dict(alpha=a, curve="bound", snr_db_crossing=rho_s_zero_crossing(eps, se, params["snr_definition"]),
                          method="steady-state bound (49), Brent's method"))
     cols = ["alpha", "curve", "snr_db_crossing", "method", "degree", "fit_snr_lo", "fit_snr_hi", "n_points", "n_runs",
-            "n_boot", "boot_fail_frac", "fit_residual_rms"]
+            "n_boot", "boot_fail_frac", "fit_residual_rms", "slope_db_per_db", "coefs", "n_replicates",
+            "n_replicates_crossing"]
     return pd.DataFrame(rows).reindex(columns=cols)
 
 
@@ -479,32 +552,50 @@ def estimator_step(params, inputs, outputs):
     rho_SL from the MSEs with a paired bootstrap interval, next to the bound (49)-(47).
     ``case_set`` is ``grid`` or ``crossing`` (:mod:`.runs`). ``estimator_crossing.csv``: the SNR
     at which the achievable rho_S crosses 0 dB by a local polynomial fit with a bootstrap interval
-    over runs (:func:`.estimators.local_crossing_fit`), the former straight-line estimate, and the
-    bound's crossing.
+    over runs (:func:`.estimators.local_crossing_fit`; the estimate's row also holds the fit's slope
+    there and its coefficients), the former straight-line estimate, and the bound's crossing.
+    ``estimator_coverage.csv`` (issue 37): every grid and crossing case's runs cut into
+    ``estimator.n_replicates`` disjoint replicates; per replicate and estimator the normal 95 %
+    interval of the MSE against the exact value (Kalman/RTS: the finite-record BCRB, which they
+    attain) or, for the 1-bit estimators, against the other replicates' mean
+    (:func:`.estimators.replicate_coverage`); and, per case (``replicate = -1``), the paired bootstrap 95 %
+    interval of the Kalman filter's MSE over the RTS smoother's (dB) against its exact value, the ratio
+    of their finite-record bounds. ``estimator_ratios.csv`` also checks each ratio's bootstrap band against
+    the replicates: ``se_boot_db`` (interval width over 2 x 1.96) and ``se_rep_db`` (standard deviation of
+    the ratio over ``estimator.n_replicates`` disjoint replicates, over sqrt(replicates)). ``estimator_edge.csv`` (issue 37): for the edge
+    cases, the bias of the 5-tau record edges: each MSE on the standard record over the MSE on
+    the long record around it, and rho_S, rho_F, rho_SL on the standard minus the long record, in dB
+    with paired bootstrap intervals (:func:`_edge_rows`).
 
     Parameters
     ----------
     params : dict
         The ``onebit`` configuration's ``estimator`` (cases, run design, ``n_boot``: bootstrap
-        resamples, ``crossing``: the crossing cases and fit ``degree``), ``sigma_eta`` and
-        ``snr_definition``.
+        resamples, ``n_replicates``, ``crossing``: the crossing cases and fit ``degree``, ``edge``:
+        the edge cases and ``extra_taus``), ``sigma_eta`` and ``snr_definition``.
     inputs : dict
         ``shards``: the files written by :func:`estimator_shard_step` (any number of shards).
     outputs : dict
-        ``table``, ``ratios`` and ``crossing``: ``results/onebit/estimator_mse.csv``,
-        ``estimator_ratios.csv`` and ``estimator_crossing.csv``.
+        ``table``, ``ratios``, ``crossing``, ``coverage`` and ``edge``: ``results/onebit/estimator_mse.csv``,
+        ``estimator_ratios.csv``, ``estimator_crossing.csv``, ``estimator_coverage.csv`` and
+        ``estimator_edge.csv``.
 
     Returns
     -------
     dict
-        ``{"table": DataFrame, "ratios": DataFrame, "crossing": DataFrame}``: the three tables above.
+        ``{"table", "ratios", "crossing", "coverage", "edge": DataFrame}``: the five tables above.
     """
     est, se = params["estimator"], params["sigma_eta"]
     mse_rows, ratio_rows, boot = [], [], {}
     z = float(ndtri(0.975))
     ref_s, onebit_s, _ = RATIO_DEFS["rho_S"]
+    cov_rows, edge_rows = [], []
+    n_rep = int(est.get("n_replicates", 8))
     for case in estimator_cases(params):
         key, eps, snr, seed = case.key, case.eps, case.snr_db, case.seed
+        if case.case_set == "edge":
+            edge_rows += _edge_rows(params, case, merged_runs(inputs["shards"], key, kinds=EDGE_KINDS))
+            continue
         runs = merged_runs(inputs["shards"], key, with_blocks=True)
         s, Fq, d = _estimator_design(params, eps, snr)
         ev = d["eval_idx"]
@@ -523,25 +614,71 @@ def estimator_step(params, inputs, outputs):
             v = runs[kind]
             m, half = float(v.mean()), z * float(v.std(ddof=1)) / math.sqrt(len(v))
             tails = run_tail_statistics(v, runs["block"])
+            if len(v) >= 2 * n_rep:   # the normal interval's coverage on disjoint replicates (issue 37)
+                exact = kind in ("kalman_filter", "rts_smoother")   # Kalman/RTS attain the finite-record BCRB
+                cov = replicate_coverage(v, n_rep, reference=bounds[kind] if exact else None)
+                cov_rows += [dict(alpha=1.0 - eps, snr_db=snr, kind=kind, case_set=case.case_set, replicate=r,
+                                  reference_kind="exact (finite-record BCRB)" if exact else "other replicates",
+                                  kurtosis=tails["kurtosis"], **{c: cov[c][r] for c in cov})
+                             for r in range(n_rep)]
             mse_rows.append(dict(alpha=1.0 - eps, snr_db=snr, kind=kind, mse=m, mse_lo=m - half, mse_hi=m + half,
                                  bound=bounds[kind], bound_steady=steady[kind], mse_over_bound=m / bounds[kind],
                                  n_runs=len(v), steady_dev=dev[kind], **design_cols, case_set=case.case_set,
                                  **tails))
         bound = information_ratios(np.array([snr]), eps, se, params["snr_definition"])
-        pairs = [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()]
+        # the three ratios, and the Kalman filter over the RTS smoother: both attain their bound, so that ratio is
+        # known exactly and checks the paired bootstrap band (adding the pair changes no other pair's numbers)
+        pairs = [(ref, onebit) for ref, onebit, _ in RATIO_DEFS.values()] + [("kalman_filter", "rts_smoother")]
         intervals, reps = paired_ratio_intervals(runs, pairs, est["n_boot"], seed,  # one resampling per case,
                                                  replicates=True)                    # shared by the ratios
         for (qty, (ref, onebit, col)), (e, lo, hi) in zip(RATIO_DEFS.items(), intervals):
+            rep = _replicate_ratios_db(runs[ref], runs[onebit], n_rep)
             ratio_rows.append(dict(alpha=1.0 - eps, snr_db=snr, quantity=qty, estimate_db=e, lo_db=lo, hi_db=hi,
                                    bound_db=float(bound[col][0]), n_runs=len(runs[ref]),
                                    steady_dev=max(dev[ref], dev[onebit]), **design_cols, case_set=case.case_set,
-                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit])))
+                                   se_boot_db=(hi - lo) / (2.0 * z), se_rep_db=float(np.std(rep, ddof=1) / math.sqrt(n_rep)),
+                                   key=key, half_db=_half_ratios_db(runs[ref], runs[onebit]), rep_db=rep))
+        e, lo, hi = intervals[-1]
+        exact_db = 10.0 * math.log10(bounds["kalman_filter"] / bounds["rts_smoother"])
+        se_b = (hi - lo) / (2.0 * z)
+        cov_rows.append(dict(alpha=1.0 - eps, snr_db=snr, kind="ratio_db:kalman_filter/rts_smoother",
+                             case_set=case.case_set, replicate=-1, reference_kind="exact (ratio of the finite-record BCRBs)",
+                             kurtosis=float("nan"), n=float(len(runs["kalman_filter"])), mean=e, se=se_b,
+                             reference=exact_db, reference_se=0.0, z=(e - exact_db) / se_b, covered=lo <= exact_db <= hi))
         # bootstrap replicates of the achievable rho_S for the crossing fit: bootstrap_ratio_db(runs[ref_s],
         # runs[onebit_s], n_boot, seed), the same numbers as the intervals' resampling (same seed), not redrawn
         boot[key] = reps[pairs.index((ref_s, onebit_s))]
     crossing = _crossing_rows(params, ratio_rows, boot)
-    ratios = pd.DataFrame(ratio_rows).drop(columns=["key", "half_db"])
-    return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": crossing}
+    ratios = pd.DataFrame(ratio_rows).drop(columns=["key", "half_db", "rep_db"])
+    coverage = pd.DataFrame(cov_rows, columns=COVERAGE_COLUMNS)
+    coverage["covered"] = coverage["covered"].astype(bool)
+    return {"table": pd.DataFrame(mse_rows), "ratios": ratios, "crossing": crossing, "coverage": coverage,
+            "edge": pd.DataFrame(edge_rows, columns=EDGE_COLUMNS)}
+
+
+COVERAGE_COLUMNS = ["alpha", "snr_db", "kind", "case_set", "replicate", "reference_kind", "kurtosis", "n", "mean", "se",
+                    "reference", "reference_se", "z", "covered"]
+EDGE_COLUMNS = ["alpha", "snr_db", "quantity", "estimate", "lo", "hi", "unit", "n_runs", "extra_taus", "tau"]
+
+
+def _edge_rows(params, case, runs) -> list:
+    """Rows of ``estimator_edge.csv`` for one edge case: each estimator's MSE on the standard record over
+    its MSE on the long record (dB), and the bias of rho_S, rho_F, rho_SL (standard minus long record, dB),
+    with paired percentile bootstrap intervals over runs (:func:`.estimators.paired_db_contrasts`)."""
+    est = params["estimator"]
+    _, _, d = _estimator_design(params, case.eps, case.snr_db)
+    contrasts, names = [], []
+    for kind in ESTIMATOR_KINDS:
+        contrasts.append([(kind, f"{kind}_long", 1.0)])
+        names.append(f"mse_edge_bias_db.{kind}")
+    for qty, (ref, onebit, _) in RATIO_DEFS.items():
+        contrasts.append([(ref, onebit, 1.0), (f"{ref}_long", f"{onebit}_long", -1.0)])
+        names.append(f"edge_bias_db.{qty}")
+    res = paired_db_contrasts(runs, contrasts, est["n_boot"], case.seed)
+    n = len(runs[ESTIMATOR_KINDS[0]])
+    return [dict(alpha=1.0 - case.eps, snr_db=case.snr_db, quantity=name, estimate=e, lo=lo, hi=hi, unit="dB",
+                 n_runs=n, extra_taus=float(est["edge"]["extra_taus"]), tau=d["tau"])
+            for name, (e, lo, hi) in zip(names, res)]
 
 
 def run_estimator(params):
@@ -559,7 +696,7 @@ def run_estimator(params):
     Returns
     -------
     dict
-        What :func:`estimator_step` returns: ``{"table", "ratios", "crossing": DataFrame}``.
+        What :func:`estimator_step` returns: ``{"table", "ratios", "crossing", "coverage", "edge": DataFrame}``.
     """
     import tempfile
     from pathlib import Path
