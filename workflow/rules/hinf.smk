@@ -334,6 +334,58 @@ rule hinf_loop_variants:
         step("netrepro.papers.hinf.steps:loop_variants_merge_step")
 
 
+rule hinf_loop_swap_shard:
+    input:
+        code=code("netrepro.papers.hinf.steps:loop_swap_shard_step"),
+    output:
+        table="results/hinf/shards/loop_swap_{shard}.csv",
+    log:
+        "logs/hinf/loop_swap_{shard}.log",
+    wildcard_constraints:
+        shard=r"\d+",
+    conda:
+        CONDA_ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        cfg=lambda w: as_json(
+            {
+                "cfg": HCFG,
+                "shard": int(w.shard),
+                "n_shards": len(shards("hinf_loop_swap")),
+            }
+        ),
+        rule="hinf_loop_swap_shard",
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:loop_swap_shard_step")
+
+
+rule hinf_loop_swap:
+    input:
+        code=code("netrepro.papers.hinf.steps:loop_swap_merge_step"),
+        shards=expand(
+            rules.hinf_loop_swap_shard.output.table,
+            shard=shards("hinf_loop_swap"),
+        ),
+    output:
+        table="results/hinf/loop_swap.csv",
+        runs="results/hinf/loop_swap_runs.csv",
+    log:
+        "logs/hinf/loop_swap.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    params:
+        cfg=as_json(HCFG),
+        rule="hinf_loop_swap",
+        io=io_json,
+    shell:
+        step("netrepro.papers.hinf.steps:loop_swap_merge_step")
+
+
 rule hinf_kalman_best_shard:
     input:
         code=code("netrepro.papers.hinf.steps:kalman_best_shard_step"),
@@ -372,6 +424,7 @@ rule hinf_kalman_best:
         ),
     output:
         table="results/hinf/kalman_best.csv",
+        fused="results/hinf/evader_fused.csv",
     log:
         "logs/hinf/kalman_best.log",
     localrule: True
@@ -432,7 +485,9 @@ rule hinf_evidence:
         fig5_control=rules.hinf_fig5_control.output.table,
         evasive_network=rules.hinf_evasive_network.output.table,
         loop_variants=rules.hinf_loop_variants.output.table,
+        loop_swap=rules.hinf_loop_swap.output.table,
         kalman_best=rules.hinf_kalman_best.output.table,
+        evader_fused=rules.hinf_kalman_best.output.fused,
         fig6_paths=rules.hinf_fig6_paths.output.table,
     output:
         table="results/evidence/hinf.csv",
@@ -479,7 +534,10 @@ if enabled("hinf"):
         rules.hinf_evasive_network.output.table,
         rules.hinf_loop_variants.output.table,
         rules.hinf_loop_variants.output.runs,
+        rules.hinf_loop_swap.output.table,
+        rules.hinf_loop_swap.output.runs,
         rules.hinf_kalman_best.output.table,
+        rules.hinf_kalman_best.output.fused,
         rules.hinf_fig6_paths.output.table,
         rules.hinf_fig6_paths.output.paths,
         rules.hinf_evidence.output.table,

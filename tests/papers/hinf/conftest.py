@@ -30,6 +30,7 @@ def tiny_section() -> dict:
     sec["fig2_horizon"].update(runs=4, horizons=[30, 40], scenarios=["fig2", "fig3"])
     sec["loop_variants"].update(runs=4, reconstructions=sec["loop_variants"]["reconstructions"][::2])
     sec["kalman_best"].update(select_runs=3, judge_runs=4, W_factors=[1.0, 2.0], gamma_factors=[1.05])
+    sec["loop_swap"].update(runs=4, settings=sec["loop_swap"]["settings"][:2])
     return sec
 
 
@@ -92,10 +93,14 @@ def hinf_run(tmp_path_factory):
     run(steps.evasive_network_step, cfg, {}, ["table"])
     files["evasive_network"] = files.pop("table")
     for name, shard_step, merge_step in (("loop_variants", steps.loop_variants_shard_step, steps.loop_variants_merge_step),
+                                         ("loop_swap", steps.loop_swap_shard_step, steps.loop_swap_merge_step),
                                          ("kalman_best", steps.kalman_best_shard_step, steps.kalman_best_merge_step)):
         files[name] = d / f"{name}.csv"
         merged = run_sharded(shard_step, merge_step, cfg, 2, d, name)
         merged["table"].to_csv(files[name], index=False)
+        if "fused" in merged:
+            files["evader_fused"] = d / "evader_fused.csv"
+            merged["fused"].to_csv(files["evader_fused"], index=False)
         if "runs" in merged:
             files[f"{name}_runs"] = d / f"{name}_runs.csv"
             merged["runs"].to_csv(files[f"{name}_runs"], index=False)

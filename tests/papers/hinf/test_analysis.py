@@ -110,9 +110,11 @@ def test_sigma_gradient_residuals_against_the_closed_form_derivative(geo):
     sig = sigma_info_form(geo.Delta, S, geo.gamma_inv2, geo.Lbar)
     dS = dinfo(dcov_dr_hand(geo.r[0], geo.theta[0]), cov_hand(geo.r[0], geo.theta[0]))
     exact = -sig @ dS @ sig
-    printed, corrected = an.sigma_gradient_residuals(geo, MODEL)
+    printed, corrected, spread = an.sigma_gradient_residuals(geo, MODEL)
     prin = printed_sigma_gradient(geo.Delta, np.zeros((2, 2)), S, dS, geo.gamma_inv2, geo.Lbar)
     assert corrected < 1e-6
+    # the spread over step sizes brackets the corrected residual: it is the finite difference's own error
+    assert 0 < spread and corrected <= 3 * spread
     assert printed == pytest.approx(np.linalg.norm(prin - exact) / np.linalg.norm(exact), rel=1e-4)
     assert printed > 0.1
 
@@ -224,3 +226,14 @@ def test_sweet_spot_grid_is_the_grid_point_nearest_a1(a1, step, expected):
     model = NoiseModel(a0=0.3, a1=a1, a2=0.001, alpha=4.0)
     r_tr, r_det, got_step = an.sweet_spot_grid(model, 60.0, step)
     assert (r_tr, r_det, got_step) == (expected, expected, step)
+
+
+def test_covariance_sampling_scale_against_replicated_sample_covariances():
+    # the RMS relative distance of sample covariances (n = 40 draws, 4000 replicates) to the true covariance
+    M = np.array([[2.0, 0.6], [0.6, 0.5]])
+    rng = np.random.default_rng(11)
+    x = rng.multivariate_normal(np.zeros(2), M, size=(4000, 40))
+    xc = x - x.mean(1, keepdims=True)
+    S = np.einsum("rni,rnj->rij", xc, xc) / 39
+    rms = np.sqrt(np.mean(np.linalg.norm(S - M, axis=(1, 2)) ** 2)) / np.linalg.norm(M)
+    assert an.covariance_sampling_scale(M, 40) == pytest.approx(rms, rel=0.05)

@@ -16,7 +16,7 @@ from netrepro.verdicts import read_evidence, verdicts_step
 
 INPUTS = ("consensus", "attenuation", "checks", "summary", "paired", "errors", "trajectories", "per_run_static_fixed",
           "per_run_static_mobile", "connectivity", "sensitivity", "sensitivity_evasive", "paired_evasive", "per_agent",
-          "modes", "evader", "evader_paired", "fig5_control", "evasive_network", "loop_variants", "kalman_best",
+          "modes", "evader", "evader_paired", "fig5_control", "evasive_network", "loop_variants", "loop_swap", "kalman_best", "evader_fused",
           "fig6_paths")
 
 

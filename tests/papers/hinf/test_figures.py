@@ -13,7 +13,7 @@ INPUT_FILES = {  # figures.yaml input (rule[.output]) -> file of the tiny run
     "tables.trajectories": "trajectories", "tables.summary": "summary", "sensitivity": "sensitivity",
     "sensitivity_evasive": "sensitivity_evasive", "consensus_check": "consensus", "fig2_horizon": "per_agent",
     "fig2_horizon.series": "series", "paired_evasive": "paired_evasive", "network": "network",
-    "network.connectivity": "connectivity", "loop_variants": "loop_variants", "kalman_best": "kalman_best",
+    "network.connectivity": "connectivity", "loop_variants": "loop_variants", "loop_swap": "loop_swap", "kalman_best": "kalman_best",
     "fig6_paths": "fig6_paths", "fig6_paths.paths": "fig6_paths_run0",
 }
 

@@ -24,7 +24,7 @@ from .noise import (NoiseModel, dinfo_dr_reading, geometry, noise_covariance, no
 
 __all__ = [
     "ERRATA_POINT", "E4_RADII", "E9_RADII", "relative_distance", "ErrataGeometry", "errata_geometry",
-    "covariance_form_residuals", "sigma_form_residuals", "sigma_gradient_residuals",
+    "covariance_form_residuals", "covariance_sampling_scale", "sigma_form_residuals", "sigma_gradient_residuals",
     "bearing_derivative_residuals", "control_direction_residuals", "average_information_residuals",
     "range_derivative_reading_residuals", "errata_residuals", "order_violation", "settles_first",
     "difference_correlation", "disturbance_weight", "information_at_positions", "mean_gain_norms",
@@ -156,6 +156,30 @@ def covariance_form_residuals(rng: np.random.Generator, model: NoiseModel, r: fl
     return relative_distance(printed, emp), relative_distance(noise_covariance(r, theta, model), emp)
 
 
+def covariance_sampling_scale(M, n: int) -> float:
+    """Root-mean-square relative Frobenius distance of the sample covariance of ``n`` Gaussian vectors to ``M``.
+
+    For ``n`` draws of ``N(0, M)`` the sample covariance ``S`` has ``Var S_ij = (M_ii M_jj + M_ij^2) / (n - 1)``
+    (Isserlis), so ``E ||S - M||_F^2 = ((tr M)^2 + ||M||_F^2) / (n - 1)``; divided by ``||M||_F``, the scale of
+    erratum E1's residuals that sampling alone produces.
+
+    Parameters
+    ----------
+    M : array_like, shape ``(d, d)``
+        The covariance.
+    n : int
+        Number of draws (> 1).
+
+    Returns
+    -------
+    float
+        ``sqrt(((tr M)^2 + ||M||_F^2) / (n - 1)) / ||M||_F``.
+    """
+    M = np.asarray(M, dtype=float)
+    fro = float(np.linalg.norm(M))
+    return math.sqrt((float(np.trace(M)) ** 2 + fro ** 2) / (int(n) - 1)) / fro
+
+
 def sigma_form_residuals(geo: ErrataGeometry, model: NoiseModel):
     """Erratum E2: the sign of ``S Delta`` in ``Sigma = Delta Omega^-1`` (eqs (6), (15)).
 
@@ -198,9 +222,11 @@ def sigma_gradient_residuals(geo: ErrataGeometry, model: NoiseModel):
 
     Returns
     -------
-    printed, corrected : float
+    printed, corrected, spread : float
         Relative distances of :func:`.motion.printed_sigma_gradient` and :func:`.motion.sigma_gradient` to
-        the central difference of ``Sigma`` (eq (6)) with respect to sensor 1's range.
+        the central difference of ``Sigma`` (eq (6)) with respect to sensor 1's range (half step 1e-6), and the
+        largest relative distance of that difference to those with half steps 2e-6 and 5e-7 (the finite
+        difference's own error, the uncertainty of both residuals).
     """
     S, dMr, _ = _information_and_range_derivative(geo, model)
 
@@ -210,10 +236,13 @@ def sigma_gradient_residuals(geo: ErrataGeometry, model: NoiseModel):
         return geo.sigma(model, r=rr)
 
     fd = central_difference(sigma_of, geo.r[0])
+    # the finite difference's own error: its spread over half steps 2x larger and smaller (rounding grows as the
+    # step shrinks, truncation as it grows), a bracket on how far fd is from the derivative
+    spread = max(relative_distance(central_difference(sigma_of, geo.r[0], eps=e), fd) for e in (2e-6, 5e-7))
     zero = np.zeros((2, 2))
     _, corr = sigma_gradient(geo.Delta, zero, S, dMr[0], geo.gamma_inv2, geo.Lbar)
     prin = printed_sigma_gradient(geo.Delta, zero, S, dMr[0], geo.gamma_inv2, geo.Lbar)
-    return relative_distance(prin, fd), relative_distance(corr, fd)
+    return relative_distance(prin, fd), relative_distance(corr, fd), spread
 
 
 def bearing_derivative_residuals(model: NoiseModel, radii, theta: float):

@@ -18,7 +18,7 @@ from .noise import NoiseModel, geometry, noise_information
 from itertools import combinations
 
 __all__ = ["overbounding_ellipse", "fused_trace", "min_fused_trace", "min_fused_trace_pairwise", "min_fused_trace_exact",
-           "fused_trace_bounds", "EXACT_TOLERANCE", "SOLVERS", "evader_move",
+           "fused_trace_bounds", "EXACT_TOLERANCE", "SOLVERS", "evader_move", "fused_trace_along",
            "evader_decisions"]
 
 
@@ -528,6 +528,36 @@ def _value_gradient_gap(Minv, lam):
     grad = -np.einsum("...ij,...nji->...n", Ai @ Ai, Minv)
     gap = np.einsum("...n,...n->...", grad, lam) - grad.min(-1)
     return A, value, grad, gap
+
+
+def fused_trace_along(target, agents, model: NoiseModel):
+    """The evader's objective along recorded paths: ``tr Q_fused`` of eqs (21)-(24) at every step ``k >= 1``.
+
+    At step ``k`` the target's position is ``x_k`` and the agents are where the evader saw them when it chose
+    ``x_k`` (``p_{k-1}``: in :func:`.model.simulate` the target moves first); the value is the minimum over the
+    weights lambda of eq (24), solved exactly and certified (:func:`min_fused_trace_exact`). For an evasive
+    target this is the value (19) the evader maximised at each step; for any other path, the same objective
+    on its positions, so an evader and a non-reactive path can be compared on it.
+
+    Parameters
+    ----------
+    target : ndarray, shape ``(R, K + 1, 2)``
+        Target positions (``simulate(...)["target"]``).
+    agents : ndarray, shape ``(R, K + 1, N, 2)``
+        Agent positions (``simulate(...)["agents"]``).
+    model : NoiseModel
+        The noise model (2)-(4).
+
+    Returns
+    -------
+    ndarray, shape ``(R, K)``
+        ``tr Q_fused`` at steps ``1..K``.
+    """
+    x = np.asarray(target, dtype=float)[:, 1:]
+    p = np.asarray(agents, dtype=float)[:, :-1]
+    R, K, N = p.shape[0], p.shape[1], p.shape[2]
+    r, th = geometry(x.reshape(R * K, 2), p.reshape(R * K, N, 2))
+    return min_fused_trace_exact(noise_information(r, th, model))[0].reshape(R, K)
 
 
 SOLVERS = {"mirror": min_fused_trace, "pairwise": min_fused_trace_pairwise,

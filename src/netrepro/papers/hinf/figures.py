@@ -193,7 +193,7 @@ def figure_fig2(params, inputs, outputs):
     axes[2].set_xticks(list(range(n_agents)) + [n_agents])
     axes[2].set_xticklabels([str(a) for a in range(n_agents)] + ["mean"])
     axes[2].set_xlabel("agent (0 and 9: ends of the path); mean over agents (the paper's reading)")
-    axes[2].set_ylabel("decentralized / local error (window late_start..H)")
+    axes[2].set_ylabel("decentralized / local mean error, late window up to H")
     axes[2].set_title("below 1: decentralized better")
     axes[2].legend(fontsize=7, ncol=2)
     fig.suptitle(params["title"])
@@ -269,34 +269,89 @@ def figure_paired(params, inputs, outputs):
     return {}
 
 
+def _loop_label(loop: str) -> str:
+    """A short tick label of a loop of loop_variants.csv (``pi|evader.step_scale=2`` -> ``pi, step x2``)."""
+    label = loop.split("|")[-1]
+    label = label.replace("evader.step_scale=", "pi, step x").replace("layouts.four=radius ", "pi, layout r")
+    return label.replace(" deg", "\u00b0").replace("exact_component", "exact comp.")
+
+
 def figure_loop_variants(params, inputs, outputs):
-    """Fig S5: the closed-loop consensus variants (issue 28): decentralized minus local, by design and target."""
+    """Fig S5: the consensus designs against the evasive target (issues 28 and 37).
+
+    (a) closed loops: decentralized minus local filter on each loop's own paths; (b) the late errors themselves,
+    local and decentralized, per loop (the local baseline moves from loop to loop); (c) the fixed-path swap: every
+    design open loop on the PI loop's and on the local loop's recorded paths (same seeds); (d) the systems: each
+    design's closed loop minus the local-steered loop. Error bars: +- z_crit SE, the two-sided Bonferroni level of
+    each table's tags; the connected fraction and topology changes per run are printed under the tick labels.
+    """
     lv = pd.read_csv(inputs["table"])
+    lv = lv[lv["target"] == "evasive"]
+    sw = pd.read_csv(inputs["swap"]) if "swap" in inputs else None
     zc = float(lv["z_crit"].iloc[0])
-    comps = (("same_paths", "decentralized minus local filter, same paths"),
-             ("vs_local_loop", "decentralized loop minus local-steered loop (paired by seed)"))
-    fig, axes = new_figure(1, 2, figsize=(15, 4.8), squeeze=False)
-    for ax, (comp, title) in zip(axes[0], comps):
-        sub = lv[lv["comparison"] == comp]
-        loops = list(dict.fromkeys(sub["loop"]))
-        for j, (target, g) in enumerate(sub.groupby("target", sort=False)):
-            g = g.set_index("loop").reindex(loops)
-            x = np.arange(len(loops)) + 0.38 * (j - 0.5)
-            ax.bar(x, g["mean_diff"], width=0.36, yerr=2 * g["se"], capsize=2, color=f"C{j}", label=f"{target} target")
-            if comp == "same_paths":
-                for xi, (cf, tc) in zip(x, zip(g["connected_fraction"], g["topology_changes"])):
-                    if np.isfinite(cf):
-                        ax.annotate(f"{cf:.0%}\n{tc:.0f}", (xi, 0), fontsize=6, ha="center", va="top",
-                                    xytext=(0, -2), textcoords="offset points")
+    fig, axes = new_figure(2, 2, figsize=(15, 10.5), squeeze=False, gridspec_kw={"hspace": 0.55})
+    ax = axes[0][0]
+    same = lv[lv["comparison"] == "same_paths"].set_index("loop")
+    loops = list(same.index)
+    x = np.arange(len(loops))
+    ax.bar(x, same["mean_diff"], width=0.6, yerr=zc * same["se"], capsize=2, color="C0")
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{_loop_label(lp)}\n{r.connected_fraction:.0%} / {r.topology_changes:.0f}"
+                        for lp, r in zip(loops, same.itertuples())], fontsize=6.5, rotation=30, ha="right")
+    ax.set_ylabel("decentralized minus local late error")
+    ax.set_title(f"(a) closed loops, each on its own paths (+- {zc:.2f} SE);\nunder the labels: connected fraction / "
+                 "topology changes per run", fontsize=8)
+    ax = axes[0][1]
+    ax.plot(x, same["error_b"], "o-", color="C0", label="local filters (the baseline moves with the loop)")
+    ax.plot(x, same["error_a"], "s-", color="C3", label="decentralized filter")
+    ax.set_xticks(x)
+    ax.set_xticklabels([_loop_label(lp) for lp in loops], fontsize=6.5, rotation=30, ha="right")
+    ax.set_ylabel("late error |x_hat - x| (mean over runs)")
+    ax.set_title("(b) the errors compared in (a): each loop's own local baseline", fontsize=8)
+    ax.legend(fontsize=7)
+    if sw is not None and len(sw):
+        zs = float(sw["z_crit"].iloc[0])
+        nominal = sw["setting"].iloc[0]
+        ax = axes[1][0]
+        fp = sw[(sw["setting"] == nominal) & (sw["comparison"] == "fixed_paths")]
+        designs = list(dict.fromkeys(fp["design"]))
+        xd = np.arange(len(designs))
+        for j, (loop, g) in enumerate(fp.groupby("loop", sort=False)):
+            if loop not in ("pi", "local_loop"):
+                continue
+            g = g.set_index("design").reindex(designs)
+            k = 0 if loop == "pi" else 1
+            ax.bar(xd + 0.38 * (k - 0.5), g["mean_diff"], width=0.36, yerr=zs * g["se"], capsize=2, color=f"C{k + 1}",
+                   label=f"on the {'PI' if loop == 'pi' else 'local'} loop's paths (local {g['error_b'].iloc[0]:.3f})")
         ax.axhline(0.0, color="k", lw=0.8)
-        ax.set_xticks(np.arange(len(loops)))
-        ax.set_xticklabels([lp.split("|")[-1].replace("evader.step_scale", "pi, evader step").replace("layouts.four", "pi, layout")
-                            for lp in loops], fontsize=7, rotation=30, ha="right")
-        ax.set_ylabel("late-error difference, +- 2 SE (below 0: decentralized better)")
-        ax.set_title(title, fontsize=9)
+        ax.set_xticks(xd)
+        ax.set_xticklabels(designs, fontsize=7)
+        ax.set_ylabel("decentralized minus local late error")
+        ax.set_title(f"(c) fixed-path swap ({nominal}): every design open loop on recorded paths,\nsame target "
+                     f"path and noise seeds (+- {zs:.2f} SE)", fontsize=8)
         ax.legend(fontsize=7)
-    fig.suptitle(f"Closed loops (agents moved by the filter judged), {int(lv['runs'].iloc[0])} runs; tags at Bonferroni "
-                 f"|z| > {zc:.2f}; numbers under the bars: connected fraction / topology changes per run", fontsize=9)
+        ax = axes[1][1]
+        sysm = sw[sw["comparison"] == "system"]
+        settings = list(dict.fromkeys(sysm["setting"]))
+        cd = list(dict.fromkeys(sysm["design"]))
+        width = 0.8 / max(1, len(settings))
+        for j, setting in enumerate(settings):
+            g = sysm[sysm["setting"] == setting].set_index("design").reindex(cd)
+            ax.bar(np.arange(len(cd)) + width * (j - (len(settings) - 1) / 2), g["mean_diff"], width=width * 0.95,
+                   yerr=zs * g["se"], capsize=1.5, color=f"C{j}", label=setting)
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_xticks(np.arange(len(cd)))
+        ax.set_xticklabels(cd, fontsize=7)
+        ax.set_ylabel("system late error minus the local-steered loop's")
+        ax.set_title(f"(d) systems: each design's closed loop minus the loop the local filters steer,\npaired by seed "
+                     f"(+- {zs:.2f} SE); settings: evader step and four-agent layout", fontsize=8)
+        ax.legend(fontsize=6.5)
+    else:
+        axes[1][0].set_visible(False)
+        axes[1][1].set_visible(False)
+    fig.suptitle(f"Consensus designs against the evasive target, {int(lv['runs'].iloc[0])} runs per loop "
+                 "(below 0: decentralized better)", fontsize=9)
     save_figure(fig, outputs["figure"])
     return {}
 

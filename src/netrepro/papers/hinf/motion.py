@@ -158,13 +158,18 @@ def printed_control_law(dJ_dr, dJ_dtheta, r, theta, Gamma: float):
     return -Gamma * (np.swapaxes(rotation(theta), -1, -2) @ local[..., None])[..., 0]
 
 
-def path_statistics(paths, v_max: float) -> dict[str, np.ndarray]:
-    """How the agents' paths move: heading reversals, clipped steps and step length, per run.
+def path_statistics(paths, v_max: float, target=None) -> dict[str, np.ndarray]:
+    """How the agents' paths move: heading reversals, clipped steps, step length, strokes and their direction, per run.
 
     A step is ``p_i(k+1) - p_i(k)``. A heading reversal is a pair of consecutive steps of one agent
     whose directions are more than 90 degrees apart (negative inner product): the zig-zag of Fig 6.
     A clipped step is one the speed limit of :func:`control_law` shortened (length ``v_max`` to
-    within 1e-9 relative).
+    within 1e-9 relative). A stroke is the run of steps between two consecutive reversals of one agent
+    (its length in steps: the difference of their step indices). The tangential share of a step is the
+    part of its squared length across the line of sight from the agent at the step's start to the target at its
+    end (in :func:`.model.simulate` the target moves before the agents), ``(s . t)^2 / |s|^2`` with ``t`` the unit
+    vector perpendicular to ``x(k+1) - p_i(k)`` (1: a pure bearing move, 0: a
+    pure range move; 0.5 for directions drawn uniformly).
 
     Parameters
     ----------
@@ -172,17 +177,36 @@ def path_statistics(paths, v_max: float) -> dict[str, np.ndarray]:
         Agent positions over time (``simulate(...)["agents"]``).
     v_max : float
         The speed limit of the control law (largest step length).
+    target : array_like, shape (runs, steps + 1, 2), optional
+        The target's positions (``simulate(...)["target"]``); needed for ``tangential_share``.
 
     Returns
     -------
     dict of str to ndarray, each of shape (runs,)
         ``reversal_fraction`` (reversals per pair of consecutive steps, over agents and time),
-        ``clipped_fraction`` (clipped steps per step) and ``mean_step`` (mean step length).
+        ``clipped_fraction`` (clipped steps per step), ``mean_step`` (mean step length),
+        ``stroke_median`` (median stroke length in steps over the run's agents; NaN without two reversals),
+        ``one_step_strokes`` (fraction of the run's strokes of one step; NaN without a stroke) and, with
+        ``target``, ``tangential_share`` (sum over agents and steps of ``(s . t)^2`` over that of ``|s|^2``).
     """
     paths = np.asarray(paths, dtype=float)
     steps = np.diff(paths, axis=1)
     length = np.linalg.norm(steps, axis=-1)
     turns = np.einsum("rkad,rkad->rka", steps[:, 1:], steps[:, :-1])
-    return {"reversal_fraction": (turns < 0).mean(axis=(1, 2)),
-            "clipped_fraction": (length >= v_max * (1 - 1e-9)).mean(axis=(1, 2)),
-            "mean_step": length.mean(axis=(1, 2))}
+    rev = turns < 0
+    R = paths.shape[0]
+    med, one = np.full(R, np.nan), np.full(R, np.nan)
+    for r in range(R):
+        strokes = np.concatenate([np.diff(np.flatnonzero(rev[r, :, a])) for a in range(rev.shape[2])])
+        if len(strokes):
+            med[r], one[r] = np.median(strokes), np.mean(strokes == 1)
+    out = {"reversal_fraction": rev.mean(axis=(1, 2)),
+           "clipped_fraction": (length >= v_max * (1 - 1e-9)).mean(axis=(1, 2)),
+           "mean_step": length.mean(axis=(1, 2)), "stroke_median": med, "one_step_strokes": one}
+    if target is not None:
+        # line of sight from the agent at the step's start to the target it steers toward (the target moves first)
+        los = np.asarray(target, dtype=float)[:, 1:, None, :] - paths[:, :-1]
+        los_len = np.maximum(np.linalg.norm(los, axis=-1), 1e-12)
+        across = (steps[..., 0] * -los[..., 1] + steps[..., 1] * los[..., 0]) / los_len  # s . t, t = rot90(los) / |los|
+        out["tangential_share"] = (across ** 2).sum(axis=(1, 2)) / np.maximum((length ** 2).sum(axis=(1, 2)), 1e-300)
+    return out

@@ -76,8 +76,13 @@ Tables (all under ``results/hinf/``)
     with a connected graph (25) and the late-window mean errors of the local and decentralized H-infinity filters.
 ``loop_variants.csv``, ``loop_variants_runs.csv`` (issue 28)
     closed-loop consensus variants of the evasive comparison, see :func:`loop_variants_merge_step`.
+``loop_swap.csv``, ``loop_swap_runs.csv`` (issue 37)
+    the fixed-path swap: every consensus design open loop on each closed loop's recorded paths, same seeds, see
+    :func:`swap_comparisons`.
 ``kalman_best.csv`` (issue 28)
     H-infinity against Kalman filters at their best, see :func:`kalman_best_merge_step`.
+``evader_fused.csv`` (issue 37)
+    the evader's objective tr Q_fused against the other targets, see :func:`fused_comparisons`.
 ``network.csv``, ``connectivity.csv``
     ``scenario, run, k, i, j`` links of eq (25) at the time marks; ``scenario, run, steps,
     connected_fraction, min_lambda2, topology_changes`` per trajectory run (steps at which a link appears or
@@ -94,7 +99,8 @@ import pandas as pd
 from .algebra import rotation
 from .consensus import (adjacency, consensus_h_max, laplacian, pi_consensus_spectral_radius,
                         pi_consensus_time_constants, run_pi_consensus, topology_changed)
-from .evader import evader_decisions
+from .evader import evader_decisions, fused_trace_along
+from ...errors import InputError
 from .filters import decentralized_update, hinf_update, kalman_update, minimum_attenuation
 from .model import (FILTER_KINDS, KINDS, FilterDoesNotExist, bonferroni_z, layout_positions, paired_z, resolve_scenario,
                     run_paired, simulate, tag_z, window_means)
@@ -105,7 +111,8 @@ __all__ = [
     "PAIRED", "noise_model_step", "consensus_check_step", "attenuation_step", "scenario_tables", "simulate_step",
     "tables_step", "sensitivity_step", "sensitivity_evasive_step", "paired_evasive_step", "fig2_horizon_step",
     "evader_check_step", "network_step", "fig5_control_step", "evasive_network_step", "loop_variants_shard_step",
-    "loop_variants_merge_step", "kalman_best_shard_step", "kalman_best_merge_step", "fig6_paths_step",
+    "loop_variants_merge_step", "recorded_evader_paths", "kalman_best_shard_step", "fused_comparisons", "kalman_best_merge_step", "fig6_paths_step",
+    "design_consensus", "loop_swap_shard_step", "swap_comparisons", "loop_swap_merge_step",
 ]
 
 PAIRED = {  # comparison -> (scenario a, filter a, scenario b, filter b); difference a - b per run
@@ -1033,7 +1040,7 @@ def loop_variants_merge_step(params, inputs, outputs):
     """Step: the closed-loop consensus variants' comparisons (``loop_variants.csv``) from the shards.
 
     Per target and loop: the connected fraction and the number of topology changes (per run, over the
-    horizon), and two paired comparisons, each tagged ``holds`` / ``not significant`` / ``reversed`` at the
+    horizon; means and their standard errors over runs), and two paired comparisons, each tagged ``holds`` / ``not significant`` / ``reversed`` at the
     Bonferroni-corrected two-sided level ``tests.alpha`` over every comparison of the table (fixed before
     the runs):
 
@@ -1073,7 +1080,9 @@ def loop_variants_merge_step(params, inputs, outputs):
             r = g[g["loop"] == loop].set_index("run")
             common = dict(target=target, loop=loop, driver=r["driver"].iloc[0], runs=len(r),
                           connected_fraction=float(r["connected_fraction"].mean()),
+                          connected_fraction_se=float(r["connected_fraction"].std(ddof=1) / math.sqrt(len(r))),
                           topology_changes=float(r["topology_changes"].mean()),
+                          topology_changes_se=float(r["topology_changes"].std(ddof=1) / math.sqrt(len(r))),
                           topology_changes_min=int(r["topology_changes"].min()),
                           topology_changes_max=int(r["topology_changes"].max()))
             comps = [("same_paths", r["decentralized"], r["local"])]
@@ -1101,14 +1110,46 @@ def _displacement(path, lag: int) -> float:
     return float(np.linalg.norm(p[:, lag:] - p[:, :-lag], axis=-1).mean()) if p.shape[1] > lag else np.nan
 
 
+def recorded_evader_paths(sc: dict, seed: int):
+    """Target paths of the evader (eqs (19)-(24)) recorded in the closed loop of ``sc`` run with another seed.
+
+    Replayed in runs of ``sc``'s own seed, such a path moves exactly as an evader moves (same step, same
+    turning) but does not react to these runs' agents: their measurement noise and initial estimates differ
+    from those of the recording, so their agents go elsewhere. The control target of ``F_kalman_at_best``.
+
+    Parameters
+    ----------
+    sc : dict
+        A resolved scenario (:func:`.model.resolve_scenario`); its driver moves the agents of the recording.
+    seed : int
+        Seed of the recording (must differ from ``sc["seed"]``, or the replay is the closed loop itself).
+
+    Returns
+    -------
+    ndarray, shape ``(runs, horizon + 1, 2)``
+        The recorded target paths.
+
+    Raises
+    ------
+    InputError
+        If ``seed`` equals the scenario's seed.
+    """
+    if int(seed) == int(sc["seed"]):
+        raise InputError(f"the recording seed {seed} is the runs' own seed: the replayed evader would still react")
+    rec = simulate({**sc, "target": "evasive", "seed": int(seed), "filters": [sc["driver"]]})
+    return rec["target"]
+
+
 def kalman_best_shard_step(params, inputs, outputs):
     """Step: per-run late errors of H-infinity filters (several gamma) and Kalman filters (several design W)
     on the same trajectories, for each target model and phase (issue 28, part 2); one shard of tasks.
 
     Phase ``select`` (``kalman_best.select_runs`` runs, seed ``select_seed``) picks each family's best setting;
     phase ``judge`` (``judge_runs``, seed ``judge_seed``, separate runs) is where they are compared.
-    Targets: ``evasive`` (eqs (19)-(24)), ``drift`` (non-reactive, the evader's step length in a fixed
-    heading), ``evasive_noise`` (the evader plus white noise W) and ``random``. Shards as in
+    Targets: ``evasive`` (eqs (19)-(24)), ``evader_replay`` (non-reactive: evader paths recorded in closed
+    loops of other seeds, ``kalman_best.replay_seeds[phase]``, replayed; :func:`recorded_evader_paths`),
+    ``drift`` (non-reactive, the evader's step length in a fixed heading), ``evasive_noise`` (the evader plus
+    white noise W) and ``random``. Shards as in
     :func:`loop_variants_shard_step`.
 
     Parameters
@@ -1125,8 +1166,9 @@ def kalman_best_shard_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame, "provenance": {"tasks": [...]}}``: one row per task, filter and run
-        (family, kind, gamma, ``W_factor``, late error, target displacement) and the task indices
-        of this shard.
+        (family, kind, gamma, ``W_factor``, late error, target displacement, ``fused_trace``: the run's
+        late-window mean of the evader's objective tr Q_fused, :func:`.evader.fused_trace_along`) and the
+        task indices of this shard.
     """
     from netrepro.engines.montecarlo import shard_blocks
 
@@ -1142,16 +1184,21 @@ def kalman_best_shard_step(params, inputs, outputs):
             (int(kb["judge_runs"]), int(kb["judge_seed"]))
         sc = resolve_scenario(cfg, kb["scenario"], runs=runs, seed=seed)
         sc["target"] = target
+        if target == "evader_replay":
+            sc.update(target="replay", target_path=recorded_evader_paths(sc, int(kb["replay_seeds"][phase])))
         res = run_paired(sc, [float(c) for c in kb["gamma_factors"]], [float(f) for f in kb["W_factors"]])
         disp = _displacement(res["out"]["target"], int(kb["displacement_lag"]))
+        # the evader's objective (19) along this task's paths, late window (steps start..K of tr Q_fused)
+        fz = fused_trace_along(res["out"]["target"], res["out"]["agents"], sc["model"])[:, start - 1:].mean(1)
         for lab, e in res["out"]["errors"].items():
             base = res["base"][lab]
             frames.append(pd.DataFrame({
                 "task": int(t), "target": target, "phase": phase, "label": lab, "family": "kalman" if FILTER_KINDS[base][1] else "hinf",
                 "kind": FILTER_KINDS[base][0], "gamma": res["gammas"][lab],
                 "W_factor": res["w_factor"].get(lab, 1.0), "run": np.arange(runs), "error": window_means(e, start),
-                "displacement": disp}))
-    cols = ["task", "target", "phase", "label", "family", "kind", "gamma", "W_factor", "run", "error", "displacement"]
+                "displacement": disp, "fused_trace": fz}))
+    cols = ["task", "target", "phase", "label", "family", "kind", "gamma", "W_factor", "run", "error", "displacement",
+            "fused_trace"]
     table = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
     return {"table": table, "provenance": {"tasks": [int(t) for t in mine]}}
 
@@ -1173,13 +1220,14 @@ def kalman_best_merge_step(params, inputs, outputs):
     inputs : dict
         ``shards``: the shard tables of :func:`kalman_best_shard_step`.
     outputs : dict
-        ``table`` (``results/hinf/kalman_best.csv``).
+        ``table`` (``results/hinf/kalman_best.csv``) and ``fused`` (``results/hinf/evader_fused.csv``).
 
     Returns
     -------
     dict
-        ``{"table": DataFrame}``: one row per target, kind and comparison (labels, means, paired
-        difference, standard error, z, ``z_crit``, ``tag`` and displacement).
+        ``{"table": DataFrame, "fused": DataFrame}``: one row per target, kind and comparison (labels, means,
+        paired difference, standard error, z, ``z_crit``, ``tag`` and displacement), and the evader's objective
+        against the other targets (:func:`fused_comparisons`).
     """
     runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
     runs = runs.sort_values(["task", "label", "run"], kind="stable").drop(columns="task").reset_index(drop=True)
@@ -1212,19 +1260,64 @@ def kalman_best_merge_step(params, inputs, outputs):
     zc = bonferroni_z(float(params["tests"]["alpha"]), len(table))
     table["z_crit"] = zc
     table["tag"] = [tag_z(z, zc) for z in table["z"]]
-    return {"table": table}
+    return {"table": table, "fused": fused_comparisons(runs, float(params["tests"]["alpha"]))}
+
+
+def fused_comparisons(runs: pd.DataFrame, alpha: float, reference: str = "evasive") -> pd.DataFrame:
+    """Does the evader raise its objective? Late-window ``tr Q_fused`` (19)-(24) of the evasive target against the
+    other targets of ``kalman_best`` on the judge runs, paired by seed (``evader_fused.csv``).
+
+    Each target's judge runs share the seed, hence the agents' start, noise stream and initial estimates; the paths
+    differ (the agents react to the target they see). Tagged at the two-sided Bonferroni level over the rows.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        Merged shard rows of :func:`kalman_best_shard_step` (``target, phase, label, run, fused_trace``).
+    alpha : float
+        Family-wise two-sided level.
+    reference : str
+        The target the others are compared with (arm a).
+
+    Returns
+    -------
+    DataFrame
+        ``target_a, target_b, runs, fused_a, fused_b, mean_diff, se, z, frac_a_higher, z_crit, tag`` (``tag``
+        ``holds`` here means the reference's value is significantly *lower*; ``reversed``: higher).
+    """
+    jud = runs[runs["phase"] == "judge"]
+    per = {t: g[g["label"] == g["label"].iloc[0]].sort_values("run")["fused_trace"].to_numpy()
+           for t, g in jud.groupby("target", sort=False)}
+    rows = []
+    for t, b in per.items():
+        if t == reference or reference not in per:
+            continue
+        a = per[reference]
+        m, se, z = paired_z(a, b)
+        rows.append({"target_a": reference, "target_b": t, "runs": len(a), "fused_a": float(a.mean()),
+                     "fused_b": float(b.mean()), "mean_diff": m, "se": se, "z": z, "frac_a_higher": float(np.mean(a > b))})
+    cols = ["target_a", "target_b", "runs", "fused_a", "fused_b", "mean_diff", "se", "z", "frac_a_higher"]
+    table = pd.DataFrame(rows, columns=cols)
+    zc = bonferroni_z(float(alpha), max(1, len(table)))
+    table["z_crit"] = zc
+    table["tag"] = [tag_z(z, zc) for z in table["z"]]
+    return table
 
 
 # --------------------------------------------------------------------------- issue 28: why Fig 6's paths zig-zag
 def fig6_paths_step(params, inputs, outputs):
-    """Why do Fig 6's agent paths zig-zag? Heading reversals under control variants, paired by seed.
+    """Why do Fig 6's agent paths zig-zag? Heading reversals, strokes and their direction under control variants.
 
     The scenario ``fig6_paths.scenario`` (agents moved by its driver) is run with the configured
     control law and with each variant of ``fig6_paths.variants``, which replaces keys of ``control``:
     ``steer_on_truth`` (each agent steers by the true target position instead of its estimate),
-    a smaller gain ``Gamma`` of eq (12), a smaller speed limit ``v_max``. Every variant uses the
-    same seeds, so its per-run statistics are compared with the nominal ones run by run
-    (:func:`.model.paired_z`; Bonferroni over the variants at ``tests.alpha``).
+    a smaller gain ``Gamma`` of eq (12), a smaller speed limit ``v_max``, ``recursion: false`` (the
+    gradient of Sigma without the recursion (14): dDelta = 0). Every variant uses the same seeds, so its
+    per-run statistics are compared run by run (:func:`.model.paired_z`) with its ``baseline`` (default
+    ``nominal``; another variant's label, e.g. steering by the truth with and without (14)); each ``family``
+    (default ``control``) is Bonferroni-corrected over its own variants at ``tests.alpha``. Where both arms
+    are the same in every run (steering by the truth: nothing random moves agents or target) the difference
+    is exact, its ``z`` infinite or NaN and its tag ``exact``.
 
     Parameters
     ----------
@@ -1239,36 +1332,48 @@ def fig6_paths_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame, "paths": DataFrame}``. ``table``: one row per variant (``variant``, ``runs``,
-        ``reversal_fraction``, ``reversal_se``, ``clipped_fraction``, ``mean_step``, ``topology_changes``,
-        ``connected_fraction``, ``error_late``, and against the nominal run by run ``reversal_diff``,
-        ``reversal_diff_se``, ``z``, ``z_crit``, ``tag``). ``paths``: run 0's agent and target positions
-        (``variant, k, who, x, y``; ``who`` is the agent index or ``target``).
+        ``{"table": DataFrame, "paths": DataFrame}``. ``table``: one row per variant (``variant``, ``family``,
+        ``baseline``, ``runs``, ``reversal_fraction``, ``reversal_se``, ``clipped_fraction``, ``mean_step``,
+        ``stroke_median`` (median over runs of the runs' median stroke length, steps), ``one_step_strokes``,
+        ``tangential_share``, ``tangential_se``, ``topology_changes``, ``connected_fraction``, ``error_late``, and
+        against the baseline run by run ``reversal_diff``, ``reversal_diff_se``, ``z``, ``z_crit``, ``tag``).
+        ``paths``: run 0's agent and target positions (``variant, k, who, x, y``; ``who`` is the agent index
+        or ``target``).
     """
     cfg, fp = params, params["fig6_paths"]
     start = int(cfg["claims"]["late_start"])
-    variants = [{"label": "nominal", "control": {}}] + list(fp["variants"])
-    z_crit = bonferroni_z(float(cfg["tests"]["alpha"]), max(1, len(fp["variants"])))
-    rows, paths, nominal = [], [], None
+    variants = [{"label": "nominal", "control": {}, "family": ""}] + [
+        {"family": "control", "baseline": "nominal", **v} for v in fp["variants"]]
+    fam_size = {}
+    for v in variants[1:]:
+        fam_size[v["family"]] = fam_size.get(v["family"], 0) + 1
+    rows, paths, rev_of = [], [], {}
     for v in variants:
         sc = resolve_scenario({**cfg, "control": {**cfg["control"], **v["control"]}}, fp["scenario"],
                               runs=int(fp["runs"]), seed=int(fp["seed"]))
         sc["filters"] = [sc["driver"]]
         out = simulate(sc)
-        stats = path_statistics(out["agents"], float(sc["control"]["v_max"]))
+        stats = path_statistics(out["agents"], float(sc["control"]["v_max"]), out["target"])
         rev = stats["reversal_fraction"]
-        row = {"variant": v["label"], "runs": len(rev), "reversal_fraction": float(rev.mean()),
-               "reversal_se": float(rev.std(ddof=1) / math.sqrt(len(rev))),
+        rev_of[v["label"]] = rev
+        tang = stats["tangential_share"]
+        row = {"variant": v["label"], "family": v["family"], "baseline": v.get("baseline", ""), "runs": len(rev),
+               "reversal_fraction": float(rev.mean()), "reversal_se": float(rev.std(ddof=1) / math.sqrt(len(rev))),
                "clipped_fraction": float(stats["clipped_fraction"].mean()), "mean_step": float(stats["mean_step"].mean()),
+               "stroke_median": float(np.nanmedian(stats["stroke_median"])) if np.isfinite(stats["stroke_median"]).any() else np.nan,
+               "one_step_strokes": float(np.nanmean(stats["one_step_strokes"])) if np.isfinite(stats["one_step_strokes"]).any() else np.nan,
+               "tangential_share": float(tang.mean()), "tangential_se": float(tang.std(ddof=1) / math.sqrt(len(tang))),
                "topology_changes": float(np.mean(out["topology_changes"])),
                "connected_fraction": float(np.asarray(out["connected_runs"], dtype=float).mean()),
                "error_late": float(window_means(out["errors"][sc["driver"]], start).mean())}
-        if nominal is None:
-            nominal = rev
-            row.update(reversal_diff=0.0, reversal_diff_se=0.0, z=np.nan, z_crit=z_crit, tag="")
+        if v["label"] == "nominal":
+            row.update(reversal_diff=0.0, reversal_diff_se=0.0, z=np.nan, z_crit=np.nan, tag="")
         else:
-            mean, se, z = paired_z(rev, nominal)
-            row.update(reversal_diff=mean, reversal_diff_se=se, z=z, z_crit=z_crit, tag=tag_z(z, z_crit))
+            z_crit = bonferroni_z(float(cfg["tests"]["alpha"]), fam_size[v["family"]])
+            mean, se, z = paired_z(rev, rev_of[v["baseline"]])
+            exact = bool(np.ptp(rev) == 0 and np.ptp(rev_of[v["baseline"]]) == 0)
+            row.update(reversal_diff=mean, reversal_diff_se=se, z=z, z_crit=z_crit,
+                       tag="exact" if exact else tag_z(z, z_crit))
         rows.append(row)
         ags, tgt = np.asarray(out["agents"])[0], np.asarray(out["target"])[0]
         k = np.arange(ags.shape[0])
@@ -1276,3 +1381,184 @@ def fig6_paths_step(params, inputs, outputs):
             paths.append(pd.DataFrame({"variant": v["label"], "k": k, "who": str(i), "x": ags[:, i, 0], "y": ags[:, i, 1]}))
         paths.append(pd.DataFrame({"variant": v["label"], "k": k, "who": "target", "x": tgt[:, 0], "y": tgt[:, 1]}))
     return {"table": pd.DataFrame(rows), "paths": pd.concat(paths, ignore_index=True)}
+
+
+# --------------------------------------------------------------------------- issue 37: the fixed-path swap
+def design_consensus(design: str) -> dict:
+    """The consensus entries of a design of ``loop_swap.designs`` (``p_only``: the PI consensus (5) with K_i = 0).
+
+    Parameters
+    ----------
+    design : str
+        ``pi``, ``pi_reset``, ``p_only``, ``exact_component`` or ``complete``.
+
+    Returns
+    -------
+    dict
+        The entries of the ``consensus`` section this design replaces.
+    """
+    return {"K_i": 0.0, "design": "pi"} if design == "p_only" else {"design": design}
+
+
+def _setting_cfg(cfg: dict, setting: dict) -> dict:
+    """The configuration of one setting of ``loop_swap.settings``: ``key`` (``section.name``) replaced by ``value``."""
+    if "key" not in setting:
+        return cfg
+    section, name = setting["key"].split(".")
+    return {**cfg, section: {**cfg[section], name: setting["value"]}}
+
+
+def _swap_tasks(ls) -> list[tuple[int, str]]:
+    """(setting index, loop) tasks of the fixed-path swap, in a fixed order (shards split this list)."""
+    return [(i, loop) for i, s in enumerate(ls["settings"]) for loop in list(s["loops"]) + ["local_loop"]]
+
+
+def loop_swap_shard_step(params, inputs, outputs):
+    """Step: the fixed-path swap (issue 37), one shard of its closed loops.
+
+    A task is (setting, loop). The loop is closed by the decentralized filter of one consensus design
+    (``loop`` in ``loop_swap.designs``) or by the local filters (``local_loop``) and its agents' paths are
+    recorded; on those same paths, target path and measurement-noise draws, every design of
+    ``loop_swap.designs`` runs open loop beside the local filters (a decentralized filter per design on its own
+    consensus (5), :func:`.model.simulate`'s ``consensus_variants``: only the driver moves the agents). Every task
+    uses seed ``loop_swap.seed`` (same target start, noise stream and initial estimates), so every design is
+    paired with every other on one loop's paths exactly and across loops by seed. A setting replaces one
+    configuration key (the evader's step, the four-agent layout).
+
+    Parameters
+    ----------
+    params : dict
+        ``cfg`` (the whole ``hinf`` configuration; ``loop_swap`` and ``claims.late_start`` are read), ``shard``
+        and ``n_shards``.
+    inputs : dict
+        Only the step's code.
+    outputs : dict
+        ``table`` (``results/hinf/shards/loop_swap_<shard>.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "provenance": {"tasks": [...]}}``: one row per task, filter and run (``setting,
+        loop, driver, filter`` = ``local`` or a design, ``run``, late ``error``, ``connected_fraction``,
+        ``topology_changes`` of the loop's paths).
+    """
+    from netrepro.engines.montecarlo import shard_blocks
+
+    from . import filter_kernels  # noqa: F401
+    cfg, ls = params["cfg"], params["cfg"]["loop_swap"]
+    start = int(cfg["claims"]["late_start"])
+    tasks = _swap_tasks(ls)
+    mine = shard_blocks(len(tasks), 1, int(params["n_shards"]), int(params["shard"]))
+    frames = []
+    for t in mine:
+        i, loop = tasks[int(t)]
+        setting = ls["settings"][i]
+        own = "pi" if loop == "local_loop" else loop  # the design of the filter named "decentralized"
+        sc = resolve_scenario(_setting_cfg(cfg, setting), ls["scenario"], runs=int(ls["runs"]), seed=int(ls["seed"]),
+                              consensus=design_consensus(own))
+        sc["target"] = "evasive"
+        sc["filters"] = ["local", "decentralized"]
+        sc["driver"] = "local" if loop == "local_loop" else "decentralized"
+        base = dict(_setting_cfg(cfg, setting)["consensus"])  # every entry: a variant does not inherit own's K_i
+        sc["consensus_variants"] = {f"design:{d}": {**base, **design_consensus(d)} for d in ls["designs"] if d != own}
+        out = simulate(sc)
+        conn = np.asarray(out["connected_runs"], dtype=float)[:, start:].mean(1)
+        errs = {"local": out["errors"]["local"], own: out["errors"]["decentralized"],
+                **{d: out["errors"][f"design:{d}"] for d in ls["designs"] if d != own}}
+        for name in ["local"] + list(ls["designs"]):
+            frames.append(pd.DataFrame({
+                "task": int(t), "setting": setting["label"], "loop": loop, "driver": sc["driver"], "filter": name,
+                "run": np.arange(sc["runs"]), "error": window_means(errs[name], start), "connected_fraction": conn,
+                "topology_changes": out["topology_changes"]}))
+    cols = ["task", "setting", "loop", "driver", "filter", "run", "error", "connected_fraction", "topology_changes"]
+    table = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=cols)
+    return {"table": table, "provenance": {"tasks": [int(t) for t in mine]}}
+
+
+def swap_comparisons(runs: pd.DataFrame, designs, alpha: float) -> pd.DataFrame:
+    """The paired comparisons of the fixed-path swap (``loop_swap.csv``), Bonferroni-tagged over all of them.
+
+    Per setting (``a - b``, per-run late errors; ``pairing`` ``exact`` on one loop's paths, ``seed`` across
+    loops):
+
+    - ``fixed_paths``: on loop L's paths, design d's decentralized filter minus the local filters (every L, d);
+    - ``fixed_paths_vs_pi``: on loop L's paths, design d minus the PI design (d != pi);
+    - ``system``: design d's decentralized filter in the loop it closes minus the local filters of the loop the
+      local filters close (the abstract's comparison of systems);
+    - ``system_vs_pi``: design d in its own loop minus PI in its own loop (d != pi): the designs ranked as systems;
+    - ``steering_local``: the local filters in the loop d closes minus the local filters in the local loop: what
+      steering by d's fused estimate does to the local filters' own error.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        The merged shard rows of :func:`loop_swap_shard_step` (``setting, loop, filter, run, error,
+        connected_fraction, topology_changes``).
+    designs : sequence of str
+        The designs of ``loop_swap.designs`` (PI among them).
+    alpha : float
+        Family-wise two-sided level; each row is tagged at ``bonferroni_z(alpha, number of rows)``.
+
+    Returns
+    -------
+    DataFrame
+        ``setting, comparison, loop, design, pairing, runs, error_a, error_b, mean_diff, se, z, frac_a_better,
+        connected_fraction, topology_changes, z_crit, tag``.
+    """
+    rows = []
+    for setting in dict.fromkeys(runs["setting"]):
+        g = runs[runs["setting"] == setting]
+        loops = list(dict.fromkeys(g["loop"]))
+        e = {(lp, f): h.sort_values("run")["error"].to_numpy() for (lp, f), h in g.groupby(["loop", "filter"])}
+        net = g.groupby("loop")[["connected_fraction", "topology_changes"]].mean()
+
+        def add(comp, loop, design, pairing, a, b):
+            m, se, z = paired_z(a, b)
+            rows.append({"setting": setting, "comparison": comp, "loop": loop, "design": design, "pairing": pairing,
+                         "runs": len(a), "error_a": float(a.mean()), "error_b": float(b.mean()), "mean_diff": m,
+                         "se": se, "z": z, "frac_a_better": float(np.mean(a < b)),
+                         "connected_fraction": float(net.loc[loop, "connected_fraction"]),
+                         "topology_changes": float(net.loc[loop, "topology_changes"])})
+
+        for lp in loops:
+            for d in designs:
+                add("fixed_paths", lp, d, "exact", e[(lp, d)], e[(lp, "local")])
+            for d in designs:
+                if d != "pi":
+                    add("fixed_paths_vs_pi", lp, d, "exact", e[(lp, d)], e[(lp, "pi")])
+        closed = [lp for lp in loops if lp != "local_loop"]
+        for d in closed:
+            add("system", d, d, "seed", e[(d, d)], e[("local_loop", "local")])
+        for d in closed:
+            if d != "pi" and "pi" in closed:
+                add("system_vs_pi", d, d, "seed", e[(d, d)], e[("pi", "pi")])
+        for d in closed:
+            add("steering_local", d, d, "seed", e[(d, "local")], e[("local_loop", "local")])
+    table = pd.DataFrame(rows)
+    zc = bonferroni_z(float(alpha), max(1, len(table)))
+    table["z_crit"] = zc
+    table["tag"] = [tag_z(z, zc) for z in table["z"]]
+    return table
+
+
+def loop_swap_merge_step(params, inputs, outputs):
+    """Step: the fixed-path swap's comparisons (``loop_swap.csv``) from the shards (see :func:`swap_comparisons`).
+
+    Parameters
+    ----------
+    params : dict
+        The ``hinf`` configuration (``loop_swap.designs`` and ``tests.alpha`` are read).
+    inputs : dict
+        ``shards``: the tables of :func:`loop_swap_shard_step`.
+    outputs : dict
+        ``table`` (``results/hinf/loop_swap.csv``) and ``runs`` (``results/hinf/loop_swap_runs.csv``).
+
+    Returns
+    -------
+    dict
+        ``{"table": DataFrame, "runs": DataFrame}``.
+    """
+    runs = pd.concat([pd.read_csv(p) for p in inputs["shards"]], ignore_index=True)
+    runs = runs.sort_values(["task", "filter", "run"], kind="stable").drop(columns="task").reset_index(drop=True)
+    table = swap_comparisons(runs, list(params["loop_swap"]["designs"]), float(params["tests"]["alpha"]))
+    return {"table": table, "runs": runs}
