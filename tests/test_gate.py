@@ -327,3 +327,17 @@ def test_solves_are_counted_capped_and_a_step_that_decides_nothing_stops(monkeyp
     monkeypatch.setenv(cvx.FAULT_MAX_ITER, "zero")
     with pytest.raises(ValueError, match="must be a positive integer"):
         cvx.solver_options()
+
+
+def test_a_statement_may_print_any_evidence_quantity_but_only_an_existing_one(tmp_path):
+    from netrepro.paperdata import PaperData, load_findings
+
+    f1 = load_findings(write_paper(tmp_path, findings=[("by a factor of about 3", "by a factor of {gain:.1f}")])
+                       / "findings.yaml")[0]
+    f1 = type(f1)(**{**f1.__dict__, "statement": "worse by {extra.ratio:.2f} (gain {gain:.1f})"})
+    ev = {"gain_vs_none": {"nominal": Cell(3.2, ""), "horizon=100": Cell(3.1, "")}, "gain": {"nominal": Cell(1.5, "")}}
+    with pytest.raises(InputError, match=r"p/F1: the statement fills \['extra.ratio'\] from the evidence"):
+        findings_table(PaperData("p", [], [], [], [f1]), ev)
+    ev["extra.ratio"] = {"nominal": Cell(2.345, "", 0.01)}
+    row = findings_table(PaperData("p", [], [], [], [f1]), ev).iloc[0]
+    assert row["statement"] == "worse by 2.35 (gain 1.5)"

@@ -34,7 +34,8 @@ import numpy as np
 import pandas as pd
 
 from .errors import ConfigError, InputError
-from .paperdata import ClaimEntry, FindingEntry, PaperData, load_paper_data, render_statement, typed_numbers
+from .paperdata import (ClaimEntry, FindingEntry, PaperData, load_paper_data, render_statement, template_fields,
+                        typed_numbers)
 
 __all__ = [
     "VERDICTS",
@@ -795,8 +796,17 @@ def compare_observed(value) -> bool:
 
 
 def _statement(f: FindingEntry, evidence: dict, slug: str) -> str:
-    """The finding's statement with its template fields filled; a typed number that is one of its values refused."""
-    cells = {q: _as_cell(evidence[q][NOMINAL]) for q in f.evidence_quantities if q in evidence and NOMINAL in evidence[q]}
+    """The finding's statement with its template fields filled; a typed number that is one of its values refused.
+
+    A template may name any quantity of the evidence table (the statement's numbers are text, not the rule:
+    the registered ``evidence_quantities`` are what the verdict rests on).
+    """
+    named = list(dict.fromkeys([*f.evidence_quantities, *(q for q, _, _ in template_fields(f.statement))]))
+    missing = [q for q in named[len(f.evidence_quantities):] if NOMINAL not in evidence.get(q, {})]
+    if missing:
+        raise InputError(f"finding {slug}/{f.finding_id}: the statement fills {missing} from the evidence, which has "
+                         f"no nominal row of them (results/evidence/{slug}.csv)")
+    cells = {q: _as_cell(evidence[q][NOMINAL]) for q in named if q in evidence and NOMINAL in evidence[q]}
     typed = typed_numbers(f.statement, {q: c[0] for q, c in cells.items()})
     if typed:
         raise InputError(f"finding {slug}/{f.finding_id}: the statement types {', '.join(typed)}: a number that comes "

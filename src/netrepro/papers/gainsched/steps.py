@@ -830,32 +830,23 @@ def scheduling_step(params, inputs, outputs):
                          "value": cost, "verdict": verdict, "certified_slack": slack, "status": sol.status,
                          "lambda": lam if sol.values else np.nan, "start": "", "n_evaluations": np.nan})
     _no_decision(rows, "gainsched_scheduling", "the performance LMI (guaranteed cost)")
-    # certified lower bound of the scheduled family's least guaranteed cost (free multiplier), on a lattice
-    # around the fixed-gain family's certified cost: the most scheduling can buy in the guarantee
-    prob, sol, _ = solved[("free", "scheduled")]
-    ref = solved[("free", "fixed_gain")][2]
-    if sol.values and np.isfinite(ref):
-        b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]), float(cfg["cost_resolution"]))
-        lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
-    else:
-        lower, upper, n_eval, und = np.nan, np.nan, 0, 0
-    for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
-        rows.append({"comparison": name, "family": "scheduled", "multiplier": "free", "value": value,
-                     "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
-                     "status": f"certified bisection on the cost level ({und} undecided lattice points)",
-                     "lambda": np.nan, "start": f"reference fixed_gain {ref:.9g}", "n_evaluations": n_eval})
-    # the zero filter's least guaranteed cost (min tr Q of x_f = 0) with the multiplier free, bracketed the same way
-    prob, sol, ref = solved[("free", "zero")]
-    if sol.values and np.isfinite(ref):
-        b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]), float(cfg["cost_resolution"]))
-        lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
-    else:
-        lower, upper, n_eval, und = np.nan, np.nan, 0, 0
-    for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
-        rows.append({"comparison": name, "family": "zero", "multiplier": "free", "value": value,
-                     "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
-                     "status": f"certified bisection on the cost level ({und} undecided lattice points)",
-                     "lambda": np.nan, "start": f"reference zero {ref:.9g}", "n_evaluations": n_eval})
+    # certified brackets of the least guaranteed cost (free multiplier) on a lattice around a reference certified
+    # cost: the scheduled family's around the fixed-gain family's (the most scheduling can buy in the guarantee),
+    # and the zero filter's (min tr Q of x_f = 0) around its own
+    for family, reference in (("scheduled", "fixed_gain"), ("zero", "zero")):
+        prob, sol, _ = solved[("free", family)]
+        ref = solved[("free", reference)][2]
+        if sol.values and np.isfinite(ref):
+            b = guaranteed_cost_bracket(prob, sol.values, X0, ref, float(cfg["cost_span"]),
+                                        float(cfg["cost_resolution"]))
+            lower, upper, n_eval, und = b.infeasible_end, b.feasible_end, b.n_evals, len(b.undecided)
+        else:
+            lower, upper, n_eval, und = np.nan, np.nan, 0, 0
+        for name, value in (("guaranteed_cost_lower", lower), ("guaranteed_cost_upper", upper)):
+            rows.append({"comparison": name, "family": family, "multiplier": "free", "value": value,
+                         "verdict": "certified" if np.isfinite(value) else "undecided", "certified_slack": np.nan,
+                         "status": f"certified bisection on the cost level ({und} undecided lattice points)",
+                         "lambda": np.nan, "start": f"reference {reference} {ref:.9g}", "n_evaluations": n_eval})
     table = read_table(inputs["gains"])
     p_seq = p_sequence(params, sys)
     mid = 0.5 * (sys.F1 + sys.F2)

@@ -659,6 +659,12 @@ def _kalman_best_rows(kb: pd.DataFrame, alpha: float = 0.05, band_lo: float = 1.
         if t != "evasive":
             rows.append({"quantity": "premise.kalman_registered_band", "variant": f"target={t}",
                          "value": band["holds"][t], "note": band["note"][t]})
+    ev_best = kb[(kb["target"] == "evasive") & kb["comparison"].str.startswith("best")]
+    for kind, w_f in ev_best.set_index("kind")["W_factor_b"].items():
+        # the statement's numbers (issue 37): each kind's best design W_f / W against the evasive target
+        rows.append({"quantity": f"premise.kalman_best_wf.{kind}", "value": float(w_f),
+                     "note": "the Kalman filter's best design W_f / W against the evasive target, chosen on the "
+                             "selection runs"})
     rows.append({"quantity": "premise.kalman_at_best", "value": pattern("evasive"),
                  "note": head + ". Above each kind's best W_f (over-tuned, not judged), evasive target: "
                          + beyond_best("evasive") + ". " + " | ".join(text(t) for t in targets)})

@@ -386,6 +386,12 @@ def _finding_rows(params, est_mse: pd.DataFrame, lag: pd.DataFrame, ratios: pd.D
             f"{r.snr_db:g} dB: {r.mse_over_bound:.2f} (lower 95 % end {r.mse_lo / r.bound:.2f})" for r in g.itertuples()))
         rows.append(dict(quantity="bound_loose_above_0db", value=value, note=note, decided=decided,
                          variant="nominal" if i == 0 else variant_label("alpha_to_1", alpha_label(1.0 - alpha))))
+        if i == 0 and len(g):
+            # the statement's numbers (issue 37): the ratio at the first and the last simulated SNR from lo_snr up
+            for end, r, h in (("first", g.iloc[0], half[0]), ("last", g.iloc[-1], half[-1])):
+                rows.append(dict(quantity=f"bound_loose.{end}_snr_db", value=float(r["snr_db"])))
+                rows.append(dict(quantity=f"bound_loose.{end}_ratio", value=float(r["mse_over_bound"]),
+                                 uncertainty=float(h), note="1-bit smoother MSE/BCRB; uncertainty: its 95 % half-width"))
     # the break-even lag exists exactly where rho_S > 0 (so it is no separate claim), and how long it is
     merged = lag.merge(ratios[["alpha", "snr_db", "rho_s_db"]], on=["alpha", "snr_db"])
     same = (merged["delta_break_even"].notna() == (merged["rho_s_db"] > 0))
