@@ -138,3 +138,24 @@ def test_overlay_with_an_unknown_key_is_named():
     update_config(merged, {"hinf": {"paired": {"runz": 2000}}})
     with pytest.raises(ConfigError, match=r"hinf\.paired\.runz' = 2000 is not a known key"):
         validate_config(merged)
+
+
+def test_a_number_yaml_reads_as_text_is_named_with_its_fix():
+    """`1.0e12` in a YAML 1.1 file is text (issue 38): the message says to write `1.0e+12`."""
+    import copy as _copy
+    from pathlib import Path
+
+    import yaml
+
+    from netrepro.config import validate_config
+    from netrepro.errors import ConfigError
+
+    root = Path(__file__).resolve().parents[1]
+    config = yaml.safe_load((root / "config" / "config.yaml").read_text())
+    bad = _copy.deepcopy(config)
+    bad["markov"]["checks"]["tight_tol"] = yaml.safe_load("x: 1.0e12")["x"]
+    assert bad["markov"]["checks"]["tight_tol"] == "1.0e12"  # what YAML 1.1 gives (no sign in the exponent)
+    with pytest.raises(ConfigError) as info:
+        validate_config(bad, root / "workflow" / "schemas")
+    assert "config key 'markov.checks.tight_tol' = '1.0e12'" in str(info.value)
+    assert "write it as 1.0e+12, with a dot and a signed exponent" in str(info.value)

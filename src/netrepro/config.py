@@ -23,6 +23,7 @@ import copy
 import importlib
 import importlib.util
 import math
+import re
 import sys
 from importlib import metadata
 from pathlib import Path
@@ -233,7 +234,21 @@ def _format_error(err, describe=None) -> str:
                          f"Expected one of: {', '.join(known)}")
         return "\n  ".join(lines)
     key = ".".join(path) or "<top level>"
-    return f"config key '{key}' = {_short(err.instance)} is invalid: {err.message}. Expected: {expected or err.message}"
+    return (f"config key '{key}' = {_short(err.instance)} is invalid: {err.message}. Expected: {expected or err.message}"
+            + _yaml_float_hint(err.instance))
+
+
+def _yaml_float_hint(value) -> str:
+    """The fix for a number YAML 1.1 read as text (``1.0e12``, ``1e-5``): "" for anything else."""
+    if not isinstance(value, str):
+        return ""
+    text = value.strip()
+    if not re.fullmatch(r"[-+]?(?:\d+(?:\.\d*)?|\.\d+)[eE][-+]?\d+", text):
+        return ""
+    mantissa, _, exponent = text.lower().partition("e")
+    fixed = f"{mantissa if '.' in mantissa else mantissa + '.0'}e{exponent if exponent[0] in '+-' else '+' + exponent}"
+    return (f" (YAML 1.1, which Snakemake reads the configuration with, takes {text} for text: write it as {fixed}, "
+            "with a dot and a signed exponent)")
 
 
 def _describer(top: dict, registry):
