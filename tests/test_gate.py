@@ -269,12 +269,36 @@ def test_a_typed_number_that_is_one_of_its_values_is_found(text, values, typed):
     assert typed_numbers(text, values) == typed
 
 
-def test_a_typed_statement_stops_the_findings_table(tmp_path):
-    data = load_paper_data("p", write_paper(tmp_path, findings=[("by a factor of about 3", "by a factor of 3.2")]))
-    ev = {"gain_vs_none": {"nominal": Cell(3.2, ""), "horizon=100": Cell(3.1, "")}, "gain": {"nominal": Cell(1.5, "")},
-          "mse_finite": {"nominal": Cell(True, ""), "gain=2.5": Cell(False, "")}}
-    with pytest.raises(InputError, match=r"p/F1: the statement types 3.2 \(= gain_vs_none 3.2\)"):
-        findings_table(data, ev)
+def test_check_paper_refuses_a_typed_statement_and_the_build_does_not(tmp_path):
+    """A typed number equal to one of its evidence values fails check-paper (lint, on the configured scale's
+    evidence); the build only renders (at another scale a typed setting may round to a result by chance)."""
+    import os
+    import shutil
+    from pathlib import Path
+
+    from netrepro.contract import _check_findings_gate
+
+    root = Path(__file__).resolve().parents[1]
+    pkg = tmp_path / "src/netrepro/papers/intermittent"
+    shutil.copytree(root / "src/netrepro/papers/intermittent", pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    text = (pkg / "findings.yaml").read_text()
+    assert "tail index {tail_index_fig1:.2f}" in text
+    (pkg / "findings.yaml").write_text(text.replace("tail index {tail_index_fig1:.2f}", "tail index 1.31"))
+    built = tmp_path / "results/evidence/intermittent.csv"
+    built.parent.mkdir(parents=True)
+    shutil.copy(root / "tests/reference/evidence/intermittent.csv", built)
+    newest = max(p.stat().st_mtime for p in pkg.iterdir())
+    os.utime(built, (newest + 1, newest + 1))
+    found = _check_findings_gate("intermittent", pkg, tmp_path)
+    assert [v.check for v in found] == ["findings-gate"]
+    assert "F6: the statement types 1.31 (= tail_index_fig1 1.31432)" in found[0].message
+    # the build renders the statement as written
+    data = load_paper_data("intermittent", pkg)
+    table = findings_table(data, read_evidence(built)).set_index("finding_id")
+    assert "tail index 1.31:" in table.loc["F6", "statement"]
+    (pkg / "findings.yaml").write_text(text)
+    os.utime(built, (newest + 2, newest + 2))
+    assert _check_findings_gate("intermittent", pkg, tmp_path) == []
 
 
 # ----------------------------------------------------------------------------- the evidence table's new columns

@@ -603,8 +603,8 @@ def typed_numbers(statement: str, values: dict) -> list[str]:
     """Numbers typed in a statement's text that equal one of our values at their printed precision.
 
     Such a number belongs in a template field: typed, it can disagree with its own evidence at
-    another scale (issue 37). Integers in parentheses (equation numbers) and single digits
-    (settings such as "gamma = 3", counts) are not read as results.
+    another scale (issue 37). Integers in parentheses (equation numbers) and numbers of one
+    significant digit (settings such as "gamma = 3", "lambda_c + 0.1", counts) are not read as results.
 
     Parameters
     ----------
@@ -623,7 +623,8 @@ def typed_numbers(statement: str, values: dict) -> list[str]:
     for match in _NUMBER.finditer(literal):
         opened, number, closed = match.groups()
         integer = re.fullmatch(r"[-+]?\d+", number) is not None
-        if (integer and opened and closed) or (integer and len(number.lstrip("+-")) < 2):
+        significant = len(re.sub(r"^[-+]?0*\.?0*", "", number.split("e")[0].split("E")[0]).replace(".", ""))
+        if (integer and opened and closed) or significant < 2:
             continue
         typed = float(number)
         decimals = len(number.split(".")[1].split("e")[0].split("E")[0]) if "." in number else 0

@@ -34,8 +34,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import ConfigError, InputError
-from .paperdata import (ClaimEntry, FindingEntry, PaperData, load_paper_data, render_statement, template_fields,
-                        typed_numbers)
+from .paperdata import ClaimEntry, FindingEntry, PaperData, load_paper_data, render_statement, template_fields
 
 __all__ = [
     "VERDICTS",
@@ -796,7 +795,11 @@ def compare_observed(value) -> bool:
 
 
 def _statement(f: FindingEntry, evidence: dict, slug: str) -> str:
-    """The finding's statement with its template fields filled; a typed number that is one of its values refused.
+    """The finding's statement with its template fields filled from the evidence.
+
+    Typed numbers that equal one of its evidence values are refused by ``check-paper`` (lint), on the configured
+    scale's evidence, not here: at another scale a typed setting ("lambda_c + 0.1") may round to a result by
+    coincidence, and a heuristic must not stop a build.
 
     A template may name any quantity of the evidence table (the statement's numbers are text, not the rule:
     the registered ``evidence_quantities`` are what the verdict rests on).
@@ -807,11 +810,6 @@ def _statement(f: FindingEntry, evidence: dict, slug: str) -> str:
         raise InputError(f"finding {slug}/{f.finding_id}: the statement fills {missing} from the evidence, which has "
                          f"no nominal row of them (results/evidence/{slug}.csv)")
     cells = {q: _as_cell(evidence[q][NOMINAL]) for q in named if q in evidence and NOMINAL in evidence[q]}
-    typed = typed_numbers(f.statement, {q: c[0] for q, c in cells.items()})
-    if typed:
-        raise InputError(f"finding {slug}/{f.finding_id}: the statement types {', '.join(typed)}: a number that comes "
-                         "from our evidence is a template field ({quantity:.2f}, {quantity#u:.2g}), so the statement "
-                         "cannot disagree with its own table at another scale")
     return " ".join(render_statement(f.statement, cells).split())
 
 
@@ -844,7 +842,7 @@ def findings_table(data: PaperData, evidence: dict) -> pd.DataFrame:
         Naming the finding and the quantity, when a quantity it rests on (``quantity``,
         ``evidence_quantities``) or its cause variant is not in the evidence table, when it
         depends on a reconstruction and has no variant across its declared range, or when its
-        statement types a number that is one of its evidence values.
+        statement prints a quantity the evidence table lacks.
     """
     rows, problems = [], []
     for f in data.findings:
