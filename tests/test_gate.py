@@ -365,3 +365,20 @@ def test_a_statement_may_print_any_evidence_quantity_but_only_an_existing_one(tm
     ev["extra.ratio"] = {"nominal": Cell(2.345, "", 0.01)}
     row = findings_table(PaperData("p", [], [], [], [f1]), ev).iloc[0]
     assert row["statement"] == "worse by 2.35 (gain 1.5)"
+
+
+def test_the_skeletons_example_finding_may_be_replaced(tmp_path):
+    """The example finding new-paper registers is a placeholder: replacing it is no deletion."""
+    from netrepro.paperdata import SKELETON_COMMIT
+
+    root = write_paper(tmp_path)
+    lock = (root / "findings.lock").read_text().replace('commit: "fixture"', f'commit: "{SKELETON_COMMIT}"')
+    (root / "findings.lock").write_text(lock)
+    text = (root / "findings.yaml").read_text()
+    (root / "findings.yaml").write_text(text.replace("- id: F2", "- id: F3"))
+    with pytest.raises(ConfigError, match="p/F3 is not registered") as info:
+        load_paper_data("p", root)
+    assert "F2 is registered" not in str(info.value)
+    assert register_findings("p", root, commit="abc", date="2026-12-03") == ["F3"]
+    assert "F2:" not in (root / "findings.lock").read_text()
+    load_paper_data("p", root)

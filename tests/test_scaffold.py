@@ -349,6 +349,11 @@ def sixth(built_repo, tmp_path_factory):
                          env={**os.environ, **env_src}, check=False)
     assert new.returncode == 0, new.stdout + new.stderr
     _fill_in(work)
+    # the finding's rule is registered before its first run, as docs/adding-a-paper.md says
+    reg = subprocess.run([sys.executable, "-m", "netrepro", "register-findings", SLUG], cwd=work, capture_output=True,
+                         text=True, env={**os.environ, **env_src}, check=False)
+    assert reg.returncode == 0 and f"{SLUG}: registered F1_divergence_at_lambda_c" in reg.stdout, reg.stdout + reg.stderr
+    assert "F1_example_variance_grows" not in (work / "src/netrepro/papers" / SLUG / "findings.lock").read_text()
     planned_before_build = _planned(work)
     run_snakemake(work, "-j2", "report")
     return work, planned_before_build

@@ -66,6 +66,7 @@ __all__ = [
     "FINDING_KINDS",
     "REGISTERED_FIELDS",
     "LOCK_FILE",
+    "SKELETON_COMMIT",
     "SOURCE_KINDS",
     "Amendment",
     "check_tolerance",
@@ -97,6 +98,9 @@ FINDING_KINDS = ("numeric", "boolean", "observation")
 # the fields of a finding that decide its verdict: registered in findings.lock before its runs (issue 37)
 REGISTERED_FIELDS = ("kind", "asserted", "rule", "quantity", "evidence_quantities", "test")
 LOCK_FILE = "findings.lock"
+# the commit recorded for the example finding of a new paper's skeleton: a placeholder, not a finding of
+# ours, so replacing it is not a deletion (register-findings drops its entry once it is gone)
+SKELETON_COMMIT = "new-paper"
 # independent sources of a numeric rule's threshold (issue 37): never our own value
 SOURCE_KINDS = ("paper", "limit", "control", "effect_size")
 # a relative tolerance of 1 already accepts 0 and twice the expected value: nothing wider is a test
@@ -935,8 +939,8 @@ def check_registry(slug: str, root: str | Path, findings: list) -> list[str]:
                             "with the rule as registered (`registered: {...}`), why it changed and when; the "
                             "report then shows the registered verdict first and the amended one beside it")
     known = {f.finding_id for f in findings}
-    for ident in registry:
-        if ident not in known:
+    for ident, entry in registry.items():
+        if ident not in known and entry.get("commit") != SKELETON_COMMIT:
             problems.append(f"{slug}/{ident} is registered in {lock} but missing from findings.yaml: findings are "
                             "never deleted; retract it instead (retracted: {reason, when})")
     return problems
@@ -998,11 +1002,15 @@ def register_findings(slug: str, root: str | Path | None = None, commit: str = "
     changed = [p for p in check_registry(slug, root, findings) if " is not registered " not in p]
     if changed:
         raise ConfigError("refusing to register over a changed rule:\n  " + "\n  ".join(changed))
+    known = {f.finding_id for f in findings}
+    dropped = [k for k, e in registry.items() if k not in known and e.get("commit") == SKELETON_COMMIT]
+    for ident in dropped:
+        del registry[ident]
     new = [f for f in findings if f.finding_id not in registry]
     for f in new:
         fields = f.amendments[0].fields if f.amendments else f.registered
         registry[f.finding_id] = {"rule": rule_hash(fields), "registered": date, "commit": commit}
-    if new or not (root / LOCK_FILE).is_file():
+    if new or dropped or not (root / LOCK_FILE).is_file():
         order = [f.finding_id for f in findings] + [k for k in registry if k not in {f.finding_id for f in findings}]
         lock = root / LOCK_FILE
         kept = [line for line in lock.read_text().splitlines(keepends=True) if line.startswith("#")] \

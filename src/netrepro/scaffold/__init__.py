@@ -23,7 +23,7 @@ import yaml
 
 from ..errors import InputError
 from ..io import load_yaml
-from ..paperdata import LOCK_FILE, registry_lock_text
+from ..paperdata import LOCK_FILE, SKELETON_COMMIT, registry_lock_text
 from ..registry import load_registry, registry_entry_text, valid_slug
 
 __all__ = ["Plan", "plan_new_paper", "write_plan", "new_paper"]
@@ -133,7 +133,7 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
     # the example finding's rule, registered with the skeleton (issue 37): a new finding is registered
     # with `python -m netrepro register-findings` before the runs that test it
     create[f"src/netrepro/papers/{slug}/{LOCK_FILE}"] = registry_lock_text(
-        load_yaml(create[f"src/netrepro/papers/{slug}/findings.yaml"]) or [], "new-paper", date.today().isoformat())
+        load_yaml(create[f"src/netrepro/papers/{slug}/findings.yaml"]) or [], SKELETON_COMMIT, date.today().isoformat())
     taken = [p for p in create if (root / p).exists()]
     if taken:
         raise InputError(f"new-paper: {taken[0]} already exists (paper {slug!r} is partly there); nothing written")
