@@ -46,6 +46,10 @@ _CHARSET = re.compile(r"<meta\s+charset=[^>]*>", re.I)
 _SCRIPT = re.compile(r"<script\b([^>]*)>(.*?)</script\s*>", re.I | re.S)
 # ``var name = <JSON>;``: a script that only assigns data (Snakemake's report keeps its data so)
 _DATA_SCRIPT = re.compile(r"\s*var\s+[A-Za-z_$][\w$]*\s*=\s*(.*?);\s*", re.S)
+# the same, read without a lazy group over the whole text (Snakemake's data scripts are megabytes)
+_DATA_HEAD = re.compile(r"\s*var\s+[A-Za-z_$][\w$]*\s*=\s*")
+_SCRIPT_OPEN = re.compile(r"<script\b([^>]*)>", re.I)
+_SCRIPT_CLOSE = re.compile(r"</script\s*>", re.I)
 
 
 def policy_text(policy: dict) -> str:
@@ -149,6 +153,10 @@ def with_csp(page: str, policy: dict = PAGE_POLICY) -> str:
 def inline_scripts(page: str) -> list[tuple[str, str]]:
     """The inline scripts of a page, in order.
 
+    The elements ``<script ...>...</script>`` that ``_SCRIPT`` finds, found by locating each opening
+    tag and the next closing tag (a lazy regex group over a page of megabytes was most of
+    ``relocate``'s time).
+
     Parameters
     ----------
     page : str
@@ -159,7 +167,23 @@ def inline_scripts(page: str) -> list[tuple[str, str]]:
     list of tuple
         ``(attributes, text)`` of each ``<script>`` element without ``src``.
     """
-    return [(m.group(1), m.group(2)) for m in _SCRIPT.finditer(page) if not re.search(r"\bsrc\s*=", m.group(1), re.I)]
+    out, pos, lowered = [], 0, page.lower()
+    while True:
+        start = lowered.find("<script", pos)
+        if start < 0:
+            break
+        opening = _SCRIPT_OPEN.match(page, start)
+        if opening is None:
+            pos = start + 7
+            continue
+        closing = _SCRIPT_CLOSE.search(page, opening.end())
+        if closing is None:
+            break
+        attrs = opening.group(1)
+        if not re.search(r"\bsrc\s*=", attrs, re.I):
+            out.append((attrs, page[opening.end():closing.start()]))
+        pos = closing.end()
+    return out
 
 
 def is_data_script(text: str) -> bool:
@@ -176,11 +200,14 @@ def is_data_script(text: str) -> bool:
         True if the text is ``var <name> = <JSON>;`` and nothing else: running it computes
         nothing and calls nothing.
     """
-    match = _DATA_SCRIPT.fullmatch(text)
-    if match is None:
+    head = _DATA_HEAD.match(text)
+    if head is None:
+        return False
+    body = text[head.end():].rstrip()
+    if not body.endswith(";"):
         return False
     try:
-        json.loads(match.group(1))
+        json.loads(body[:-1])
     except ValueError:
         return False
     return True
