@@ -964,9 +964,14 @@ def registry_lock_text(findings: list, commit: str, date: str) -> str:
     lines = [_LOCK_HEADER]
     for raw in findings:
         fields = raw["amendments"][0]["registered"] if raw.get("amendments") else raw
-        lines.append(f"{raw['id']}: {{rule: \"{rule_hash(registered_fields(fields))}\", registered: \"{date}\", "
-                     f"commit: \"{commit}\"}}\n")
+        lines.append(_lock_line(str(raw["id"]), rule_hash(registered_fields(fields)), date, commit))
     return "".join(lines)
+
+
+def _lock_line(ident: str, rule: str, date: str, commit: str) -> str:
+    """One entry of ``findings.lock``, as every writer of the file writes it."""
+    return f'{ident}: {{rule: "{rule}", registered: "{date}", commit: "{commit}"}}\n'
+
 
 
 def register_findings(slug: str, root: str | Path | None = None, commit: str = "", date: str = "") -> list[str]:
@@ -1018,8 +1023,7 @@ def register_findings(slug: str, root: str | Path | None = None, commit: str = "
         lines = kept or [_LOCK_HEADER]
         for ident in order:
             e = registry[ident]
-            lines.append(f"{ident}: {{rule: \"{e['rule']}\", registered: \"{e.get('registered', '')}\", "
-                         f"commit: \"{e.get('commit', '')}\"}}\n")
+            lines.append(_lock_line(ident, e["rule"], e.get("registered", ""), e.get("commit", "")))
         (root / LOCK_FILE).write_text("".join(lines))
     return [f.finding_id for f in new]
 

@@ -74,13 +74,8 @@ def ms_stability_index(sys: System, gains: Gains, ps, p_seq, worst_gain: bool = 
         The larger of the largest frozen radius and the largest growth rate; below 1 for mean-square
         stability.
     """
-    from .feasibility import worst_sector_gain
-
-    cases = list(sector_cases(sys).values())
-    if worst_gain and sys.nz == 2:
-        cases.append(worst_sector_gain(sys, sys.sigma2)["K"])
-    rho = max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases)
-    growth = max(scheduled_growth_rate(sys, gains, p_seq, F) for F in cases)
+    rho = frozen_ms_radius(sys, gains, ps, worst_gain)
+    growth = max(scheduled_growth_rate(sys, gains, p_seq, F) for F in _class3_gains(sys, worst_gain))
     return float(max(rho, growth))
 
 
@@ -110,12 +105,18 @@ def frozen_ms_radius(sys: System, gains: Gains, ps, worst_gain: bool = True) -> 
     float
         The largest frozen radius.
     """
+    return float(max(frozen_radius(sys, gains, float(p), F) for p in ps for F in _class3_gains(sys, worst_gain)))
+
+
+def _class3_gains(sys: System, worst_gain: bool) -> list:
+    """The linear gains F of class (3) the indices check: the diagonal sector vertices, and (nz = 2,
+    ``worst_gain``) the worst rotated gain of :func:`.feasibility.worst_sector_gain` at ``sys.sigma2``."""
     from .feasibility import worst_sector_gain
 
     cases = list(sector_cases(sys).values())
     if worst_gain and sys.nz == 2:
         cases.append(worst_sector_gain(sys, sys.sigma2)["K"])
-    return float(max(frozen_radius(sys, gains, float(p), F) for p in ps for F in cases))
+    return cases
 
 
 def ms_stable_decision(index: float, sigma2: float, certified_to: float, refuted_from: float) -> tuple:
