@@ -3,7 +3,7 @@
 Starts a single-node Slurm cluster on this machine (``tests/slurm/cluster.py``:
 munged as the ``munge`` user, slurmctld and slurmd as root, no slurmdbd), runs the sharded
 tables of the small test configuration (intermittent's tables, the onebit estimator, hinf's loop
-variants and Kalman-best: :data:`tests.slurm.measure.TARGETS`) in a scratch copy of the
+variants, Kalman-best and the fixed-path swap: :data:`tests.slurm.measure.TARGETS`) in a scratch copy of the
 repository with ``snakemake --profile workflow/profiles/slurm`` (job states from squeue), and
 checks that
 
@@ -50,6 +50,7 @@ TABLES = TARGETS + [
     "results/onebit/estimator_ratios.csv",
     "results/onebit/estimator_crossing.csv",
     "results/hinf/loop_variants_runs.csv",
+    "results/hinf/loop_swap_runs.csv",
 ]
 LOCAL_TIMEOUT = 900  # s, the local reference run
 SLURM_TIMEOUT = 900  # s, the whole run under Slurm (the whole test: 92 s on a loaded 2-core machine)
@@ -176,7 +177,7 @@ def test_sharded_tables_through_slurm_as_job_arrays(cluster, tmp_path_factory):
 
     # the shard rules went as job arrays: the plugin's array submissions, and Slurm's array task ids
     subs = submissions(log)
-    assert planned >= 10  # 5 sharded steps x (2 + 1) shards and the plain jobs, at least
+    assert planned >= 10  # 6 sharded steps x (2 + 1) shards and the plain jobs, at least
     assert subs["arrays"], f"no array submission in the log:\n{log[-4000:]}"
     known = {job_id: (partition, state, comment) for job_id, partition, state, comment
              in cluster.jobs(fields="%i|%P|%T|%k")}

@@ -57,3 +57,16 @@ def test_array_list_parse_checks_itself():
     # the parser above reads what the plugin reads: comma or semicolon separated, blanks ignored
     assert _array_rules({"slurm-array-jobs": " a_shard, b_shard;c_shard ,"}) == ["a_shard", "b_shard", "c_shard"]
     assert yaml.safe_load(PROFILE.read_text())["executor"] == "slurm"
+
+
+@pytest.mark.slow  # the workflow's rule list comes from Snakemake
+def test_every_sharded_step_has_a_shard_count_key_and_shards_in_the_test_configuration():
+    # a shard rule whose step is missing from the schema's `shards` runs as one job whatever the
+    # profile asks (the key is refused), and one the test configuration leaves at 1 shard is never
+    # sent to Slurm as an array by tests/test_slurm.py
+    steps = {name.removesuffix("_shard") for name in _workflow_rules() if name.endswith("_shard")}
+    schema = yaml.safe_load((ROOT / "workflow/schemas/config.schema.yaml").read_text())
+    keys = set(schema["properties"]["shards"]["properties"])
+    assert keys == steps, f"steps without a shard key: {sorted(steps - keys)}; keys without a step: {sorted(keys - steps)}"
+    test_shards = yaml.safe_load((ROOT / "config/test.yaml").read_text())["shards"]
+    assert {step for step, count in test_shards.items() if count >= 2} == steps, test_shards

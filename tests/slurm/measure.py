@@ -50,6 +50,7 @@ TARGETS = [
     "results/onebit/estimator_mse.csv",
     "results/hinf/loop_variants.csv",
     "results/hinf/kalman_best.csv",
+    "results/hinf/loop_swap.csv",
 ]
 MODES = {"arrays": [], "individual": ["--slurm-array-jobs", ""]}
 FIELDS = ["mode", "repeat", "submissions", "array_submissions", "single_submissions", "jobs", "array_tasks",
