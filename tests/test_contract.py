@@ -1,5 +1,6 @@
 """The paper contract as a command (issue 30): it passes on every paper and names each planted violation."""
 
+import re
 import shutil
 import subprocess
 import sys
@@ -12,11 +13,23 @@ from netrepro.registry import paper_slugs
 
 ROOT = Path(__file__).resolve().parents[1]
 SLUG = "intermittent"
-# what check_paper reads of a checkout
-PARTS = ("src/netrepro/papers.yaml", f"src/netrepro/papers/{SLUG}", f"workflow/rules/{SLUG}.smk",
-         f"workflow/schemas/{SLUG}.schema.yaml", "workflow/schemas/config.schema.yaml",
-         f"workflow/notebooks/{SLUG}.ipynb", f"workflow/report/{SLUG}", f"tests/papers/{SLUG}",
-         f"tests/reference/{SLUG}", "config/config.yaml", "config/test.yaml")
+
+
+def parts(slug):
+    """What check_paper reads of a checkout for paper ``slug``."""
+    return ("src/netrepro/papers.yaml", f"src/netrepro/papers/{slug}", f"workflow/rules/{slug}.smk",
+            f"workflow/schemas/{slug}.schema.yaml", "workflow/schemas/config.schema.yaml",
+            f"workflow/notebooks/{slug}.ipynb", f"workflow/report/{slug}", f"tests/papers/{slug}",
+            f"tests/reference/{slug}", "config/config.yaml", "config/test.yaml")
+
+
+def copy_parts(slug, target: Path) -> Path:
+    """A scratch checkout with the files of paper ``slug`` that the contract reads."""
+    for part in parts(slug):
+        src, dst = ROOT / part, target / part
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
+    return target
 
 
 @pytest.mark.parametrize("slug", paper_slugs())
@@ -35,10 +48,7 @@ def test_the_command_passes_on_all_papers_and_exits_zero():
 @pytest.fixture
 def scratch(tmp_path):
     """The files of one paper that the contract reads, in a scratch checkout."""
-    for part in PARTS:
-        src, dst = ROOT / part, tmp_path / part
-        dst.parent.mkdir(parents=True, exist_ok=True)
-        (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
+    copy_parts(SLUG, tmp_path)
     assert not check_paper(SLUG, tmp_path)
     return tmp_path
 
@@ -71,6 +81,7 @@ def test_each_planted_violation_is_named_with_file_and_line(scratch):
     smk = scratch / f"workflow/rules/{SLUG}.smk"
     rule_line = _append(smk, "\n\nrule wrong_prefix:\n    output:\n        'x'\n    shell:\n        'touch {output}'\n")
     key_line = _append(smk, "\nEXTRA = pick(ICFG.get('scalar', {}), 'a', 'no_such_key')\n")
+    whole_line = _append(smk, "\n\nrule intermittent_whole:\n    params:\n        cfg=as_json(ICFG),\n")
 
     found = check_paper(SLUG, scratch)
     text = "\n".join(map(str, found))
@@ -86,8 +97,10 @@ def test_each_planted_violation_is_named_with_file_and_line(scratch):
     assert _named(found, "rule-name", f"workflow/rules/{SLUG}.smk", rule_line + 2), text
     assert [v for v in _named(found, "config-key", f"workflow/rules/{SLUG}.smk", key_line + 1)
             if "intermittent.scalar.no_such_key" in v.message], text
+    assert [v for v in _named(found, "whole-section", f"workflow/rules/{SLUG}.smk", whole_line + 4)
+            if "ICFG" in v.message], text
     # and nothing else: every violation is one of those planted
-    assert len(found) == 11, text
+    assert len(found) == 12, text
 
 
 def test_a_missing_reference_folder_is_a_violation(scratch):
@@ -104,3 +117,93 @@ def test_an_unregistered_paper_is_a_violation(scratch):
     registry.write_text(text[:start] + text[end:])
     found = check_paper(SLUG, scratch)
     assert [v for v in found if v.check == "roles" and "not registered" in v.message], found
+
+
+# ----------------------------------------------------------------------------- issue 39: params carry picked keys
+WHOLE_SECTION_SMK = '''
+HCFG = config.get("hinf", {})
+
+
+rule hinf_whole:
+    params:
+        cfg=as_json(HCFG),
+        rule="hinf_whole",
+
+
+rule hinf_nested:
+    params:
+        cfg=lambda w: as_json({"scenario": w.scenario, "cfg": HCFG}),
+
+
+rule hinf_config:
+    params:
+        cfg=as_json(config["hinf"]),
+        other=as_json(config),
+
+
+rule hinf_picked:
+    params:
+        # passing HCFG whole here would rerun the step on any edit
+        cfg=as_json(pick(HCFG, "noise", "noise_check")),
+        sub=as_json({**pick(HCFG, "claims"), "scenarios": pick(HCFG.get("scenarios", {}), "fig2")}),
+        entry=as_json(HCFG["network"]),
+        shards=as_json(config["shards"]),
+'''
+
+
+@pytest.fixture(scope="module")
+def hinf_checkout(tmp_path_factory):
+    return copy_parts("hinf", tmp_path_factory.mktemp("hinf"))
+
+
+def _whole_section(smk_text: str, checkout: Path):
+    """check_paper's whole-section violations with ``smk_text`` as workflow/rules/hinf.smk of ``checkout``."""
+    smk = checkout / "workflow/rules/hinf.smk"
+    original = smk.read_text()
+    smk.write_text(smk_text)
+    try:
+        return [v for v in check_paper("hinf", checkout) if v.check == "whole-section"]
+    finally:
+        smk.write_text(original)
+
+
+def test_params_passing_a_whole_section_are_named_with_file_and_line(hinf_checkout):
+    found = _whole_section(WHOLE_SECTION_SMK, hinf_checkout)
+    lines = WHOLE_SECTION_SMK.splitlines()
+    where = {(v.path, v.line) for v in found}
+    expected = {("workflow/rules/hinf.smk", i + 1) for i, text in enumerate(lines)
+                if text.strip().startswith(("cfg=as_json(HCFG)", "cfg=lambda w:", "cfg=as_json(config[", "other="))}
+    assert where == expected and len(found) == 4, "\n".join(map(str, found))
+    assert any('config["hinf"]' in v.message for v in found)
+
+
+def _unpicked(text: str) -> str:
+    """The hinf rules as they were before issue 39: every ``pick(HCFG, ...)`` replaced by ``HCFG``."""
+    from netrepro.contract import _calls
+    calls = [(offset, source) for offset, source in _calls(text, "pick") if re.match(r"pick\(\s*HCFG\s*,", source)]
+    for offset, source in reversed(calls):
+        text = text[:offset] + "HCFG" + text[offset + len(source):]
+    return text
+
+
+def test_the_old_hinf_rules_fail_the_check_and_the_new_pass(hinf_checkout):
+    new = (ROOT / "workflow/rules/hinf.smk").read_text()
+    assert not _whole_section(new, hinf_checkout)
+    # every hinf rule but hinf_tables passed the whole section: as_json(HCFG), {"cfg": HCFG, ...}
+    old = _unpicked(new)
+    found = _whole_section(old, hinf_checkout)
+    assert len(found) == 20, "\n".join(map(str, found))
+    assert len({v.line for v in found}) == 20
+    assert all("HCFG" in old.splitlines()[v.line - 1] for v in found)
+    # and the text of the last commit before the change, where the history is at hand
+    before = subprocess.run(["git", "show", "94f38aa:workflow/rules/hinf.smk"], cwd=ROOT, capture_output=True,
+                            text=True, check=False)
+    if before.returncode == 0:
+        found = _whole_section(before.stdout, hinf_checkout)
+        assert len(found) == 20, "\n".join(map(str, found))
+        assert all("HCFG" in before.stdout.splitlines()[v.line - 1] for v in found)
+
+
+@pytest.mark.parametrize("slug", paper_slugs())
+def test_no_paper_passes_its_whole_section(slug):
+    assert not [v for v in check_paper(slug, ROOT) if v.check == "whole-section"]

@@ -19,7 +19,9 @@ reading the files (nothing is imported or run), and names the file and line of e
   with our value lacks an independent source of its threshold (issue 37);
 * ``figure-spec``: every figure of ``figures.yaml`` has its plotting function and a caption;
 * ``rule-name``: every rule of ``workflow/rules/<slug>.smk`` starts with the slug;
-* ``config-key``: every configuration key the rules pick for their steps is in the paper's schema.
+* ``config-key``: every configuration key the rules pick for their steps is in the paper's schema;
+* ``whole-section``: no rule's params pass the paper's configuration section (or the whole
+  configuration) whole: a step gets only the keys it reads, ``pick(SECTION, "key", ...)`` (issue 39).
 """
 
 from __future__ import annotations
@@ -436,6 +438,85 @@ def _check_config_keys(slug: str, root: Path) -> list[Violation]:
     return out
 
 
+def _params_blocks(text: str):
+    """(start, end) offsets of the body of every ``params:`` block of a rules file (by indentation)."""
+    lines = text.splitlines(keepends=True)
+    starts = [0]
+    for line in lines:
+        starts.append(starts[-1] + len(line))
+    for i, line in enumerate(lines):
+        m = re.match(r"^(\s*)params:\s*(#.*)?$", line)
+        if not m:
+            continue
+        indent, j = len(m.group(1)), i + 1
+        while j < len(lines) and (not lines[j].strip() or len(lines[j]) - len(lines[j].lstrip()) > indent):
+            j += 1
+        yield starts[i + 1], starts[j]
+
+
+def _first_argument(source: str) -> tuple[int, int]:
+    """(start, end) offsets in ``source`` (a call ``name(...)``) of its first argument."""
+    start = source.index("(") + 1
+    depth = 0
+    for i in range(start, len(source)):
+        ch = source[i]
+        if ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            if depth == 0:
+                return start, i
+            depth -= 1
+        elif ch == "," and depth == 0:
+            return start, i
+    return start, len(source)
+
+
+# one key taken of a mapping, at the start of the text: ["key"] / [expr] or .get("key", ...) / .get(expr, ...)
+_ACCESSOR = re.compile(r"""\s*(?:\[\s*["']?([^\[\]"']*)["']?\s*\]|\.get\(\s*["']?([^,()"']*)["']?[^()]*\))""")
+
+
+def _check_whole_section(slug: str, root: Path) -> list[Violation]:
+    """Rules whose params pass a whole configuration section (or the whole configuration) to their step.
+
+    A step's params carry only the keys it reads (``pick(SECTION, "key", ...)``): a section passed whole
+    reruns the step on an edit of any key of it (issue 39). In a ``params:`` block, the paper's section (a
+    name bound to ``config.get("<slug>", ...)`` or ``config["<slug>"]``, or that expression itself) and
+    ``config`` are mentioned only as the first argument of a ``pick`` call or to take one key of them
+    (``SECTION["key"]``, ``SECTION.get("key", ...)``: an entry of the section, for a step that reads it all).
+    """
+    path = root / "workflow/rules" / f"{slug}.smk"
+    if not path.is_file():
+        return []
+    text = path.read_text()
+    names = set(re.findall(rf"^(\w+)\s*=\s*config(?:\.get\(\s*|\[\s*)[\"']{re.escape(slug)}[\"']", text, re.M))
+    names.add("config")
+    pattern = re.compile(r"(?<![\w.])(" + "|".join(sorted(map(re.escape, names))) + r")\b")
+    out = []
+    for start, end in _params_blocks(text):
+        block = text[start:end]
+        allowed = []
+        for offset, source in _calls(block, "pick"):
+            a, b = _first_argument(source)
+            allowed.append((offset + a, offset + b))
+        for m in pattern.finditer(block):
+            line_text = block[block.rfind("\n", 0, m.start()) + 1:m.start()]
+            if "#" in line_text or any(a <= m.start() < b for a, b in allowed):
+                continue
+            keys, pos = [], m.end()
+            while len(keys) < 2 and (a := _ACCESSOR.match(block, pos)):
+                keys.append((a.group(1) or a.group(2) or "").strip())
+                pos = a.end()
+            if m.group(1) == "config" and keys[:1] == [slug]:
+                keys = keys[1:]  # config["<slug>"] is the section itself
+            if keys:
+                continue
+            expr = re.sub(r"\s+", "", block[m.start():pos])
+            out.append(Violation(_rel(path, root), text.count("\n", 0, start + m.start()) + 1, "whole-section",
+                                 f"the params pass {expr} whole: pass only the keys the step reads, "
+                                 f"pick({expr}, \"key\", ...)"))
+    return out
+
+
 def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     """Every breach of the paper contract by paper ``slug`` in the checkout ``root``.
 
@@ -458,7 +539,7 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
             *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_findings_gate(slug, pkg, root),
             *_check_figures(slug, pkg, root),
-            *_check_rule_names(slug, root), *_check_config_keys(slug, root)]
+            *_check_rule_names(slug, root), *_check_config_keys(slug, root), *_check_whole_section(slug, root)]
 
 
 def main(slugs, root: str | Path = ".") -> int:

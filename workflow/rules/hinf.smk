@@ -4,6 +4,18 @@
 # notebook are generated from src/netrepro/papers/hinf/figures.yaml (workflow/rules/figures.smk).
 
 HCFG = config.get("hinf", {})
+# the configuration keys each step reads (only these trigger its rerun): what
+# model.resolve_scenario reads of the section, then each step's own keys (steps.py, evidence.py)
+HINF_SCENARIO_KEYS = (
+    "scenarios",
+    "filter",
+    "consensus",
+    "control",
+    "layouts",
+    "noise",
+    "comm_radius",
+    "evader",
+)
 HINF_SCENARIOS = [
     "fig2",
     "fig3",
@@ -26,7 +38,7 @@ rule hinf_noise_model:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "noise", "noise_check")),
         rule="hinf_noise_model",
         io=io_json,
     shell:
@@ -43,7 +55,7 @@ rule hinf_consensus_check:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "consensus_check", "consensus", "layouts", "comm_radius")),
         rule="hinf_consensus_check",
         io=io_json,
     shell:
@@ -61,7 +73,7 @@ rule hinf_attenuation:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "attenuation")),
         rule="hinf_attenuation",
         io=io_json,
     shell:
@@ -84,7 +96,16 @@ rule hinf_simulate:
     conda:
         CONDA_ENV
     params:
-        cfg=lambda wildcards: as_json({"scenario": wildcards.scenario, "cfg": HCFG}),
+        # one scenario's entry: an edit of another scenario does not rerun this one
+        cfg=lambda w: as_json(
+            {
+                "scenario": w.scenario,
+                "cfg": {
+                    **pick(HCFG, *HINF_SCENARIO_KEYS, "output", "claims"),
+                    "scenarios": pick(HCFG.get("scenarios", {}), w.scenario),
+                },
+            }
+        ),
         rule="hinf_simulate",
         io=io_json,
     shell:
@@ -128,7 +149,7 @@ rule hinf_sensitivity:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "sensitivity", "claims")),
         rule="hinf_sensitivity",
         io=io_json,
     shell:
@@ -145,7 +166,7 @@ rule hinf_sensitivity_evasive:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "sensitivity", "claims")),
         rule="hinf_sensitivity_evasive",
         io=io_json,
     shell:
@@ -166,7 +187,7 @@ rule hinf_paired_evasive:
         mem_mb=2000,
         runtime=20,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "paired", "claims")),
         rule="hinf_paired_evasive",
         io=io_json,
     shell:
@@ -189,7 +210,7 @@ rule hinf_fig2_horizon:
         mem_mb=2000,
         runtime=20,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "fig2_horizon", "claims", "sensitivity")),
         rule="hinf_fig2_horizon",
         io=io_json,
     shell:
@@ -211,7 +232,7 @@ rule hinf_evader_check:
         mem_mb=1000,
         runtime=10,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "evader_check", "paired", "claims")),
         rule="hinf_evader_check",
         io=io_json,
     shell:
@@ -232,7 +253,7 @@ rule hinf_fig5_control:
         mem_mb=1000,
         runtime=10,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "sensitivity", "claims")),
         rule="hinf_fig5_control",
         io=io_json,
     shell:
@@ -253,7 +274,7 @@ rule hinf_evasive_network:
         mem_mb=1000,
         runtime=10,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "paired", "claims")),
         rule="hinf_evasive_network",
         io=io_json,
     shell:
@@ -275,7 +296,7 @@ rule hinf_fig6_paths:
         mem_mb=1000,
         runtime=10,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, *HINF_SCENARIO_KEYS, "fig6_paths", "claims", "tests")),
         rule="hinf_fig6_paths",
         io=io_json,
     shell:
@@ -300,7 +321,7 @@ rule hinf_loop_variants_shard:
     params:
         cfg=lambda w: as_json(
             {
-                "cfg": HCFG,
+                "cfg": pick(HCFG, *HINF_SCENARIO_KEYS, "loop_variants", "claims"),
                 "shard": int(w.shard),
                 "n_shards": len(shards("hinf_loop_variants")),
             }
@@ -327,7 +348,7 @@ rule hinf_loop_variants:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "loop_variants", "tests")),
         rule="hinf_loop_variants",
         io=io_json,
     shell:
@@ -352,7 +373,7 @@ rule hinf_loop_swap_shard:
     params:
         cfg=lambda w: as_json(
             {
-                "cfg": HCFG,
+                "cfg": pick(HCFG, *HINF_SCENARIO_KEYS, "loop_swap", "claims"),
                 "shard": int(w.shard),
                 "n_shards": len(shards("hinf_loop_swap")),
             }
@@ -379,7 +400,7 @@ rule hinf_loop_swap:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "loop_swap", "tests")),
         rule="hinf_loop_swap",
         io=io_json,
     shell:
@@ -404,7 +425,7 @@ rule hinf_kalman_best_shard:
     params:
         cfg=lambda w: as_json(
             {
-                "cfg": HCFG,
+                "cfg": pick(HCFG, *HINF_SCENARIO_KEYS, "kalman_best", "claims"),
                 "shard": int(w.shard),
                 "n_shards": len(shards("hinf_kalman_best")),
             }
@@ -431,7 +452,7 @@ rule hinf_kalman_best:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "kalman_best", "filter", "tests")),
         rule="hinf_kalman_best",
         io=io_json,
     shell:
@@ -451,7 +472,7 @@ rule hinf_network:
     conda:
         CONDA_ENV
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(pick(HCFG, "comm_radius", "network")),
         rule="hinf_network",
         io=io_json,
     shell:
@@ -501,7 +522,25 @@ rule hinf_evidence:
         mem_mb=1000,
         runtime=5,
     params:
-        cfg=as_json(HCFG),
+        cfg=as_json(
+            pick(
+                HCFG,
+                "claims",
+                "errata",
+                "noise",
+                "filter",
+                "consensus",
+                "control",
+                "evader",
+                "layouts",
+                "scenarios",
+                "fig2_horizon",
+                "sensitivity",
+                "loop_variants",
+                "kalman_best",
+                "tests",
+            )
+        ),
         rule="hinf_evidence",
         io=io_json,
     shell:

@@ -878,7 +878,7 @@ def _reconstruction_rows(cfg, sens, ev_conv) -> list[dict]:
 def evidence_step(params, inputs, outputs):
     """Step of rule ``hinf_evidence``: the evidence table ``results/evidence/hinf.csv``.
 
-    ``params``: the ``hinf`` configuration section. ``inputs``: ``claims`` (the paper's ``claims.yaml``, whose
+    ``params``: the entries of the ``hinf`` configuration it reads. ``inputs``: ``claims`` (the paper's ``claims.yaml``, whose
     ``at`` fields hold the claims' settings) and the result tables named in the rule
     (consensus check, attenuation and filter checks, summary, paired, per-run pieces of the
     stationary-target scenarios, errors, trajectories, connectivity, sensitivity sweeps, paired
@@ -887,8 +887,9 @@ def evidence_step(params, inputs, outputs):
     Parameters
     ----------
     params : dict
-        The ``hinf`` configuration section (``claims``, ``consensus``, ``filter``, ``scenarios``,
-        ``loop_variants`` and the reconstructed settings are read).
+        The entries of the ``hinf`` configuration it reads (the rule passes only these): ``claims``,
+        ``errata``, ``noise``, ``filter``, ``consensus``, ``control``, ``evader``, ``layouts``,
+        ``scenarios``, ``fig2_horizon``, ``sensitivity``, ``loop_variants``, ``kalman_best``, ``tests``.
     inputs : dict
         ``claims`` and the result tables named above (``consensus``, ``attenuation``, ``checks``,
         ``summary``, ``paired``, ``errors``, ``trajectories``, ``per_run_static_fixed``,

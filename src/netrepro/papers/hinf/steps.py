@@ -399,8 +399,9 @@ def simulate_step(params, inputs, outputs):
     Parameters
     ----------
     params : dict
-        ``scenario`` (a scenario name of ``hinf.scenarios``) and ``cfg`` (the whole ``hinf``
-        configuration).
+        ``scenario`` (a scenario name of ``hinf.scenarios``) and ``cfg`` (the entries of the ``hinf``
+        configuration it reads: ``output``, ``claims``, what :func:`.model.resolve_scenario` reads,
+        ``scenarios`` holding this scenario only).
     inputs : dict
         Only the step's code (no table is read).
     outputs : dict
@@ -998,8 +999,8 @@ def loop_variants_shard_step(params, inputs, outputs):
     Parameters
     ----------
     params : dict
-        ``cfg`` (the whole ``hinf`` configuration; ``loop_variants`` and ``claims.late_start`` are
-        read), ``shard`` (this shard's index) and ``n_shards``.
+        ``cfg`` (the ``hinf`` configuration's entries ``loop_variants``, ``claims`` and what
+        :func:`.model.resolve_scenario` reads), ``shard`` (this shard's index) and ``n_shards``.
     inputs : dict
         Only the step's code (no table is read).
     outputs : dict
@@ -1155,8 +1156,8 @@ def kalman_best_shard_step(params, inputs, outputs):
     Parameters
     ----------
     params : dict
-        ``cfg`` (the whole ``hinf`` configuration; ``kalman_best`` and ``claims.late_start`` are
-        read), ``shard`` (this shard's index) and ``n_shards``.
+        ``cfg`` (the ``hinf`` configuration's entries ``kalman_best``, ``claims`` and what
+        :func:`.model.resolve_scenario` reads), ``shard`` (this shard's index) and ``n_shards``.
     inputs : dict
         Only the step's code (no table is read).
     outputs : dict
@@ -1428,8 +1429,8 @@ def loop_swap_shard_step(params, inputs, outputs):
     Parameters
     ----------
     params : dict
-        ``cfg`` (the whole ``hinf`` configuration; ``loop_swap`` and ``claims.late_start`` are read), ``shard``
-        and ``n_shards``.
+        ``cfg`` (the ``hinf`` configuration's entries ``loop_swap``, ``claims`` and what
+        :func:`.model.resolve_scenario` reads), ``shard`` and ``n_shards``.
     inputs : dict
         Only the step's code.
     outputs : dict
