@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report test test-fast lint lock bench verify clean clean-results readme check update-references
+.PHONY: report repair unlock test test-fast lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -38,8 +38,11 @@ $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 CONFIG ?=
 PROFILE ?= default
 SHARDS ?=
-SMK = $(BIN)/snakemake report --profile workflow/profiles/$(PROFILE) $(if $(filter default,$(PROFILE)),-j$(JOBS)) \
+SMK_OPTS = --profile workflow/profiles/$(PROFILE) $(if $(filter default,$(PROFILE)),-j$(JOBS)) \
 	$(if $(SHARDS),--config 'shards=$(SHARDS)') $(if $(CONFIG),--configfile config/config.yaml config/$(CONFIG).yaml)
+# The build driver (netrepro.build) runs `snakemake report $(SMK_OPTS)`: it says "interrupted; rerun" after
+# Ctrl-C, refuses to start beside a running build of this checkout, and says whose a lock is.
+BUILD = $(BIN)/python -m netrepro
 
 # Bytecode of the package compiled once: where PYTHONDONTWRITEBYTECODE is set (containers, CI), every job
 # would otherwise compile the modules it imports again (~0.05-0.1 CPU s per job); elsewhere a no-op.
@@ -48,8 +51,19 @@ SMK = $(BIN)/snakemake report --profile workflow/profiles/$(PROFILE) $(if $(filt
 # wait for its last re-evaluation timer (max-jobs-per-timespan, workflow/profiles/default/config.yaml).
 report: $(STAMP)
 	$(BIN)/python -m compileall -q src
-	$(SMK) --report report/snakemake_report.html --report-after-run
+	$(BUILD) build -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
 	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
+
+# A damaged build repaired in one command: removes every output `verify` finds corrupt, unfinished or
+# unverifiable, rebuilds those and every declared output that is missing, and what depends on them.
+repair: $(STAMP)
+	$(BIN)/python -m compileall -q src
+	$(BUILD) repair -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
+	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
+
+# Removes the lock a killed build left (Snakemake's --unlock); refuses while a build of this checkout runs.
+unlock: $(STAMP)
+	$(BUILD) unlock -- $(SMK_OPTS)
 
 test: $(STAMP_TEST)
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests

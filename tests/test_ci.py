@@ -57,7 +57,7 @@ def test_make_report_takes_an_overlay_a_profile_and_shard_counts():
 
     def dry(*args):
         out = subprocess.run(["make", "-n", "report", *args], cwd=root, capture_output=True, text=True, check=True)
-        return [line for line in out.stdout.splitlines() if "snakemake report" in line]
+        return [line for line in out.stdout.splitlines() if "netrepro build -- " in line]
 
     default = dry()
     assert default and all("--configfile" not in line and "--config " not in line and "-j2" in line for line in default)

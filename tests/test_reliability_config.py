@@ -331,6 +331,33 @@ def test_blocked_import_gives_clear_message(tmp_path, blocked):
     assert "Fix: run `make`" in proc.stdout
 
 
+def test_a_crippled_solver_is_refused_at_start_up_with_the_reinstall_command(tmp_path):
+    # clarabel present (found by its spec) but failing on import, as a broken build or a missing
+    # shared library does: found-only checks passed it and every LMI job then failed with a traceback
+    fake = tmp_path / "site" / "clarabel"
+    fake.mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise ImportError('libclarabel.so: cannot open shared object file')\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path / "site"), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        from netrepro.config import check_dependencies, DependencyError
+        try:
+            check_dependencies()
+        except DependencyError as exc:
+            print(exc)
+            raise SystemExit(3)
+        """)], capture_output=True, text=True, env=env, cwd=ROOT, timeout=120)
+    assert proc.returncode == 3, proc.stdout + proc.stderr
+    assert "required package 'clarabel'" in proc.stdout and "cannot be imported" in proc.stdout
+    assert "libclarabel.so" in proc.stdout and "pip install --force-reinstall 'clarabel" in proc.stdout
+
+
+def test_the_solver_of_the_lmi_engine_is_imported_at_start_up():
+    from netrepro.config import IMPORTED_AT_START
+    from netrepro.engines.cvx import SOLVER
+
+    assert SOLVER.lower() in IMPORTED_AT_START
+
+
 def test_paper_needing_a_missing_package_is_not_reported_as_a_missing_paper(tmp_path):
     # a paper's checks module that imports a missing package (pandas, blocked). The packaged papers keep
     # checks.py light (no pandas), so the import of such a module is simulated by a finder that

@@ -238,6 +238,8 @@ def interrupt(work, how):
         running = not (work / "results/intermittent/monte_carlo.csv").exists()
         if how == "TERM":
             proc.send_signal(signal.SIGTERM)
+        elif how == "KILL-snakemake":  # Snakemake alone, as `kill -9 PID`: its jobs run on
+            proc.send_signal(signal.SIGKILL)
         else:
             os.killpg(proc.pid, signal.SIGTERM if how == "TERM-group" else signal.SIGKILL)
         proc.wait(timeout=300)
@@ -301,6 +303,29 @@ def test_interrupted_monte_carlo_reruns_to_identical_tables(how, built, referenc
         assert (work / path).read_bytes() == reference[path], f"{path} differs after the {how} interruption"
     assert verify(work).returncode == 0
     assert not list((work / "results").rglob(".*.part*")), "a temporary file of an interrupted write was left"
+
+
+def test_a_job_whose_snakemake_is_killed_stops_without_writing(built, reference, tmp_path_factory):
+    # issue 38 item 5: after `kill -9` of Snakemake alone, its running job used to finish and write
+    # its outputs later, unwarned; now it notices before writing and leaves nothing
+    work = clone(built, tmp_path_factory, "rel_orphan", results=False)
+    interrupt(work, "KILL-snakemake")
+    deadline = time.monotonic() + 300
+    while job_processes(work):
+        assert time.monotonic() < deadline, "the orphaned job never ended"
+        time.sleep(0.1)
+    shard = work / "results/intermittent/shards/monte_carlo_0.npz"
+    assert not shard.exists() and not (shard.parent / (shard.name + ".meta.json")).exists()
+    log = (work / "logs/intermittent/monte_carlo_0.log").read_text()
+    assert "the Snakemake process that started this job" in log and "stops without writing" in log, log[-2000:]
+    assert verify(work).returncode == 0
+    # the lock it left is a killed build's: `unlock` (the driver) proceeds, as no build of this checkout runs
+    unlock = subprocess.run([sys.executable, "-m", "netrepro", "unlock", "--", "--configfile", "config/rel.yaml"],
+                            cwd=work, capture_output=True, text=True, timeout=300, env=isolated_env(work))
+    assert unlock.returncode == 0, unlock.stdout + unlock.stderr
+    snakemake(work, "-j2", "--rerun-incomplete", *MC_TARGETS)
+    for path in MC_TABLES:
+        assert (work / path).read_bytes() == reference[path], f"{path} differs after the orphaned job"
 
 
 # ----------------------------------------------------------------------------- part 3: corrupted caches

@@ -55,6 +55,9 @@ REQUIRED_PACKAGES = (
 )
 # Distribution name -> import name, where they differ.
 IMPORT_NAMES = {"pyyaml": "yaml", "scikit-learn": "sklearn"}
+# packages imported (not only found) by the start-up check: the solvers the LMI steps name
+# (netrepro.engines.cvx.SOLVER), whose failure would otherwise surface inside the jobs
+IMPORTED_AT_START = ("clarabel",)
 # What each package is for, to make the message actionable.
 PURPOSE = {
     "cvxpy": "LMI feasibility problems",
@@ -127,6 +130,16 @@ def check_dependencies(requirements=None) -> list[str]:
             problems.append(f"required package '{dist}' is missing: cannot import '{module}'{why}; "
                             f"expected {text!r}")
             continue
+        if dist.lower() in IMPORTED_AT_START:
+            # a solver that is present but cannot load (a broken build, a missing shared library) would
+            # otherwise fail inside every LMI job with a traceback; importing it costs ~30 ms
+            try:
+                importlib.import_module(module)
+            except Exception as exc:  # noqa: BLE001 - any import failure is the message
+                problems.append(f"required package '{dist}'{why} is installed but cannot be imported: "
+                                f"{type(exc).__name__}: {exc}; reinstall it: "
+                                f"`{sys.executable} -m pip install --force-reinstall '{text}'`")
+                continue
         if spec is None or not str(spec):
             continue
         try:

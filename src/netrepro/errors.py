@@ -15,6 +15,7 @@ __all__ = [
     "CorruptOutputError",
     "LMIError",
     "ModelError",
+    "OrphanedJobError",
 ]
 
 
@@ -48,3 +49,7 @@ class LMIError(NetreproError, RuntimeError):
 
 class ModelError(NetreproError, RuntimeError):
     """A model's quantity does not exist for the given arguments (e.g. a filter below its attenuation level)."""
+
+
+class OrphanedJobError(NetreproError, RuntimeError):
+    """The Snakemake process that started a job is gone: the job stops without writing its outputs."""

@@ -491,11 +491,17 @@ def compare_figures(baseline: Baseline, figures_dir, rules: dict | None = None, 
             if ref_data is None:
                 d.problems.append(f"figures/{name}{SUFFIX}: the reference has no data sidecar")
             elif not sidecar.is_file():
-                d.problems.append(f"figures/{name}{SUFFIX}: missing (figures must be saved with "
-                                  "netrepro.plotting.save_figure)")
+                d.problems.append(f"figures/{name}{SUFFIX}: missing; `make repair` rebuilds it (or "
+                                  f"`snakemake --forcerun {name.replace('/', '_')}`)")
             else:
-                d.problems.extend(f"figures/{name}: {p}" for p in compare_figure_data(
-                    json.loads(ref_data), json.loads(sidecar.read_text()), rtol, atol, rules.get(name, ())))
+                try:
+                    drawn = json.loads(sidecar.read_text())
+                except ValueError as exc:
+                    d.problems.append(f"figures/{name}{SUFFIX}: not readable JSON ({exc}; truncated?); "
+                                      f"`make repair` rebuilds it (or `snakemake --forcerun {name.replace('/', '_')}`)")
+                else:
+                    d.problems.extend(f"figures/{name}: {p}" for p in compare_figure_data(
+                        json.loads(ref_data), drawn, rtol, atol, rules.get(name, ())))
             if ref_png is None:
                 d.problems.append(f"figures/{name}.png: the reference has no PNG")
             else:

@@ -352,7 +352,7 @@ def verify_output(output: str | Path) -> dict:
     if not output.is_file():
         raise CorruptOutputError(f"{output}: missing, but its sidecar {side.name} exists; rebuild it with snakemake")
     if not side.is_file():
-        raise CorruptOutputError(f"{output}: no provenance sidecar {side.name}; rebuild it with snakemake")
+        raise CorruptOutputError(f"{output}: no provenance sidecar {side.name}; `make repair` rebuilds it")
     try:
         meta = json.loads(side.read_text())
         if isinstance(meta, dict) and meta.get("unfinished"):
@@ -363,13 +363,13 @@ def verify_output(output: str | Path) -> dict:
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise CorruptOutputError(
             f"{output}: its provenance sidecar {side.name} is unreadable ({type(exc).__name__}: {exc}); "
-            f"delete both and rerun snakemake to rebuild them.") from None
+            f"`make repair` rebuilds both.") from None
     actual = sha256_file(output)
     if actual != recorded:
         raise CorruptOutputError(
             f"{output}: checksum {actual[:12]}… differs from the sidecar's "
             f"{str(recorded)[:12]}…; the file was truncated or edited. "
-            f"Delete it and rerun snakemake to rebuild it (or `python -m netrepro verify --remove-corrupt`)."
+            f"`make repair` rebuilds it and what depends on it."
         )
     return meta
 

@@ -39,7 +39,8 @@ import time
 import warnings
 from pathlib import Path
 
-from .errors import LMIError
+from .processes import process_alive, snakemake_ancestor
+from .errors import LMIError, OrphanedJobError
 from .io import write_table
 from .provenance import (PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, step_environment, verify_output,
                          verify_tree, write_sidecar, write_unfinished_sidecar)
@@ -106,7 +107,7 @@ def _check_inputs(inputs: dict) -> None:
         elif path.parts[:1] == ("results",) and path.is_file():
             raise CorruptOutputError(
                 f"{path}: no provenance sidecar {sidecar_path(path).name}, so its checksum cannot be verified "
-                "(written outside the pipeline, or by an interrupted job). Delete it and rerun snakemake.")
+                "(written outside the pipeline, or by an interrupted job). `make repair` rebuilds it.")
 
 
 def _described(outputs: dict) -> dict:
@@ -220,18 +221,31 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     outputs = {k: Path(v) for k, v in outputs.items()}
     _check_inputs(inputs)
     _clear_stale(outputs, rule)
+    starter = snakemake_ancestor()
     try:
-        _run_and_record(rule, func, func_spec, params, inputs, outputs)
-    except BaseException:
+        _run_and_record(rule, func, func_spec, params, inputs, outputs, starter)
+    except BaseException as exc:
         # a failed step leaves no sidecar (Snakemake deletes its outputs); a killed one cannot get
-        # here, and its outputs stay marked unfinished
+        # here, and its outputs stay marked unfinished. An orphaned job removes what it wrote itself:
+        # no Snakemake is left to do it
         for path in _described(outputs).values():
-            with contextlib.suppress(FileNotFoundError):
-                sidecar_path(path).unlink()
+            for leftover in (sidecar_path(path), path) if isinstance(exc, OrphanedJobError) else (sidecar_path(path),):
+                with contextlib.suppress(FileNotFoundError, IsADirectoryError):
+                    leftover.unlink()
         raise
 
 
-def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
+def _refuse_orphaned(rule: str, starter) -> None:
+    """Stop before writing when the Snakemake that started this job is gone (``kill -9``, a lost login node).
+
+    Nobody would delete what the job writes then, and a later build could take it for its own work.
+    """
+    if starter is not None and not process_alive(starter):
+        raise OrphanedJobError(f"rule {rule}: the Snakemake process that started this job (pid {starter[0]}) is "
+                               "gone, so the job stops without writing its outputs; rerun the build to resume")
+
+
+def _run_and_record(rule, func, func_spec, params, inputs, outputs, starter=None) -> None:
     """Run the step, write the tables it returns, then each output's sidecar (replacing its unfinished mark)."""
     import pandas as pd  # here, not at import: `verify` (before every notebook) needs no pandas
 
@@ -259,6 +273,7 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs) -> None:
                         "certificates, and points the certificates cannot decide are undecided", rule,
                         sum(unsure.values()), sum(statuses.values()),
                         ", ".join(f"{k}: {v}" for k, v in unsure.items()))
+    _refuse_orphaned(rule, starter)
     nonfinite = {}
     for name, value in result.items():
         if name not in outputs:
@@ -354,8 +369,8 @@ def verify_main(paths, inputs_only=False, remove_corrupt=False, quiet=False, str
     summary = ", ".join(f"{n} {status}" for status, n in sorted(counts.items())) or "nothing to check"
     print(f"verify: {len(verdicts)} files checked in {', '.join(map(str, paths))}: {summary}", file=stream)
     if bad and not remove_corrupt:
-        print("verify: FAILED. Rebuild with `python -m netrepro verify --remove-corrupt` then `snakemake`.",
-              file=stream)
+        print("verify: FAILED. Repair with `make repair` (removes what fails and rebuilds it, with what "
+              "depends on it).", file=stream)
     return 1 if bad and not remove_corrupt else 0
 
 

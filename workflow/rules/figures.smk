@@ -35,6 +35,8 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
                 step()
 
     _figures = [_spec.path for _spec in _specs]
+    # what each figure draws: read by `make check`; an input here so that a missing one is rebuilt
+    _figure_data = [f"figures/{_slug}/{_spec.figure_id}.data.json" for _spec in _specs]
     # the notebook and the report show the captions and the figure list's layout notes
     _captions = [f"workflow/report/{_slug}/{_spec.figure_id}.rst" for _spec in _specs]
     _figure_list = f"src/netrepro/papers/{_slug}/figures.yaml"
@@ -51,6 +53,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             notebook=f"workflow/notebooks/{_slug}.ipynb",
             code=code("netrepro.report.notebooks"),
             figures=_figures,
+            figure_data=_figure_data,
             tables=PAPER_TABLES[_slug],
             claims=_claims,
             errata=_errata,
