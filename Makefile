@@ -16,19 +16,27 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report repair unlock test test-fast lint lock bench verify clean clean-results readme check update-references
+.PHONY: venv-paths report repair unlock test test-fast lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/bootstrap.txt
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/default.txt
 	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
+	$(BIN)/python src/netrepro/venv_paths.py $(VENV)
 	$(BIN)/python -m ipykernel install --prefix $(VENV) --name python3 >/dev/null
 	touch $(STAMP)
 
 $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/test.txt
 	touch $(STAMP_TEST)
+
+# The environment moves with its checkout: its editable install names src/ by a relative path, and a
+# .venv/ moved or copied from another checkout is pointed at this one's src/ (said when it happens).
+# The tools are started through the environment's python, not their scripts, whose first line names
+# the interpreter by its absolute path at install time.
+venv-paths: $(STAMP)
+	@$(BIN)/python src/netrepro/venv_paths.py $(VENV)
 
 # Console: one line per finished job and the warnings (workflow/profiles/default); each job's
 # full command is in its log (logs/) and its provenance sidecar (*.meta.json).
@@ -49,50 +57,50 @@ BUILD = $(BIN)/python -m netrepro
 # Snakemake's own report is written by the run itself (--report-after-run): a second `snakemake --report`
 # parsed the workflow and built the DAG again (~1.3 s after every build), and the run's report overlaps the
 # wait for its last re-evaluation timer (max-jobs-per-timespan, workflow/profiles/default/config.yaml).
-report: $(STAMP)
+report: $(STAMP) venv-paths
 	$(BIN)/python -m compileall -q src
 	$(BUILD) build -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
 	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
 
 # A damaged build repaired in one command: removes every output `verify` finds corrupt, unfinished or
 # unverifiable, rebuilds those and every declared output that is missing, and what depends on them.
-repair: $(STAMP)
+repair: $(STAMP) venv-paths
 	$(BIN)/python -m compileall -q src
 	$(BUILD) repair -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
 	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
 
 # Removes the lock a killed build left (Snakemake's --unlock); refuses while a build of this checkout runs.
-unlock: $(STAMP)
+unlock: $(STAMP) venv-paths
 	$(BUILD) unlock -- $(SMK_OPTS)
 
-test: $(STAMP_TEST)
+test: $(STAMP_TEST) venv-paths
 	$(BIN)/python -m pytest -n 2 --dist loadgroup tests
 
 # The fast lane: every test that runs no Snakemake and no build (marked `slow`), with fewer
 # property-test examples (the hypothesis profile "fast", tests/conftest.py).
-test-fast: $(STAMP_TEST)
+test-fast: $(STAMP_TEST) venv-paths
 	$(BIN)/python -m pytest -n 2 -m "not slow" --hypothesis-profile fast tests
 
 # Check every result table against the checksum in its provenance sidecar.
-verify: $(STAMP)
+verify: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro verify
 
-lint: $(STAMP_TEST)
-	$(BIN)/snakefmt --check Snakefile workflow
-	$(BIN)/snakemake --lint
+lint: $(STAMP_TEST) venv-paths
+	$(BIN)/python -m snakefmt --check Snakefile workflow
+	$(BIN)/python -m snakemake --lint
 	$(BIN)/python -m netrepro check-paper
-	$(BIN)/actionlint .github/workflows/regenerate.yml
+	$(BIN)/python $(BIN)/actionlint .github/workflows/regenerate.yml
 
 # What CI runs after its build (after `make report`): every table against the checksum in its
 # provenance sidecar, then tables and figures against the committed references; on a difference
 # it fails and writes results/regeneration/index.html (README: "Checking that figures regenerate").
-check: $(STAMP)
+check: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro verify
 	$(BIN)/python -m netrepro.regression compare --reference tests/reference --results results
 
 # An intended change: the last build becomes the reference (tables into tests/reference/; the
 # figures and their data sidecars are already in figures/). Prints what changed; then commit both.
-update-references: $(STAMP)
+update-references: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
@@ -104,12 +112,12 @@ lock: $(STAMP)
 	$(BIN)/python -m netrepro.lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
 
 # Rewrite the results table of README.md from the claims, errata and figures of the last build.
-readme: $(STAMP)
+readme: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro.readme README.md
 
 # Benchmarks with ratios against simple references (issue 9); `make bench BENCH_ARGS=--quick` skips the pipeline.
 BENCH_ARGS ?=
-bench: $(STAMP)
+bench: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro.bench --out results/benchmarks.csv $(BENCH_ARGS)
 
 # Everything the pipeline makes: tables, logs, figures (committed, but rebuilt), the report and

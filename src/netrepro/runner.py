@@ -222,8 +222,9 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     _check_inputs(inputs)
     _clear_stale(outputs, rule)
     starter = snakemake_ancestor()
+    package = _own_package()
     try:
-        _run_and_record(rule, func, func_spec, params, inputs, outputs, starter)
+        _run_and_record(rule, func, func_spec, params, inputs, outputs, starter, package)
     except BaseException as exc:
         # a failed step leaves no sidecar (Snakemake deletes its outputs); a killed one cannot get
         # here, and its outputs stay marked unfinished. An orphaned job removes what it wrote itself:
@@ -233,6 +234,21 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
                 with contextlib.suppress(FileNotFoundError, IsADirectoryError):
                     leftover.unlink()
         raise
+
+
+def _own_package(cwd: Path | None = None) -> str:
+    """The resolved directory of the imported netrepro package, refused when the job's checkout has its own.
+
+    A ``.venv/`` moved or copied from another checkout imported that checkout's code, while the
+    provenance recorded this checkout's files (issue 40); ``make`` repoints it (src/netrepro/venv_paths.py).
+    """
+    imported = Path(__file__).resolve().parent
+    own = (cwd or Path.cwd()).resolve() / "src" / "netrepro"
+    if own.is_dir() and own != imported:
+        raise ImportError(f"this job imported netrepro from {imported}, not from its own checkout's {own}: the "
+                          "environment belongs to another checkout. Run `make` (it repoints .venv/ at this "
+                          "checkout), or set PYTHONPATH to this checkout's src/")
+    return str(imported)
 
 
 def _refuse_orphaned(rule: str, starter) -> None:
@@ -245,7 +261,7 @@ def _refuse_orphaned(rule: str, starter) -> None:
                                "gone, so the job stops without writing its outputs; rerun the build to resume")
 
 
-def _run_and_record(rule, func, func_spec, params, inputs, outputs, starter=None) -> None:
+def _run_and_record(rule, func, func_spec, params, inputs, outputs, starter=None, package=None) -> None:
     """Run the step, write the tables it returns, then each output's sidecar (replacing its unfinished mark)."""
     import pandas as pd  # here, not at import: `verify` (before every notebook) needs no pandas
 
@@ -265,6 +281,7 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs, starter=None
                     item["count"])
     if summary:
         extra.setdefault("warnings", summary)
+
     if statuses:
         extra.setdefault("solver_statuses", statuses)
         unsure = {k: v for k, v in statuses.items() if k != "optimal"}
@@ -302,7 +319,8 @@ def _run_and_record(rule, func, func_spec, params, inputs, outputs, starter=None
         inputs=flat_inputs,
         wall_time_s=elapsed,
         extra=extra,
-        environment=step_environment(flat_inputs),
+        # where the code came from: a job refuses another checkout's package (_own_package), and says which it ran
+        environment={**step_environment(flat_inputs), **({"package_path": package} if package else {})},
     )
     for name, path in outputs.items():
         if not path.exists():

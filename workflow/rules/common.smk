@@ -18,6 +18,7 @@ try:
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
+    from netrepro.venv_paths import interpreter
     from netrepro.paperdata import (
         DATA_FILES,
         LOCK_FILE,
@@ -44,7 +45,8 @@ try:
 except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
 
-PYTHON = sys.executable
+# relative to the checkout when the interpreter lies inside it (.venv/bin/python): a moved checkout reruns nothing
+PYTHON = interpreter()
 # Filled by each paper's .smk: slug -> list of its result tables (shown by its notebook).
 PAPER_TABLES = {}
 # Filled by figures.smk: slug -> dict(figures=[...], tables=[...], claims=..., errata=...,
