@@ -92,8 +92,13 @@ check: $(STAMP)
 
 # An intended change: the last build becomes the reference (tables into tests/reference/; the
 # figures and their data sidecars are already in figures/). Prints what changed; then commit both.
+# `make update-references PAPER=markov` (or PAPER='markov hinf'): only those papers' tables (their folder and
+# their rows of the shared claims/, errata/, findings/, evidence/, reconstructions/); every other reference
+# stays byte-identical. Timing columns (netrepro.regression.TIMING_COLUMNS) are never copied.
+PAPER ?=
 update-references: $(STAMP)
-	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results
+	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results \
+		$(foreach p,$(PAPER),--paper $(p))
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
 lock: $(STAMP)
