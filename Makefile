@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: report repair unlock test test-fast lint lock bench verify clean clean-results readme check update-references
+.PHONY: report repair unlock prune test test-fast lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -86,9 +86,19 @@ lint: $(STAMP_TEST)
 # What CI runs after its build (after `make report`): every table against the checksum in its
 # provenance sidecar, then tables and figures against the committed references; on a difference
 # it fails and writes results/regeneration/index.html (README: "Checking that figures regenerate").
+# Then the stale outputs (files in results/ and figures/ no rule of this workflow produces, with the
+# same CONFIG/PROFILE as the build): listed with `make prune`, and they fail the check, since a stale
+# table could be frozen into the references by `make update-references`.
 check: $(STAMP)
 	$(BIN)/python -m netrepro verify
-	$(BIN)/python -m netrepro.regression compare --reference tests/reference --results results
+	status=0; $(BIN)/python -m netrepro.regression compare --reference tests/reference --results results \
+		|| status=$$?; $(BIN)/python -m netrepro prune --check -- $(SMK_OPTS) || status=1; exit $$status
+
+# Removes the stale outputs (netrepro.stale): files in results/ and figures/ that no rule of the current
+# workflow produces (a renamed or removed step's), with their sidecars; `make prune PRUNE_ARGS=--dry-run` lists them.
+PRUNE_ARGS ?=
+prune: $(STAMP)
+	$(BIN)/python -m netrepro prune $(PRUNE_ARGS) -- $(SMK_OPTS)
 
 # An intended change: the last build becomes the reference (tables into tests/reference/; the
 # figures and their data sidecars are already in figures/). Prints what changed; then commit both.
