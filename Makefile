@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: venv-paths report repair unlock test test-fast lint lock bench verify clean clean-results readme check update-references
+.PHONY: venv-paths report repair unlock prune test test-fast lint lock bench verify clean clean-results readme check update-references
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -94,14 +94,29 @@ lint: $(STAMP_TEST) venv-paths
 # What CI runs after its build (after `make report`): every table against the checksum in its
 # provenance sidecar, then tables and figures against the committed references; on a difference
 # it fails and writes results/regeneration/index.html (README: "Checking that figures regenerate").
+# Then the stale outputs (files in results/ and figures/ no rule of this workflow produces, with the
+# same CONFIG/PROFILE as the build): listed with `make prune`, and they fail the check, since a stale
+# table could be frozen into the references by `make update-references`.
 check: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro verify
-	$(BIN)/python -m netrepro.regression compare --reference tests/reference --results results
+	status=0; $(BIN)/python -m netrepro.regression compare --reference tests/reference --results results \
+		|| status=$$?; $(BIN)/python -m netrepro prune --check -- $(SMK_OPTS) || status=1; exit $$status
+
+# Removes the stale outputs (netrepro.stale): files in results/ and figures/ that no rule of the current
+# workflow produces (a renamed or removed step's), with their sidecars; `make prune PRUNE_ARGS=--dry-run` lists them.
+PRUNE_ARGS ?=
+prune: $(STAMP) venv-paths
+	$(BIN)/python -m netrepro prune $(PRUNE_ARGS) -- $(SMK_OPTS)
 
 # An intended change: the last build becomes the reference (tables into tests/reference/; the
 # figures and their data sidecars are already in figures/). Prints what changed; then commit both.
+# `make update-references PAPER=markov` (or PAPER='markov hinf'): only those papers' tables (their folder and
+# their rows of the shared claims/, errata/, findings/, evidence/, reconstructions/); every other reference
+# stays byte-identical. Timing columns (netrepro.regression.TIMING_COLUMNS) are never copied.
+PAPER ?=
 update-references: $(STAMP) venv-paths
-	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results
+	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results \
+		$(foreach p,$(PAPER),--paper $(p))
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
 lock: $(STAMP)

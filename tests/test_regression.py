@@ -173,3 +173,74 @@ def test_compare_with_no_page_deletes_nothing_in_the_working_directory(tmp_path,
     monkeypatch.chdir(tmp_path)
     main(["compare", "--reference", "ref", "--results", "res", "--figures", "", "--html", "", "--platform-rules", ""])
     assert (tmp_path / "precious.txt").read_text() == "keep me"
+
+
+def _two_papers(root):
+    """A results tree and a reference tree of papers a and b: own tables and shared per-paper tables."""
+    for side, value in (("ref", 1.0), ("res", 2.0)):
+        for paper in ("a", "b"):
+            for rel in (f"{paper}/t.csv", f"{paper}/sim/u.csv", f"claims/{paper}.csv", f"errata/{paper}.csv",
+                        f"findings/{paper}.csv", f"evidence/{paper}.csv", f"reconstructions/{paper}.csv"):
+                path = root / side / rel
+                path.parent.mkdir(parents=True, exist_ok=True)
+                pd.DataFrame({"x": [value], "wall_time_s": [value * 7]}).to_csv(path, index=False)
+    return root / "ref", root / "res"
+
+
+def test_update_of_one_paper_leaves_every_other_reference_byte_identical(tmp_path, capsys):
+    """Issue 40 A: `make update-references PAPER=a` touches a's tables (own and shared) only."""
+    from netrepro.regression import main, paper_of
+
+    ref, res = _two_papers(tmp_path)
+    (res / "a" / "new.csv").write_text("x\n3\n")
+    (res / "b" / "new.csv").write_text("x\n3\n")
+    (ref / "a" / "gone.csv").write_text("x\n1\n")
+    (ref / "b" / "gone.csv").write_text("x\n1\n")
+    before = {p: p.read_bytes() for p in ref.rglob("*") if p.is_file()}
+    args = ["--reference", str(ref), "--results", str(res), "--figures", "", "--platform-rules", ""]
+    assert main(["update", *args, "--paper", "a"]) == 0
+    out = capsys.readouterr().out
+    assert "/a/" in out and "claims/a.csv" in out and "/b/" not in out and "b.csv" not in out
+    for path, data in before.items():
+        if paper_of(path.relative_to(ref)) == "b":
+            assert path.read_bytes() == data, path
+    assert not (ref / "b" / "new.csv").exists() and (ref / "b" / "gone.csv").exists()
+    assert (ref / "a" / "new.csv").exists() and not (ref / "a" / "gone.csv").exists()
+    for rel in ("a/t.csv", "a/sim/u.csv", "claims/a.csv", "errata/a.csv", "findings/a.csv", "evidence/a.csv",
+                "reconstructions/a.csv"):
+        assert (ref / rel).read_text() == "x\n2.0\n", rel  # copied, without the timing column
+    assert main(["update", *args, "--paper", "a", "--paper", "b"]) == 0
+    assert main(["compare", *args, "--html", ""]) == 0
+    assert main(["update", *args, "--paper", "nosuch"]) == 2
+    assert "nosuch" in capsys.readouterr().err
+
+
+def test_a_timing_column_difference_is_not_reported_and_not_copied(tmp_path):
+    """Issue 40 A: measured times are no part of a reference (TIMING_COLUMNS, one list)."""
+    from netrepro.regression import is_timing_column, update_tables
+
+    timings = ["wall_time_s", "solve_time_s", "total_time_s", "seconds", "solves_per_second", "elapsed",
+               "elapsed_s", "build_seconds", "extrapolated_1000_s", "fit_exponent"]
+    assert all(is_timing_column(c) for c in timings)
+    assert not any(is_timing_column(c) for c in ("t", "time_constant_steps", "n_steps", "x", "note"))
+    columns = {"x": [1.0, 2.0], "s": ["a", "b,c"], **{c: [0.1, 0.2] for c in timings}}
+    ref, got = _pair(tmp_path, pd.DataFrame(columns), pd.DataFrame({**columns, **{c: [9.0, 8.0] for c in timings}}))
+    assert compare_tables(ref, got) == []
+    assert compare_trees(tmp_path / "ref", tmp_path / "res") == (1, [])
+    assert update_tables(tmp_path / "ref", tmp_path / "res") == [f"table changed: {ref}"]
+    assert ref.read_text() == 'x,s\n1.0,a\n2.0,"b,c"\n'
+    assert compare_trees(tmp_path / "ref", tmp_path / "res") == (1, [])  # result with timings vs reference without
+    assert update_tables(tmp_path / "ref", tmp_path / "res") == []  # a rerun with other times changes nothing
+    pd.DataFrame({**columns, "x": [1.0, 2.5]}).to_csv(got, index=False)
+    assert "column 'x' differs" in compare_tables(ref, got)[0]
+
+
+def test_no_committed_reference_has_a_timing_column():
+    from pathlib import Path
+
+    from netrepro.regression import _reference_tables, is_timing_column
+
+    reference = Path(__file__).parent / "reference"
+    found = [(t.relative_to(reference).as_posix(), c) for t in _reference_tables(reference)
+             for c in pd.read_csv(t, nrows=0).columns if is_timing_column(c)]
+    assert found == [], found

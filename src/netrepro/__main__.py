@@ -1,6 +1,7 @@
 """``python -m netrepro``: the pipeline runner's command line (:func:`netrepro.runner.main`), and the
 commands for people (:mod:`netrepro.commands`: new-paper, check-paper, register-findings, diff, scale-record, scaling),
-and the build driver behind ``make report``/``repair``/``unlock`` (:mod:`netrepro.build`)."""
+the build driver behind ``make report``/``repair``/``unlock`` (:mod:`netrepro.build`), and ``prune``
+(:mod:`netrepro.stale`: the outputs no rule produces any more, ``make prune``)."""
 
 import sys
 
@@ -11,6 +12,11 @@ if sys.argv[1:2] and sys.argv[1] in ("build", "repair", "unlock"):
     from .build import main as build_main
 
     sys.exit(build_main(sys.argv[1:]))
+if sys.argv[1:2] == ["prune"]:
+    # like the build driver, it runs Snakemake and imports nothing of the pipeline
+    from .stale import main as prune_main
+
+    sys.exit(prune_main(sys.argv[1:]))
 
 from .runner import exit_process, main  # noqa: E402 - after the build driver's early exit
 

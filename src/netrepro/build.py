@@ -26,7 +26,7 @@ from pathlib import Path
 
 from .processes import RunningBuild, running_builds
 
-__all__ = ["damaged_outputs", "missing_outputs", "main"]
+__all__ = ["damaged_outputs", "missing_outputs", "main", "summary_rows"]
 
 INTERRUPTED = 130  # the shell's exit status after SIGINT
 # verify's statuses that mean "this output cannot be trusted or is gone" (netrepro.provenance.verify_tree)
@@ -74,8 +74,8 @@ def damaged_outputs(paths=("results", "figures"), stream=None) -> list[Path]:
     return targets
 
 
-def missing_outputs(snakemake: list[str], options: list[str]) -> list[Path]:
-    """The declared outputs of the report's jobs that do not exist (``snakemake report --summary``).
+def summary_rows(snakemake: list[str], options: list[str]) -> list[list[str]]:
+    """``snakemake report --summary``: one row of fields per declared output of the report's jobs.
 
     Parameters
     ----------
@@ -86,7 +86,8 @@ def missing_outputs(snakemake: list[str], options: list[str]) -> list[Path]:
 
     Returns
     -------
-    list of Path
+    list of list of str
+        The rows without the header: output path, date, rule, log files, status, plan.
 
     Raises
     ------
@@ -108,12 +109,30 @@ def missing_outputs(snakemake: list[str], options: list[str]) -> list[Path]:
     proc = subprocess.run([*snakemake, "report", "--summary", *kept], capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"`snakemake --summary` failed:\n{proc.stderr[-3000:]}")
-    missing = []
-    for line in proc.stdout.splitlines()[1:]:
-        fields = line.split("\t")
-        if len(fields) >= 5 and fields[4].strip() == "missing":
-            missing.append(Path(fields[0]))
-    return missing
+    return [line.split("\t") for line in proc.stdout.splitlines()[1:] if line.strip()]
+
+
+def missing_outputs(snakemake: list[str], options: list[str]) -> list[Path]:
+    """The declared outputs of the report's jobs that do not exist (``snakemake report --summary``).
+
+    Parameters
+    ----------
+    snakemake : list of str
+        The command that starts Snakemake.
+    options : list of str
+        The build's options (configuration, profile); report options are left out.
+
+    Returns
+    -------
+    list of Path
+
+    Raises
+    ------
+    RuntimeError
+        If Snakemake cannot list the outputs (its message included).
+    """
+    return [Path(fields[0]) for fields in summary_rows(snakemake, options)
+            if len(fields) >= 5 and fields[4].strip() == "missing"]
 
 
 def _run(command: list[str], make_target: str) -> int:

@@ -8,9 +8,12 @@ pixels); on any difference it writes ``results/regeneration/index.html``. String
 columns exactly, numeric columns within ``rtol``/``atol`` (seeds are fixed, so
 differences only come from floating-point details of the platform).
 ``python -m netrepro.regression update`` refreshes the reference tables from ``results/`` and
-prints what changed (the figures' references are the committed files under ``figures/``).
-Measured times (columns named like ``*time*``, ``seconds``, ...) and the free-text
-``note`` of claims tables are not compared. Numbers printed inside text are compared
+prints what changed (the figures' references are the committed files under ``figures/``);
+``--paper SLUG`` (repeatable; ``make update-references PAPER=slug``) touches only that paper's
+tables: ``<slug>/...`` and the shared ``claims/<slug>.csv``, ``errata/<slug>.csv``, ... .
+Measured times (the columns :data:`TIMING_COLUMNS` names, e.g. ``solve_time_s``, ``seconds``)
+are no part of any reference: ``update`` does not copy them and ``compare`` ignores them; the
+free-text ``note`` of claims tables is copied but not compared. Numbers printed inside text are compared
 with the numeric tolerance, the words exactly. The few values that legitimately
 differ between CPUs (a solver point that is not unique, an unconverged iterative
 solver, certificate margins at the solver's accuracy) are listed, with their reason
@@ -20,6 +23,8 @@ and the weaker check they get, in ``tests/platform_dependent.yaml``.
 from __future__ import annotations
 
 import argparse
+import csv
+import fnmatch
 import re
 import sys
 import time
@@ -29,12 +34,17 @@ import numpy as np
 import pandas as pd
 import yaml
 
-__all__ = ["compare_tables", "compare_trees", "load_platform_rules", "main"]
+__all__ = ["TIMING_COLUMNS", "compare_tables", "compare_trees", "is_timing_column", "load_platform_rules", "main",
+           "paper_of", "update_tables"]
 
 RTOL = 1e-6
 ATOL = 1e-9
-# measured times are not reproducible values; claim notes may quote them
-VOLATILE_COLUMNS = re.compile(r"time|seconds|per_second|extrapolated|fit_exponent", re.I)
+# Columns that hold measured times, or numbers derived from them alone (shell patterns, case-insensitive): they
+# differ run to run, so they are no part of any reference: `update` does not copy them, `compare` ignores them.
+# The one list (tests/test_regression.py checks that no committed reference has such a column). A simulated
+# time (a trajectory's `t`, `time_constant_steps`) is a reproducible value and is compared.
+TIMING_COLUMNS = ("*_time_s", "wall_time*", "elapsed*", "*_elapsed*", "seconds", "*_seconds",
+                  "*per_second", "extrapolated_*_s", "fit_exponent")
 # where the figures' references live in the repository (their committed versions: --figure-reference git:REV)
 FIGURES = Path("figures")
 PLATFORM_RULES = Path(__file__).resolve().parents[2] / "tests" / "platform_dependent.yaml"
@@ -43,8 +53,44 @@ CHECKS = ("sign", "text", "finite", "info")
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
+def is_timing_column(column: str) -> bool:
+    """Whether ``column`` holds a measured time (:data:`TIMING_COLUMNS`, case-insensitive).
+
+    Parameters
+    ----------
+    column : str
+        A table's column name.
+
+    Returns
+    -------
+    bool
+        True for a timing column (no part of any reference).
+    """
+    return any(fnmatch.fnmatchcase(str(column).lower(), pattern) for pattern in TIMING_COLUMNS)
+
+
 def _volatile(path: Path, column: str) -> bool:
-    return bool(VOLATILE_COLUMNS.search(column)) or (path.parent.name == "claims" and column == "note")
+    """Compared by no check: measured times; the claims tables' notes (they may quote times)."""
+    return is_timing_column(column) or (path.parent.name == "claims" and column == "note")
+
+
+def _without_timings(data: bytes) -> bytes:
+    """A CSV table's bytes without its timing columns (unchanged, byte for byte, when it has none)."""
+    text = data.decode()
+    rows = list(csv.reader(text.splitlines(keepends=True)))
+    if not rows or not any(is_timing_column(c) for c in rows[0]):
+        return data
+    keep = [i for i, c in enumerate(rows[0]) if not is_timing_column(c)]
+    out = _Lines()  # not io.StringIO: `import io` would read as netrepro.io to the byte-code test of codedeps
+    writer = csv.writer(out, lineterminator="\r\n" if "\r\n" in text else "\n")
+    writer.writerows([row[i] for i in keep if i < len(row)] for row in rows)
+    return "".join(out).encode()
+
+
+class _Lines(list):
+    """A list that csv.writer can write to."""
+
+    write = list.append
 
 
 def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, list[dict]]:
@@ -133,8 +179,8 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
 
     Numeric columns agree where ``numpy.isclose(result, reference, rtol, atol)`` (NaN equals
     NaN, equal infinities agree); text cells where their words are the same and their numbers
-    agree by the same rule. Measured-time columns (``VOLATILE_COLUMNS``) and the claims tables'
-    ``note`` are skipped.
+    agree by the same rule. Measured-time columns (:data:`TIMING_COLUMNS`) are left out of both
+    tables (a reference has none); the claims tables' ``note`` is skipped.
 
     Parameters
     ----------
@@ -161,6 +207,8 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
         If a rule names a column the table lacks.
     """
     ref, got = pd.read_csv(reference), pd.read_csv(result)
+    ref = ref[[c for c in ref.columns if not is_timing_column(c)]]  # no part of a reference (older ones had them)
+    got = got[[c for c in got.columns if not is_timing_column(c)]]
     problems = []
     if list(ref.columns) != list(got.columns):
         return [f"{result}: columns {list(got.columns)} differ from reference {list(ref.columns)}"]
@@ -197,6 +245,10 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
 # results/scale/: the comparison with the recorded paper-scale run (its staleness follows every code
 # edit, and its verdicts are the claims tables, which have references of their own)
 _UNCHECKED_RESULT_DIRS = ("shards", "scale", "regeneration")
+# the folders of tables with one file per paper (results/claims/<slug>.csv, ...)
+SHARED_TABLE_DIRS = ("claims", "errata", "evidence", "findings", "reconstructions")
+
+
 # tests/reference/paper-scale/: a recorded run at another configuration (netrepro.scale), not a reference
 _RECORDED_RUNS = ("paper-scale",)
 
@@ -274,14 +326,73 @@ def compare_trees(reference_dir: Path, results_dir: Path, platform_rules=None, d
     return count, problems
 
 
-def _update_tables(reference: Path, results: Path) -> list[str]:
-    """Replace the reference tables by the result tables; returns what changed (added, removed, changed)."""
-    old = {p.relative_to(reference).as_posix(): p.read_bytes() for p in _reference_tables(reference)} \
-        if reference.is_dir() else {}
-    new = {t.relative_to(results).as_posix(): t.read_bytes() for t in _result_tables(results)}
-    for rel in old:  # the recorded runs of other configurations (tests/reference/paper-scale/) stay
+def paper_of(rel) -> str | None:
+    """The paper a table belongs to, from its path relative to the results (or reference) folder.
+
+    ``<slug>/...`` is the paper's own table; ``claims/<slug>.csv`` (and ``errata/``, ``findings/``,
+    ``evidence/``, ``reconstructions/``) a shared table's part for that paper.
+
+    Parameters
+    ----------
+    rel : str or PurePath
+        The table's relative path.
+
+    Returns
+    -------
+    str or None
+        The slug; None for a table at the top of the folder.
+    """
+    parts = Path(rel).parts
+    if len(parts) < 2:
+        return None
+    return Path(parts[1]).stem if len(parts) == 2 and parts[0] in SHARED_TABLE_DIRS else parts[0]
+
+
+def update_tables(reference: Path, results: Path, papers=None) -> list[str]:
+    """Replace the reference tables by the result tables; returns what changed (added, removed, changed).
+
+    Timing columns (:data:`TIMING_COLUMNS`) are not copied. The recorded runs of other configurations
+    (``tests/reference/paper-scale/``) stay.
+
+    Parameters
+    ----------
+    reference : Path
+        The reference folder (``tests/reference``).
+    results : Path
+        The build's tables (``results``).
+    papers : sequence of str, optional
+        Only these papers' tables (:func:`paper_of`) are written or removed; every other file stays
+        byte-identical. None: every table.
+
+    Returns
+    -------
+    list of str
+        One line per table added, removed or changed.
+
+    Raises
+    ------
+    ValueError
+        If a paper has no table in either folder (a misspelt slug).
+    """
+    reference, results = Path(reference), Path(results)
+    old_tables = _reference_tables(reference) if reference.is_dir() else []
+    new_tables = _result_tables(results) if results.is_dir() else []
+    if papers is not None:
+        known = {paper_of(p.relative_to(reference)) for p in old_tables} | \
+                {paper_of(t.relative_to(results)) for t in new_tables}
+        unknown = sorted(set(papers) - known)
+        if unknown:
+            raise ValueError(f"no tables of paper {', '.join(unknown)} in {results} or {reference}; "
+                             f"papers: {', '.join(sorted(p for p in known if p))}")
+        old_tables = [p for p in old_tables if paper_of(p.relative_to(reference)) in papers]
+        new_tables = [t for t in new_tables if paper_of(t.relative_to(results)) in papers]
+    old = {p.relative_to(reference).as_posix(): p.read_bytes() for p in old_tables}
+    new = {t.relative_to(results).as_posix(): _without_timings(t.read_bytes()) for t in new_tables}
+    for rel in set(old) - set(new):
         (reference / rel).unlink()
     for rel, data in new.items():
+        if old.get(rel) == data:
+            continue
         target = reference / rel
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_bytes(data)
@@ -314,21 +425,30 @@ def main(argv=None) -> int:
                         help="the figures' references: git:REV (committed files under figures/) or a folder")
     parser.add_argument("--html", default="results/regeneration/index.html",
                         help="the difference page, written when anything differs")
+    parser.add_argument("--paper", action="append", default=None, metavar="SLUG",
+                        help="update: only this paper's tables (repeatable; default every paper)")
     args = parser.parse_args(argv)
     if args.command == "update":
-        changes = _update_tables(Path(args.reference), Path(args.results))
+        try:
+            changes = update_tables(Path(args.reference), Path(args.results), papers=args.paper)
+        except ValueError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
         if args.figures:
             from .figurecheck import compare_figures, open_baseline
 
             _, diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures)
             for d in diffs:
+                if args.paper and d.name.split("/")[0] not in args.paper:
+                    continue
                 changes.append(f"figure changed: figures/{d.name}.png (and its .data.json): " + "; ".join(
                     (d.problems + d.notes)[:2]))
             if args.figure_reference.startswith("git:"):
                 changes.append("figure references are the files under figures/: commit them with the tables")
         for line in changes or ["nothing changed"]:
             print(line)
-        print(f"reference tables written to {args.reference}")
+        print(f"reference tables written to {args.reference}"
+              + (f" (papers {', '.join(args.paper)} only)" if args.paper else ""))
         return 0
     start = time.perf_counter()
     if args.html:  # a page from an earlier run would describe differences that may be gone
