@@ -58,6 +58,17 @@ def test_the_package_schemas_are_the_workflow_schemas_in_a_checkout():
     assert (PACKAGE / "py.typed").is_file()
 
 
+def test_a_clone_without_symbolic_links_reads_the_workflow_schemas(tmp_path, monkeypatch):
+    package = tmp_path / "site-packages" / "netrepro"
+    package.mkdir(parents=True)
+    (package / "schemas").write_text("../../workflow/schemas")  # what git writes where links are off
+    monkeypatch.setattr(locations, "package_root", lambda: package)
+    monkeypatch.chdir(ROOT / "workflow")
+    assert locations._schema_dir() == ROOT / "workflow" / "schemas"
+    monkeypatch.chdir(tmp_path)
+    assert locations._schema_dir() == package / "schemas"  # nothing better: loading names the missing file
+
+
 def test_a_checkout_is_known_by_its_top_level_files(tmp_path):
     assert locations.is_checkout(ROOT) and not locations.is_checkout(tmp_path)
     for marker in ("pyproject.toml", "Snakefile", "workflow/rules"):

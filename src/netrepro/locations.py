@@ -15,7 +15,8 @@ Two kinds of files, found in two ways:
 
 In a clone, ``src/netrepro/schemas`` is a symbolic link to ``workflow/schemas``: the
 workflow reads its schemas where they have always been (``workflow/rules/common.smk``), and
-the wheel holds a copy of them as package data (the build follows the link).
+the wheel holds a copy of them as package data (the build follows the link). A clone made
+without symbolic links (the link is then a small text file) reads ``workflow/schemas`` directly.
 """
 
 from __future__ import annotations
@@ -66,13 +67,6 @@ def package_file(*parts: str) -> Path:
         The path (whether or not it exists).
     """
     return package_root().joinpath(*parts)
-
-
-# the configuration schemas (config.schema.yaml and one per paper) and the papers' data schemas
-SCHEMA_DIR = package_file("schemas")
-PAPER_SCHEMA_DIR = SCHEMA_DIR / "paper"
-# one package (or module) per paper; a package holds the paper's data files
-PAPERS_DIR = package_file("papers")
 
 
 def is_checkout(path: str | Path) -> bool:
@@ -132,3 +126,19 @@ def checkout_file(*parts: str) -> Path:
     """
     root = checkout_root()
     return (root if root is not None else Path()).joinpath(*parts)
+
+
+def _schema_dir() -> Path:
+    packaged = package_file("schemas")
+    if packaged.is_dir():
+        return packaged
+    # a clone made without symbolic links (git on Windows without core.symlinks) has the link as a text file
+    root = checkout_root()
+    return root / "workflow" / "schemas" if root is not None else packaged
+
+
+# the configuration schemas (config.schema.yaml and one per paper) and the papers' data schemas
+SCHEMA_DIR = _schema_dir()
+PAPER_SCHEMA_DIR = SCHEMA_DIR / "paper"
+# one package (or module) per paper; a package holds the paper's data files
+PAPERS_DIR = package_file("papers")
