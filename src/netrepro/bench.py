@@ -86,6 +86,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .locations import checkout_file, checkout_root
+
 __all__ = [
     "COLUMNS",
     "BenchRow",
@@ -105,7 +107,8 @@ __all__ = [
 ]
 
 COLUMNS = ["benchmark", "metric", "ours", "reference", "ratio", "unit"]
-ROOT = Path(__file__).resolve().parents[2]
+# the clone whose sources the pipeline benchmark copies and runs (benchmarks need a clone)
+ROOT = checkout_root() or Path.cwd()
 
 
 def BenchRow(benchmark, metric, ours, reference, ratio, unit) -> dict:  # noqa: N802 (a row constructor)
@@ -318,7 +321,7 @@ def _configured(slug: str) -> dict:
     """The paper's section of the full configuration (the benchmarks run the configured problem)."""
     import yaml
 
-    return yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())[slug]
+    return yaml.safe_load(checkout_file("config", "config.yaml").read_text())[slug]
 
 
 def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ConfigError, DependencyError
+from .locations import PAPERS_DIR, SCHEMA_DIR
 
 __all__ = [
     "ConfigError",
@@ -45,8 +46,6 @@ __all__ = [
     "require_matrix",
     "require_pd",
 ]
-
-SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 
 # Used when the distribution metadata is unavailable (e.g. running from a source tree).
 REQUIRED_PACKAGES = (
@@ -183,7 +182,8 @@ def load_schemas(schema_dir: Path = SCHEMA_DIR):
     Parameters
     ----------
     schema_dir : pathlib.Path
-        The folder of the schemas (``workflow/schemas`` of this checkout by default).
+        The folder of the schemas (by default the package's own, :data:`netrepro.locations.SCHEMA_DIR`:
+        ``workflow/schemas`` in a clone, a copy of it in an installed wheel).
 
     Returns
     -------
@@ -408,7 +408,7 @@ def validate_config(config: dict, schema_dir: Path = SCHEMA_DIR) -> dict:
         raise ConfigError("invalid configuration:\n  " + "\n  ".join(problems))
     for slug in papers:
         # a paper package keeps its configuration checks in `checks.py`, light to import at start-up
-        is_package = (Path(__file__).resolve().parent / "papers" / str(slug) / "__init__.py").is_file()
+        is_package = (PAPERS_DIR / str(slug) / "__init__.py").is_file()
         module_name = f"netrepro.papers.{slug}.checks" if is_package else f"netrepro.papers.{slug}"
         try:
             module = importlib.import_module(module_name)

@@ -60,6 +60,7 @@ import yaml
 
 from .errors import ConfigError
 from .io import load_yaml
+from .locations import PAPER_SCHEMA_DIR, PAPERS_DIR
 
 __all__ = [
     "KINDS",
@@ -120,8 +121,8 @@ DATA_FILES = ("claims", "errata", "reconstructions", "findings")
 CAUSAL_WORDING = re.compile(
     r"\b(because|due to|caused by|causes?|causing|owing to|explains?|explained by|comes? from|is why|"
     r"the reason|attributed to|responsible for)\b", re.IGNORECASE)
-_SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "paper"
-_PAPERS_DIR = Path(__file__).resolve().parent / "papers"
+_SCHEMA_DIR = PAPER_SCHEMA_DIR
+_PAPERS_DIR = PAPERS_DIR
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from .locations import checkout_file
+
 __all__ = ["TIMING_COLUMNS", "compare_tables", "compare_trees", "is_timing_column", "load_platform_rules", "main",
            "paper_of", "update_tables"]
 
@@ -47,7 +49,8 @@ TIMING_COLUMNS = ("*_time_s", "wall_time*", "elapsed*", "*_elapsed*", "seconds",
                   "*per_second", "extrapolated_*_s", "fit_exponent")
 # where the figures' references live in the repository (their committed versions: --figure-reference git:REV)
 FIGURES = Path("figures")
-PLATFORM_RULES = Path(__file__).resolve().parents[2] / "tests" / "platform_dependent.yaml"
+# a file of the clone (not shipped in the wheel): outside a clone it is absent, which gives no rules
+PLATFORM_RULES = checkout_file("tests", "platform_dependent.yaml")
 CHECKS = ("sign", "text", "finite", "info")
 # a decimal number as printed in a table or a sentence (sign, digits, optional exponent)
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
