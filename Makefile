@@ -16,7 +16,7 @@ LOCK_FLAGS = --universal --python-version 3.11.5 --generate-hashes --quiet \
 # `make lock UPGRADE=1`: newest versions the bounds in pyproject.toml allow (else: keep the pins)
 UPGRADE ?=
 
-.PHONY: venv-paths report repair unlock prune test test-fast lint lock bench verify clean clean-results readme check update-references
+.PHONY: venv-paths report repair unlock prune test test-fast lint lock bench verify clean clean-results readme check update-references archive
 
 $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -124,6 +124,7 @@ lock: $(STAMP)
 	$(BIN)/uv pip compile $(LOCK)/bootstrap.in $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/bootstrap.txt
 	$(BIN)/uv pip compile pyproject.toml $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/default.txt
 	$(BIN)/uv pip compile pyproject.toml --extra test $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/test.txt
+	$(BIN)/uv pip compile pyproject.toml --extra archive $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/archive.txt
 	$(BIN)/python -m netrepro.lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
 
 # Rewrite the results table of README.md from the claims, errata and figures of the last build.
@@ -146,3 +147,10 @@ clean:
 
 # Kept for old habits: a rebuild needs the figures and the report gone too, so this is `make clean`.
 clean-results: clean
+
+# One deposit of this commit (issue 41): a BagIt bag archive/netrepro-<commit12>/ (and its .zip) with the
+# git archive of HEAD, the built report/ (run `make report` first), the lock files, CITATION.cff and, made
+# from it, .zenodo.json and codemeta.json. bagit is installed on demand from its own lock (hashes).
+archive: $(STAMP) venv-paths $(LOCK)/archive.txt
+	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/archive.txt
+	$(BIN)/python -m netrepro.archive --out archive --zip

@@ -63,3 +63,58 @@ def test_a_broken_registry_is_refused_naming_the_problem(tmp_path, text, message
     path.write_text(text)
     with pytest.raises(ConfigError, match=message.replace("[", r"\[").replace("]", r"\]")):
         load_registry(path)
+
+
+# ----------------------------------------------------------------------------- identifiers (issue 41 item 4)
+def test_every_identifier_names_its_source_and_check_date_and_papers_without_say_why():
+    import datetime as dt
+
+    from netrepro.registry import IDENTIFIER_TYPES, identifier_problems
+
+    for slug, entry in load_registry().items():
+        assert identifier_problems(entry) == [], slug
+        for ident in entry["identifiers"]:
+            assert ident["type"] in IDENTIFIER_TYPES, slug
+            assert ident["source"].startswith(("https://", "http://")), slug
+            assert isinstance(ident["checked"], dt.date), slug
+        if not entry["identifiers"]:
+            assert "verified" in entry["identifier_note"] or "no DOI" in entry["identifier_note"], slug
+
+
+def test_every_citation_has_a_year_or_says_why_not():
+    for slug, entry in load_registry().items():
+        cite = entry["citation"]
+        assert cite.get("year") or cite.get("year_note"), slug
+
+
+@pytest.mark.parametrize("identifiers,message", [
+    ("", "lacks 'identifiers'"),
+    ("identifiers: []", "no identifier_note"),
+    ("identifiers: [{type: isbn, value: '1', source: 'https://x.org', checked: 2026-12-02}]", "not one of"),
+    ("identifiers: [{type: doi, value: 'abc', source: 'https://x.org', checked: 2026-12-02}]", "not a doi"),
+    ("identifiers: [{type: doi, value: '10.1109/x.1', checked: 2026-12-02}]", "'source' must be"),
+    ("identifiers: [{type: arxiv, value: '1511.05318', source: 'https://x.org'}]", "'checked' must be"),
+])
+def test_a_malformed_identifier_is_refused(tmp_path, identifiers, message):
+    path = tmp_path / "papers.yaml"
+    path.write_text("p:\n  source: a\n  title: b\n  authors: c\n"
+                    "  citation: {type: article, title: b, authors: [x], year: 2000}\n"
+                    + (f"  {identifiers}\n" if identifiers else ""))
+    with pytest.raises(ConfigError, match=message):
+        load_registry(path)
+
+
+def test_a_well_formed_identifier_is_accepted(tmp_path):
+    path = tmp_path / "papers.yaml"
+    path.write_text("p:\n  source: a\n  title: b\n  authors: c\n"
+                    "  citation: {type: article, title: b, authors: [x], year_note: unknown}\n"
+                    "  identifiers: [{type: doi, value: '10.1109/x.1', source: 'https://doi.org/x', checked: 2026-12-02}]\n")
+    assert load_registry(path)["p"]["identifiers"][0]["value"] == "10.1109/x.1"
+
+
+def test_a_citation_without_year_or_year_note_is_refused(tmp_path):
+    path = tmp_path / "papers.yaml"
+    path.write_text("p:\n  source: a\n  title: b\n  authors: c\n"
+                    "  citation: {type: article, title: b, authors: [x]}\n  identifiers: []\n  identifier_note: none\n")
+    with pytest.raises(ConfigError, match="no year and no year_note"):
+        load_registry(path)

@@ -161,3 +161,34 @@ def test_notebook_cells_have_unique_ids(notebook):
     assert None not in ids, f"{notebook.name}: a cell has no id"
     assert len(set(ids)) == len(ids), f"{notebook.name}: duplicate cell ids"
     nbformat.validate(nbformat.from_dict(raw))
+
+
+def test_references_print_one_full_stop_and_a_year_or_nd():
+    from netrepro.references import format_reference
+
+    for slug, ref in load_references().items():
+        text = format_reference(ref)
+        assert ".." not in text, text
+        assert re.search(r"\((\d{4}|n\.d\.)\)", text), text
+
+
+def test_identifiers_flow_into_citation_cff_the_report_and_the_crate():
+    from netrepro.references import crate_citations, load_identifiers, references_html
+    from netrepro.registry import identifier_url
+
+    doc = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert doc["date-released"]
+    by_title = {ref["title"]: ref for ref in doc["references"]}
+    html = references_html(list(load_references()))
+    crate = {c["name"]: c for c in crate_citations(list(load_references()))}
+    assert len(crate) == len(load_references())
+    for slug, idents in load_identifiers().items():
+        title = load_references()[slug]["title"]
+        for ident in idents:
+            url = identifier_url(ident)
+            assert f'href="{url}"' in html, slug
+            values = [i["value"] for i in by_title[title]["identifiers"]]
+            assert (ident["value"] if ident["type"] == "doi" else url) in values, slug
+            assert crate[title]["@id"] == identifier_url(idents[0]), slug
+        if not idents:
+            assert crate[title]["@id"] == f"#paper-{slug}" and "identifiers" not in by_title[title], slug

@@ -165,7 +165,7 @@ def _job_key(meta: dict) -> str:
 
 def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, run: dict,
                 workflow_files: list[str], config_files: list[str], pages: list[str],
-                versions: dict, out: str | Path | None = None) -> Path:
+                versions: dict, out: str | Path | None = None, citations: list[dict] | None = None) -> Path:
     """Write ``ro-crate-metadata.json`` into ``crate_root`` (the report folder).
 
     Parameters
@@ -187,6 +187,9 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
         Package -> version of the software that computed the results (``None`` versions are left out).
     out : str or Path, optional
         Where to write the metadata; default ``<crate_root>/ro-crate-metadata.json``.
+    citations : list of dict, optional
+        The reproduced papers as contextual entities (:func:`netrepro.references.crate_citations`),
+        listed by the root dataset's ``citation`` (RO-Crate 1.1, "Publications via citation property").
 
     Returns
     -------
@@ -279,9 +282,11 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
                   "author": {"@id": MAINTAINERS["@id"]}, "publisher": {"@id": MAINTAINERS["@id"]},
                   "conformsTo": _ref(PROFILES), "mainEntity": {"@id": main},
                   "hasPart": _ref(data_id(p) if p in sidecars else p for p in has_part),
-                  "mentions": _ref([run_id, *(a["@id"] for a in actions)])})
+                  "mentions": _ref([run_id, *(a["@id"] for a in actions)]),
+                  **({"citation": _ref(c["@id"] for c in citations)} if citations else {})})
     graph.extend({"@id": url, "@type": "CreativeWork", "name": name, "version": version}
                  for url, (name, version) in PROFILES.items())
+    graph.extend(dict(c) for c in citations or [])
     graph.append({"@id": LICENSE, "@type": "CreativeWork", "name": "BSD 3-Clause License"})
     graph.append(dict(MAINTAINERS))
     graph.append({"@id": BIOSCHEMAS_WORKFLOW, "@type": "CreativeWork", "name": "Bioschemas ComputationalWorkflow profile",

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import yaml
 
-from .registry import REGISTRY_FILE, load_registry
+from .registry import REGISTRY_FILE, identifier_url, load_registry
 
-__all__ = ["load_references", "format_reference", "references_html", "cff_reference", "citation_cff",
-           "SOFTWARE", "main"]
+__all__ = ["load_references", "load_identifiers", "format_reference", "references_html", "cff_reference",
+           "citation_cff", "crate_citations", "SOFTWARE", "main"]
 
 # This software as CITATION.cff describes it (title, licence, version: keep in step with pyproject.toml).
 SOFTWARE = {
@@ -32,6 +32,8 @@ SOFTWARE = {
                  "decentralized H-infinity filtering, checks each number the papers state, and lists every "
                  "equation they print wrong."),
     "keywords": ["reproducibility", "Kalman filtering", "networked control", "Snakemake", "RO-Crate"],
+    # the release date of `version` (CFF date-released): change both together
+    "date-released": "2026-12-02",
 }
 
 
@@ -53,6 +55,22 @@ def load_references(path: str | Path = REGISTRY_FILE) -> dict:
     return {slug: entry["citation"] for slug, entry in load_registry(path).items()}
 
 
+def load_identifiers(path: str | Path = REGISTRY_FILE) -> dict:
+    """Slug -> the paper's verified identifiers (``type``, ``value``, ``source``, ``checked``; maybe empty).
+
+    Parameters
+    ----------
+    path : str or Path, default REGISTRY_FILE
+        The paper registry (``src/netrepro/papers.yaml``).
+
+    Returns
+    -------
+    dict
+        Paper slug -> list of identifier mappings.
+    """
+    return {slug: list(entry.get("identifiers") or []) for slug, entry in load_registry(path).items()}
+
+
 def _author(person: dict) -> str:
     given = " ".join(f"{part[0]}." for part in str(person.get("given-names", "")).replace(".", " ").split())
     return f"{person['family-names']}, {given}".rstrip(", ") if given else str(person.get("family-names", person))
@@ -69,12 +87,13 @@ def format_reference(ref: dict) -> str:
     Returns
     -------
     str
-        Authors separated by ``"; "``, the year in parentheses, title and venue.
+        Authors separated by ``"; "``, the year in parentheses (``(n.d.)`` when the registry gives
+        none), title and venue; one full stop after each part, never two.
     """
     authors = "; ".join(_author(a) for a in ref.get("authors", []))
-    year = f" ({ref['year']})" if ref.get("year") else ""
-    venue = f" {ref['venue']}." if ref.get("venue") else ""
-    return f"{authors}{year}. {ref['title']}.{venue}"
+    year = f" ({ref['year']})" if ref.get("year") else " (n.d.)"
+    venue = f" {ref['venue'].rstrip('.')}." if ref.get("venue") else ""
+    return f"{authors}{year}. {ref['title'].rstrip('.')}.{venue}"
 
 
 def references_html(slugs) -> str:
@@ -89,9 +108,11 @@ def references_html(slugs) -> str:
     -------
     str
         An HTML ``<section id="cite">`` with one escaped list item per paper (and the works it
-        reproduces); an unchecked venue is flagged.
+        reproduces), linking each verified identifier (``doi:`` to https://doi.org/, ``arXiv:`` to
+        https://arxiv.org/abs/); an unchecked venue is flagged.
     """
     refs = load_references()
+    idents = load_identifiers()
     items = []
     for slug in slugs:
         ref = refs.get(slug)
@@ -99,9 +120,11 @@ def references_html(slugs) -> str:
             continue
         note = "" if ref.get("venue_checked", True) or not ref.get("venue") else \
             ' <small class="sha">(venue not in the source text: check before citing)</small>'
+        links = "".join(f' <a class="ident" href="{html.escape(identifier_url(i))}">'
+                        f"{html.escape(_ident_label(i))}</a>" for i in idents.get(slug, []))
         under = "".join(f"<li>{html.escape(format_reference(u))}</li>" for u in ref.get("underlying", []))
         items.append(f'<li id="cite-{html.escape(slug)}"><code>{html.escape(slug)}</code> '
-                     f"{html.escape(format_reference(ref))}{note}"
+                     f"{html.escape(format_reference(ref))}{links}{note}"
                      + (f"<br><small>which reproduces</small><ul>{under}</ul>" if under else "") + "</li>")
     return ('<section id="cite"><h2>Cite the originals</h2><p class="sub">The results above are ours; the '
             "questions, models and stated numbers are the authors'. Cite the original papers, and this "
@@ -109,19 +132,27 @@ def references_html(slugs) -> str:
             f"<ol class=\"refs\">{''.join(items)}</ol></section>")
 
 
-def cff_reference(ref: dict) -> dict:
+def _ident_label(ident: dict) -> str:
+    return f"doi:{ident['value']}" if ident["type"] == "doi" else f"arXiv:{ident['value']}"
+
+
+def cff_reference(ref: dict, identifiers=()) -> dict:
     """A reference in the Citation File Format (``references`` entry).
 
     Parameters
     ----------
     ref : dict
         A registry reference (``type``, ``title``, ``authors``, optional ``year``, ``venue``, ``affiliation``).
+    identifiers : iterable of dict, default ()
+        The paper's verified identifiers (registry ``identifiers``).
 
     Returns
     -------
     dict
         The CFF entry: the venue as ``journal`` (article), ``conference.name`` (conference paper)
-        or ``notes`` (otherwise); the affiliation appended to ``notes``.
+        or ``notes`` (otherwise); the affiliation appended to ``notes``; the first DOI as ``doi``,
+        and every identifier under ``identifiers`` (a DOI as ``type: doi``, an arXiv id as its
+        ``type: url``), each described with where and when it was verified.
     """
     out = {"type": ref["type"], "title": ref["title"], "authors": [dict(a) for a in ref["authors"]]}
     if ref.get("year"):
@@ -135,6 +166,16 @@ def cff_reference(ref: dict) -> dict:
         out["notes"] = venue
     if ref.get("affiliation"):
         out["notes"] = (out.get("notes", "") + " " if out.get("notes") else "") + f"Authors' affiliation: {ref['affiliation']}"
+    identifiers = list(identifiers)
+    dois = [i["value"] for i in identifiers if i["type"] == "doi"]
+    if dois:
+        out["doi"] = dois[0]
+    if identifiers:
+        out["identifiers"] = [
+            {"type": "doi", "value": i["value"]} if i["type"] == "doi" else {"type": "url", "value": identifier_url(i)}
+            for i in identifiers]
+        for cff, i in zip(out["identifiers"], identifiers):
+            cff["description"] = f"{_ident_label(i)}, verified at {i['source']} on {i['checked']}"
     return out
 
 
@@ -148,9 +189,10 @@ def citation_cff() -> dict:
         registry followed by the works it reproduces.
     """
     refs = load_references()
+    idents = load_identifiers()
     references = []
-    for ref in refs.values():
-        references.append(cff_reference(ref))
+    for slug, ref in refs.items():
+        references.append(cff_reference(ref, idents.get(slug, [])))
         references.extend(cff_reference(u) for u in ref.get("underlying", []))
     return {
         "cff-version": "1.2.0",
@@ -160,6 +202,51 @@ def citation_cff() -> dict:
         **SOFTWARE,
         "references": references,
     }
+
+
+_SCHEMA_TYPES = {"article": "ScholarlyArticle", "conference-paper": "ScholarlyArticle", "report": "Report"}
+
+
+def crate_citations(slugs) -> list[dict]:
+    """The papers ``slugs`` as RO-Crate contextual entities, for the root dataset's ``citation``.
+
+    RO-Crate 1.1 ("Publications via citation property") asks for a URL, for example a DOI URL,
+    as the ``@id`` of each publication, described as a ``ScholarlyArticle`` or ``CreativeWork``.
+    A paper with a verified identifier is named by its resolver URL (``https://doi.org/...``,
+    ``https://arxiv.org/abs/...``); one without is named ``#paper-<slug>`` and says so in
+    ``description`` (no identifier is made up).
+
+    Parameters
+    ----------
+    slugs : iterable of str
+        Paper slugs, in list order; a slug without a citation in the registry is skipped.
+
+    Returns
+    -------
+    list of dict
+        One entity per paper: ``@id``, ``@type``, ``name``, ``author`` (names), ``datePublished``
+        (when the registry gives a year), ``identifier`` (resolver URLs), ``description``.
+    """
+    refs, idents = load_references(), load_identifiers()
+    out = []
+    for slug in slugs:
+        ref = refs.get(slug)
+        if not ref:
+            continue
+        urls = [identifier_url(i) for i in idents.get(slug, [])]
+        entity = {"@id": urls[0] if urls else f"#paper-{slug}",
+                  "@type": _SCHEMA_TYPES.get(ref["type"], "CreativeWork"), "name": ref["title"],
+                  "author": [" ".join(filter(None, (a.get("given-names"), a.get("family-names")))) or a.get("name", "")
+                             for a in ref["authors"]]}
+        if ref.get("year"):
+            entity["datePublished"] = str(ref["year"])
+        if urls:
+            entity["identifier"] = urls
+        entity["description"] = (f"The original paper reproduced by the workflow's `{slug}` part: "
+                                 + format_reference(ref)
+                                 + ("" if urls else " No DOI or arXiv id was verified for it."))
+        out.append(entity)
+    return out
 
 
 def main(argv=None) -> int:

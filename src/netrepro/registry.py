@@ -9,7 +9,9 @@ report only, and adding a paper reruns nothing of the others.
 
 from __future__ import annotations
 
+import datetime as _dt
 import keyword
+import re
 from functools import lru_cache
 from pathlib import Path
 
@@ -17,12 +19,81 @@ import yaml
 
 from .errors import ConfigError
 
-__all__ = ["REGISTRY_FILE", "REQUIRED_FIELDS", "load_registry", "paper_slugs", "valid_slug", "registry_entry_text",
-           "schema_mismatches"]
+__all__ = ["REGISTRY_FILE", "REQUIRED_FIELDS", "IDENTIFIER_TYPES", "load_registry", "paper_slugs", "valid_slug",
+           "registry_entry_text", "schema_mismatches", "identifier_problems", "identifier_url"]
 
 REGISTRY_FILE = Path(__file__).with_name("papers.yaml")
 REQUIRED_FIELDS = ("source", "title", "authors", "citation")
 _CITATION_FIELDS = ("type", "title", "authors")
+# A persistent identifier of a paper: its type, the pattern its value must match, and the URL it resolves at.
+IDENTIFIER_TYPES = {
+    "doi": (re.compile(r"10\.\d{4,9}/\S+"), "https://doi.org/{}"),
+    "arxiv": (re.compile(r"\d{4}\.\d{4,5}(v\d+)?"), "https://arxiv.org/abs/{}"),
+}
+
+
+def identifier_url(ident: dict) -> str:
+    """The URL an identifier resolves at: ``https://doi.org/<doi>`` or ``https://arxiv.org/abs/<id>``.
+
+    Parameters
+    ----------
+    ident : dict
+        A registry identifier (``type``, ``value``).
+
+    Returns
+    -------
+    str
+        The resolver URL.
+    """
+    return IDENTIFIER_TYPES[ident["type"]][1].format(ident["value"])
+
+
+def identifier_problems(entry: dict) -> list[str]:
+    """What is wrong with a registry entry's ``identifiers`` and ``identifier_note``.
+
+    Each paper lists the identifiers verified for it (``identifiers``: type ``doi`` or ``arxiv``,
+    ``value``, ``source``: the http(s) URL where it was found, ``checked``: the ISO date of the
+    check); a paper without any (an empty list) says why in ``identifier_note``.
+
+    Parameters
+    ----------
+    entry : dict
+        One paper's registry entry.
+
+    Returns
+    -------
+    list of str
+        One message per problem (empty when the entry is well formed).
+    """
+    if "identifiers" not in entry:
+        return ["lacks 'identifiers' (a list; [] with an identifier_note when none was verified)"]
+    idents = entry["identifiers"]
+    if not isinstance(idents, list):
+        return ["'identifiers' must be a list"]
+    problems = []
+    if not idents and not str(entry.get("identifier_note") or "").strip():
+        problems.append("has no identifiers and no identifier_note saying why")
+    for i, ident in enumerate(idents):
+        where = f"identifiers[{i}]"
+        if not isinstance(ident, dict):
+            problems.append(f"{where} must be a mapping of type, value, source, checked")
+            continue
+        kind, value = ident.get("type"), str(ident.get("value") or "")
+        if kind not in IDENTIFIER_TYPES:
+            problems.append(f"{where}: type {kind!r} is not one of {sorted(IDENTIFIER_TYPES)}")
+        elif not IDENTIFIER_TYPES[kind][0].fullmatch(value):
+            problems.append(f"{where}: {value!r} is not a {kind} identifier")
+        if not re.match(r"https?://\S+$", str(ident.get("source") or "")):
+            problems.append(f"{where}: 'source' must be the http(s) URL where the identifier was verified")
+        checked = ident.get("checked")
+        if isinstance(checked, str):
+            try:
+                checked = _dt.date.fromisoformat(checked)
+            except ValueError:
+                checked = None
+        if not isinstance(checked, _dt.date):
+            problems.append(f"{where}: 'checked' must be the ISO date (YYYY-MM-DD) of the check")
+    return problems
 
 
 def valid_slug(slug: str) -> bool:
@@ -56,6 +127,11 @@ def _validate(path: Path, data) -> dict:
         missing = [k for k in _CITATION_FIELDS if not (isinstance(cite, dict) and cite.get(k))]
         if missing:
             raise ConfigError(f"{path}: paper {slug!r}: citation lacks {missing}")
+        if not cite.get("year") and not str(cite.get("year_note") or "").strip():
+            raise ConfigError(f"{path}: paper {slug!r}: citation has no year and no year_note saying why")
+        problems = identifier_problems(entry)
+        if problems:
+            raise ConfigError(f"{path}: paper {slug!r}: " + "; ".join(problems))
     return data
 
 
@@ -138,8 +214,12 @@ def registry_entry_text(slug: str, title: str, source: str, authors: str = "") -
     entry = {slug: {"source": source, "title": title, "authors": authors or "TODO: the authors",
                     "citation": {"type": "article", "title": title,
                                  "authors": [{"family-names": "TODO", "given-names": "TODO"}],
-                                 "venue_checked": False}}}
-    return ("# added by `python -m netrepro new-paper`: fill in authors and citation (CFF persons, year, venue)\n"
+                                 "year_note": "TODO: the year of publication", "venue_checked": False},
+                    "identifiers": [],
+                    "identifier_note": "TODO: a DOI or arXiv id verified at a named source (with source URL and "
+                                       "checked date), or why there is none"}}
+    return ("# added by `python -m netrepro new-paper`: fill in authors, citation (CFF persons, year, venue) "
+            "and identifiers\n"
             + yaml.safe_dump(entry, sort_keys=False, allow_unicode=True, width=110))
 
 

@@ -16,7 +16,7 @@ from ..errors import ConfigError
 from ..figurespec import load_figure_specs
 from ..io import atomic_path
 from ..provenance import git_state, package_versions
-from ..references import references_html
+from ..references import crate_citations, references_html
 from ..summary import scorecard
 from .markup import read_csv, relocate_json, render, stylesheet
 from .sections import table_view
@@ -107,7 +107,7 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
                          "commit": git["commit"], "dirty": git["dirty"]},
                     workflow_files=[f"{prefix}/workflow/{rel}" for rel in workflow_files if f"workflow/{rel}" in site.raw],
                     config_files=[f"{prefix}/workflow/{rel}" for rel in configs if f"workflow/{rel}" in site.raw],
-                    pages=pages, versions=versions, out=outputs["crate"])
+                    pages=pages, versions=versions, out=outputs["crate"], citations=crate_citations(papers))
     return {"provenance": {"scorecard": score.to_dict(orient="records")}}
 
 
