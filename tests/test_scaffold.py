@@ -430,3 +430,54 @@ def test_a_title_fix_reruns_only_the_report(sixth):
     registry = work / "src/netrepro/papers.yaml"
     registry.write_text(registry.read_text().replace("title: Stability Conditions", "title: Stability conditions", 1))
     assert set(_planned(work)) == {"report"}
+
+
+# ----------------------------------------------------------------------------- the untouched skeleton (issue 40 item 2)
+@pytest.fixture(scope="module")
+def untouched(built_repo, tmp_path_factory):
+    """The built repository with a new paper's skeleton, untouched, built, and its references written by the command."""
+    work = tmp_path_factory.mktemp("untouched") / "repo"
+    shutil.copytree(built_repo, work, symlinks=True)
+    source = work / "paper.txt"
+    source.write_text("A paper.\n")
+    env = {**os.environ, "PYTHONPATH": str(work / "src")}
+
+    def run(*args):
+        proc = subprocess.run([sys.executable, "-m", *args], cwd=work, capture_output=True, text=True, env=env,
+                              check=False, timeout=900)
+        assert proc.returncode == 0, f"{args}:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+        return proc
+
+    written = run("netrepro", "new-paper", "skeleton_only", "--title", "An untouched skeleton",
+                  "--source", str(source)).stdout
+    # whatever must change outside the paper's package is written by the command itself
+    assert "wrote CITATION.cff" in written and "wrote config/README.md" in written
+    run_snakemake(work, "-j2", "report")
+    run("netrepro.regression", "update", "--reference", "tests/reference", "--results", "results",
+        "--paper", "skeleton_only")
+    return work, env
+
+
+def test_the_untouched_skeleton_passes_check_paper_and_the_project_tests(untouched):
+    work, env = untouched
+    assert not check_paper("skeleton_only", work)
+    # the project's own tests that a new paper's files meet: docstrings, citation, configuration docs,
+    # the contract, and the paper's own tests (fast lane options)
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-m", "not slow",
+                           "--hypothesis-profile", "fast", "tests/test_docstrings.py", "tests/test_release_files.py",
+                           "tests/test_contract.py", "tests/test_paperdata.py", "tests/papers/skeleton_only"],
+                          cwd=work, capture_output=True, text=True, env=env, check=False, timeout=900)
+    assert proc.returncode == 0, proc.stdout[-4000:]
+
+
+def test_the_untouched_skeleton_passes_make_check(untouched):
+    work, env = untouched
+    verify = subprocess.run([sys.executable, "-m", "netrepro", "verify", "-q"], cwd=work, capture_output=True,
+                            text=True, env=env, check=False, timeout=300)
+    assert verify.returncode == 0, verify.stdout[-3000:]
+    # the test configuration's tables are not the committed references of the other papers: compare the new
+    # paper's own folder, as `make check` does for every paper
+    compare = subprocess.run([sys.executable, "-m", "netrepro.regression", "compare", "--reference",
+                              "tests/reference/skeleton_only", "--results", "results/skeleton_only"],
+                             cwd=work, capture_output=True, text=True, env=env, check=False, timeout=300)
+    assert compare.returncode == 0, compare.stdout[-3000:] + compare.stderr[-3000:]

@@ -109,8 +109,9 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
         root / "workflow/schemas" / f"{slug}.schema.yaml": "the paper's configuration schema",
         root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.report make-notebook)",
         root / "tests/papers" / slug: "the paper's tests (tests/papers/<slug>/)",
-        root / "tests/reference" / slug: "the committed reference tables (tests/reference/<slug>/; copy them from "
-                                          "results/<slug>/ after a checked build)",
+        root / "tests/reference" / slug: f"the committed reference tables (tests/reference/<slug>/): after a "
+                                          f"checked build (`make report`), `make update-references PAPER={slug}` "
+                                          "writes them; then commit them",
     }
     out += [Violation(_rel(path, root), 0, "roles", f"missing: {what}") for path, what in required.items()
             if not path.exists()]

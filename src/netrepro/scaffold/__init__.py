@@ -84,6 +84,15 @@ def _add_to_schema(path: Path, text: str, slug: str) -> str:
     return text[:end] + f'  {slug}: {{$ref: "{slug}.schema.yaml"}}\n' + text[end:]
 
 
+def _add_config_section(path: Path, text: str, values: dict) -> str:
+    """config/README.md with the new paper's section, before the paper-scale section (or at the end)."""
+    section = _render("config_readme.md.tmpl", values)
+    marker = re.search(r"^## Paper scale", text, re.M)
+    if marker is None:
+        return text.rstrip("\n") + "\n\n" + section
+    return text[:marker.start()] + section + "\n" + text[marker.start():]
+
+
 def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".", authors: str = "") -> Plan:
     """Check the request and compute every file ``new-paper`` writes, writing nothing.
 
@@ -123,7 +132,8 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
     source = Path(source)
     if not source.is_file():
         raise InputError(f"new-paper: source file {source} does not exist")
-    values = {"slug": slug, "title": title.strip(), "source": source.name, "CFG": f"{slug.upper()}_CFG"}
+    values = {"slug": slug, "title": title.strip(), "source": source.name, "CFG": f"{slug.upper()}_CFG",
+              "authors": authors.strip() or "authors to be named (TODO in the registry)"}
     create = {f"src/netrepro/papers/{slug}/{name}": _render(f"package/{name}.tmpl", values) for name in PACKAGE_FILES}
     create |= {f"tests/papers/{slug}/{name}": _render(f"tests/{name}.tmpl", values) for name in TEST_FILES}
     create[f"workflow/rules/{slug}.smk"] = _render("rules.smk.tmpl", values)
@@ -146,6 +156,9 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
         rewrite[cfg] = _add_to_papers_list(root / cfg, text, slug).rstrip("\n") + "\n" + section
     schema = "workflow/schemas/config.schema.yaml"
     rewrite[schema] = _add_to_schema(root / schema, (root / schema).read_text(), slug)
+    readme = "config/README.md"
+    if (root / readme).is_file():
+        rewrite[readme] = _add_config_section(root / readme, (root / readme).read_text(), values)
     registry_text = registry_path.read_text()
     rewrite["src/netrepro/papers.yaml"] = (registry_text.rstrip("\n") + "\n"
                                            + registry_entry_text(slug, title.strip(), source.name, authors))
@@ -212,4 +225,12 @@ def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".",
     InputError
         When the request is refused (see :func:`plan_new_paper`).
     """
-    return write_plan(plan_new_paper(slug, title, source, root, authors), root)
+    written = write_plan(plan_new_paper(slug, title, source, root, authors), root)
+    # CITATION.cff lists every paper of the registry; it is written from the registry the package reads
+    from ..references import REGISTRY_FILE, main as write_citation
+
+    citation = Path(root) / "CITATION.cff"
+    if citation.is_file() and Path(REGISTRY_FILE).resolve() == (Path(root) / "src/netrepro/papers.yaml").resolve():
+        write_citation([str(citation)])
+        written = sorted({*written, "CITATION.cff"})
+    return written
