@@ -89,11 +89,11 @@ lint: $(STAMP_TEST) venv-paths
 	$(BIN)/python -m snakefmt --check Snakefile workflow
 	$(BIN)/python -m snakemake --lint
 	$(BIN)/python -m netrepro check-paper
-	$(BIN)/python $(BIN)/actionlint .github/workflows/regenerate.yml
+	$(BIN)/python $(BIN)/actionlint .github/workflows/regenerate.yml .github/workflows/pages.yml
 
 # What CI runs after its build (after `make report`): every table against the checksum in its
-# provenance sidecar, then tables and figures against the committed references; on a difference
-# it fails and writes results/regeneration/index.html (README: "Checking that figures regenerate").
+# provenance sidecar, then tables and figures against the committed references; it always writes
+# results/regeneration/index.html and summary.json/summary.md (what was compared) and fails on a difference (README: "Checking that figures regenerate").
 # Then the stale outputs (files in results/ and figures/ no rule of this workflow produces, with the
 # same CONFIG/PROFILE as the build): listed with `make prune`, and they fail the check, since a stale
 # table could be frozen into the references by `make update-references`.

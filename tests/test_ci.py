@@ -29,7 +29,7 @@ def test_the_workflow_runs_the_make_targets_of_ci_run_in_the_same_order():
     assert ci[-1] == "check" and {"test", "lint", "clean", "report"} <= set(ci)
 
 
-def test_the_workflow_sets_up_like_ci_and_uploads_the_differences_on_failure():
+def test_the_workflow_sets_up_like_ci_and_uploads_the_comparison_on_every_run():
     job, steps = _steps()
     runs = "\n".join(step.get("run", "") for step in steps)
     assert "for setup in .ci/setup.d/*.sh" in runs and "for setup in .ci/setup.d/*.sh" in (ROOT / ".ci/run").read_text()
@@ -40,8 +40,26 @@ def test_the_workflow_sets_up_like_ci_and_uploads_the_differences_on_failure():
     cache = [s for s in steps if str(s.get("uses", "")).startswith("actions/cache")]
     assert cache and cache[0]["with"]["path"] == ".venv" and "hashFiles('requirements/*.txt'" in cache[0]["with"]["key"]
     upload = [s for s in steps if str(s.get("uses", "")).startswith("actions/upload-artifact")]
-    assert upload and upload[0]["if"] == "failure()"
+    # the comparison's evidence is uploaded on every run, passing or not, with a job summary (issue 41 item 5)
+    assert upload and upload[0]["if"] == "always()"
     assert "results/regeneration/" in upload[0]["with"]["path"] and "report/" in upload[0]["with"]["path"]
+    summary = [s for s in steps if "GITHUB_STEP_SUMMARY" in s.get("run", "")]
+    assert summary and summary[0]["if"] == "always()" and "results/regeneration/summary.md" in summary[0]["run"]
+
+
+def test_the_pages_workflow_publishes_the_report_from_main_and_passes_actionlint():
+    pages = ROOT / ".github" / "workflows" / "pages.yml"
+    doc = yaml.safe_load(pages.read_text())
+    triggers = doc.get("on", doc.get(True))
+    assert triggers["push"]["branches"] == ["main"]
+    steps = doc["jobs"]["build"]["steps"]
+    assert any("make report" in s.get("run", "") for s in steps)
+    assert any(str(s.get("uses", "")).startswith("actions/upload-pages-artifact") and s["with"]["path"] == "report/"
+               for s in steps)
+    assert any(str(s.get("uses", "")).startswith("actions/deploy-pages") for s in doc["jobs"]["deploy"]["steps"])
+    actionlint = Path(sys.executable).parent / "actionlint"
+    proc = subprocess.run([sys.executable, str(actionlint), str(pages)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
 def test_the_workflow_passes_actionlint_and_make_lint_runs_it():

@@ -555,7 +555,8 @@ def clear_difference_page(out_dir) -> None:
 
 
 def write_difference_page(out_dir, figures: list[FigureDifference], tables: list[dict],
-                          other: list[str] = ()) -> Path:
+                          other: list[str] = (), compared: list[FigureDifference] = (),
+                          tables_compared: int | None = None) -> Path:
     """Write ``out_dir/index.html`` (and its images) showing every difference; returns its path.
 
     ``tables``: ``{"table": path, "problems": [...], "cells": [(row, column, result, reference), ...]}``.
@@ -572,6 +573,11 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
         The differing tables, in the form above.
     other : sequence of str, default ()
         Further problems, shown as lines at the top of the page.
+    compared : list of FigureDifference, default ()
+        Every figure compared: listed with its pixel difference and status, so a passing check
+        also leaves its evidence.
+    tables_compared : int, optional
+        How many tables were compared (said in the summary line).
 
     Returns
     -------
@@ -590,7 +596,11 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
              f"<title>Regeneration differences</title><style>{_CSS}</style></head><body>",
              "<h1>Regeneration differences</h1>",
              f"<p id='summary'>{len(failing)} figure(s) and {len(tables)} table(s) differ from their "
-             "references. An intended change: <code>make update-references</code>, then commit.</p>"]
+             "references. An intended change: <code>make update-references</code>, then commit.</p>"
+             if failing or tables else
+             f"<p id='summary' class='pass'>No difference: {len(compared)} figure(s)"
+             + (f" and {tables_compared} table(s)" if tables_compared is not None else "")
+             + " compared with their references.</p>"]
     for line in other:
         parts.append(f"<p class='fail'>{html.escape(line)}</p>")
     for d in figures:
@@ -626,6 +636,12 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
                                    f"<td>{html.escape(str(v))}</td></tr>" for r, c, g, v in t["cells"])
                          + "</table>")
         parts.append("</section>")
+    if compared:
+        parts.append("<section id='compared'><h2>Every figure compared</h2><table><tr><th>figure</th><th>status</th>"
+                     "<th>pixel RMS</th></tr>" + "".join(
+                         f"<tr><td>{html.escape(d.name)}</td><td>{'differs' if d.problems else 'same'}</td>"
+                         f"<td>{'' if d.rms is None else f'{d.rms:.3g}'}</td></tr>" for d in compared)
+                     + "</table></section>")
     parts.append("</body></html>")
     page = out / "index.html"
     with atomic_path(page) as tmp:

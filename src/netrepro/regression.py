@@ -37,7 +37,7 @@ import yaml
 from .locations import checkout_file
 
 __all__ = ["TIMING_COLUMNS", "compare_tables", "compare_trees", "is_timing_column", "load_platform_rules", "main",
-           "paper_of", "update_tables"]
+           "paper_of", "update_tables", "write_check_summary"]
 
 RTOL = 1e-6
 ATOL = 1e-9
@@ -478,12 +478,68 @@ def main(argv=None) -> int:
                 print("NOTE", line)
         print(f"regression: {n_fig} figures compared, {len(failing)} differ "
               f"({time.perf_counter() - start:.1f} s with the tables)")
-    if (problems or failing) and args.html:
+    failed = bool(problems or failing or count == 0 or (args.figures and n_fig == 0))
+    if args.html:
+        # written on every run, passing or not: the evidence of what was compared (issue 41 item 5)
         from .figurecheck import write_difference_page
 
-        page = write_difference_page(Path(args.html).parent, failing, details)
-        print(f"regression: the differences, figure by figure: {page}")
-    return 1 if problems or failing or count == 0 or (args.figures and n_fig == 0) else 0
+        page = write_difference_page(Path(args.html).parent, failing, details, compared=figure_diffs,
+                                     tables_compared=count)
+        summary = write_check_summary(Path(args.html).parent, failed, count, details, figure_diffs)
+        print(f"regression: the comparison, figure by figure: {page} (summary: {summary})")
+    return 1 if failed else 0
+
+
+def write_check_summary(out_dir: Path, failed: bool, tables_compared: int, tables: list[dict], figures: list) -> Path:
+    """Write ``summary.json`` and ``summary.md`` of a comparison beside its page; return the JSON's path.
+
+    Parameters
+    ----------
+    out_dir : Path
+        The comparison page's folder.
+    failed : bool
+        Whether the check fails.
+    tables_compared : int
+        How many reference tables were compared.
+    tables : list of dict
+        The differing tables (``{"table", "problems", "cells"}``).
+    figures : list of FigureDifference
+        Every figure compared (those with problems differ).
+
+    Returns
+    -------
+    Path
+        ``out_dir/summary.json``.
+    """
+    import json
+
+    from .io import atomic_path
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rms = [d.rms for d in figures if d.rms is not None]
+    doc = {
+        "status": "fail" if failed else "pass",
+        "tables": {"compared": tables_compared, "differing": len(tables),
+                   "differences": [{"table": str(t["table"]), "problems": list(t["problems"])} for t in tables]},
+        "figures": {"compared": len(figures), "differing": sum(1 for d in figures if d.problems),
+                    "largest_pixel_rms": max(rms) if rms else None,
+                    "each": [{"figure": d.name, "status": "differs" if d.problems else "same", "pixel_rms": d.rms,
+                              "problems": list(d.problems), "notes": list(d.notes)} for d in figures]},
+    }
+    path = out_dir / "summary.json"
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
+    largest = f"{doc['figures']['largest_pixel_rms']:.3g}" if rms else "n/a"
+    lines = [f"## make check: {doc['status']}", "",
+             f"* tables: {tables_compared} compared, {len(tables)} differ",
+             f"* figures: {len(figures)} compared, {doc['figures']['differing']} differ "
+             f"(largest pixel RMS {largest})", ""]
+    lines += [f"* table `{t['table']}`: {'; '.join(t['problems'])[:300]}" for t in tables]
+    lines += [f"* figure `{d.name}`: {'; '.join(d.problems)[:300]}" for d in figures if d.problems]
+    with atomic_path(out_dir / "summary.md") as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
+    return path
 
 
 if __name__ == "__main__":
