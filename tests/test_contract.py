@@ -207,3 +207,40 @@ def test_the_old_hinf_rules_fail_the_check_and_the_new_pass(hinf_checkout):
 @pytest.mark.parametrize("slug", paper_slugs())
 def test_no_paper_passes_its_whole_section(slug):
     assert not [v for v in check_paper(slug, ROOT) if v.check == "whole-section"]
+
+
+# ----------------------------------------------------------------------------- configuration keys named in the data files
+def test_a_configuration_key_the_data_files_name_must_exist(scratch):
+    """``(config <key>`` in a data file's text names a key of the paper's configuration section (issue 40 item 2)."""
+    recon = scratch / f"src/netrepro/papers/{SLUG}/reconstructions.yaml"
+    line = _append(recon, '- key: scalar.planted_choice\n'
+                          '  reason: "a choice of ours"\n'
+                          '  range: "0.1 and 0.2 (config evidence.no_such_key); horizon (config scalar.horizon), '
+                          'rtol (config growth_ratio_rtol), runs (config no_such_leaf)"\n')
+    found = _named(check_paper(SLUG, scratch), "config-reference", f"src/netrepro/papers/{SLUG}/reconstructions.yaml")
+    assert {v.line for v in found} == {line + 2}
+    messages = " ".join(v.message for v in found)
+    # the missing keys are named, with the entry, the configurations and the fix
+    assert "'evidence.no_such_key'" in messages and "'no_such_leaf'" in messages and "scalar.planted_choice" in messages
+    assert "config/config.yaml and config/test.yaml" in messages and "add the key" in messages
+    # existing keys are not: a dotted path from the section, and a bare key at any depth of it
+    assert "scalar.horizon" not in messages and "growth_ratio_rtol" not in messages
+    assert len(found) == 2
+
+
+def test_a_key_missing_from_one_configuration_names_that_one(scratch):
+    claims = scratch / f"src/netrepro/papers/{SLUG}/claims.yaml"
+    text = claims.read_text()
+    assert "(config growth_ratio_rtol)" in text
+    test_yaml = scratch / "config/test.yaml"
+    test_yaml.write_text(test_yaml.read_text().replace("growth_ratio_rtol:", "growth_ratio_rtol_renamed:"))
+    found = _named(check_paper(SLUG, scratch), "config-reference", f"src/netrepro/papers/{SLUG}/claims.yaml")
+    assert len(found) == 1 and "config/test.yaml" in found[0].message and "config/config.yaml" not in found[0].message
+    assert found[0].line == text[:text.index("(config growth_ratio_rtol)")].count("\n") + 1
+
+
+def test_reconstruction_keys_and_settings_are_not_configuration_paths(scratch):
+    """A reconstruction's key names a choice (``steady_state``), not a configuration key: not checked."""
+    recon = scratch / f"src/netrepro/papers/{SLUG}/reconstructions.yaml"
+    _append(recon, '- key: scalar.not_a_config_key\n  reason: "a modelling choice named by its key"\n')
+    assert not _named(check_paper(SLUG, scratch), "config-reference", f"src/netrepro/papers/{SLUG}/reconstructions.yaml")

@@ -20,6 +20,11 @@ reading the files (nothing is imported or run), and names the file and line of e
 * ``figure-spec``: every figure of ``figures.yaml`` has its plotting function and a caption;
 * ``rule-name``: every rule of ``workflow/rules/<slug>.smk`` starts with the slug;
 * ``config-key``: every configuration key the rules pick for their steps is in the paper's schema;
+* ``config-reference``: every configuration key that the paper's data files name in their text, as
+  ``(config <key>`` (e.g. ``range: "... (config evidence.low_snr_db)"``), is in the paper's section of
+  ``config/config.yaml`` and ``config/test.yaml``: a dotted key as a path from the section, a bare key
+  at any depth of it. Reconstruction keys, ``at`` settings and variant labels are not configuration
+  paths by definition (``steady_state``, ``Z22``, ``p``, ``steer_on_truth``), so they are not checked;
 * ``whole-section``: no rule's params pass the paper's configuration section (or the whole
   configuration) whole: a step gets only the keys it reads, ``pick(SECTION, "key", ...)`` (issue 39).
 """
@@ -518,6 +523,87 @@ def _check_whole_section(slug: str, root: Path) -> list[Violation]:
     return out
 
 
+# a configuration key named in the text of a data file: "(config evidence.low_snr_db", "(config growth_ratio_rtol"
+_CONFIG_REFERENCE = re.compile(r"\(config\s+([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)")
+_CONFIG_FILES = ("config/config.yaml", "config/test.yaml")
+
+
+def _strings(value):
+    """Every string in a loaded entry (a dataclass, dict, list or scalar), depth first."""
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, dict):
+        for item in value.values():
+            yield from _strings(item)
+    elif isinstance(value, (list, tuple)):
+        for item in value:
+            yield from _strings(item)
+    elif hasattr(value, "__dataclass_fields__"):
+        for name in value.__dataclass_fields__:
+            yield from _strings(getattr(value, name))
+
+
+def _resolves(section, key: str) -> bool:
+    """Whether ``key`` names an entry of ``section``: a dotted key as a path, a bare key at any depth."""
+    if "." not in key:
+        stack = [section]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, dict):
+                if key in node:
+                    return True
+                stack.extend(node.values())
+        return False
+    node = section
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
+
+
+def _check_config_references(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    """Configuration keys named in the data files' text, ``(config <key>``, that the configurations lack.
+
+    The entries are read as :func:`netrepro.paperdata.load_paper_data` loads them (YAML comments
+    are not read); data files that do not load are the ``findings-gate`` check's to report.
+    """
+    from .errors import NetreproError
+    from .paperdata import load_paper_data
+
+    try:
+        data = load_paper_data(slug, pkg)
+    except NetreproError:
+        return []
+    configs = {}
+    for name in _CONFIG_FILES:
+        path = root / name
+        if path.is_file():
+            configs[name] = (yaml.safe_load(path.read_text()) or {}).get(slug) or {}
+    entries = [("claims.yaml", c.claim_id, "id", c) for c in data.claims]
+    entries += [("errata.yaml", e["id"], "id", e) for e in data.errata]
+    entries += [("reconstructions.yaml", r["key"], "key", r) for r in data.reconstructions]
+    entries += [("findings.yaml", f.finding_id, "id", f) for f in data.findings]
+    texts, out = {}, []
+    for file, ident, field_name, entry in entries:
+        path = pkg / file
+        text = texts.setdefault(file, path.read_text() if path.is_file() else "")
+        keys = dict.fromkeys(m.group(1) for s in _strings(entry) for m in _CONFIG_REFERENCE.finditer(s))
+        for key in keys:
+            missing = [name for name, section in configs.items() if not _resolves(section, key)]
+            if not missing:
+                continue
+            how = "a path from" if "." in key else "a key at any depth of"
+            start = max(text.find(f"{field_name}: {ident}"), 0)
+            found = re.compile(r"\(config\s+" + re.escape(key) + r"\b").search(text, start)
+            line = text.count("\n", 0, found.start()) + 1 if found else _line_of(text, f"{field_name}: {ident}")
+            out.append(Violation(_rel(path, root), line, "config-reference",
+                                 f"{ident}: names the configuration key {key!r} ('(config {key}'), which is not "
+                                 f"{how} the {slug!r} section of {' and '.join(missing)}: add the key to the "
+                                 "configuration (and its schema) or correct the name"))
+    return out
+
+
 def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     """Every breach of the paper contract by paper ``slug`` in the checkout ``root``.
 
@@ -539,7 +625,7 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
         return [Violation(_rel(pkg, root), 0, "roles", f"paper {slug!r} has no package")]
     return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
             *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_findings_gate(slug, pkg, root),
-            *_check_figures(slug, pkg, root),
+            *_check_figures(slug, pkg, root), *_check_config_references(slug, pkg, root),
             *_check_rule_names(slug, root), *_check_config_keys(slug, root), *_check_whole_section(slug, root)]
 
 
