@@ -54,3 +54,27 @@ def test_the_plan_creates_every_role_and_registers_the_paper(tmp_path):
     assert "kalman_iid:" in plan.rewrite["src/netrepro/papers.yaml"]
     assert 'kalman_iid: {$ref: "kalman_iid.schema.yaml"}' in plan.rewrite["workflow/schemas/config.schema.yaml"]
     assert "papers: [intermittent, markov, onebit, gainsched, hinf, kalman_iid]" in plan.rewrite["config/test.yaml"]
+
+
+def test_a_source_outside_the_shared_papers_folder_is_warned_about(tmp_path, monkeypatch, capsys):
+    """The registry records only the source's file name, looked up in ../shared/papers/: elsewhere it dangles."""
+    from netrepro import commands, scaffold
+
+    root = tmp_path / "checkout"
+    shared = tmp_path / "shared/papers"
+    root.mkdir()
+    shared.mkdir(parents=True)
+    inside, outside = shared / "007_paper.txt", tmp_path / "paper.txt"
+    inside.write_text("text")
+    outside.write_text("text")
+    assert scaffold.source_warnings(inside, root) == []
+    assert scaffold.source_warnings(root / ".." / "shared/papers/007_paper.txt", root) == []  # the same folder
+    (warning,) = scaffold.source_warnings(outside, root)
+    assert "../shared/papers/" in warning and "'paper.txt'" in warning and "copy the source" in warning
+    # the command prints it after writing the skeleton (new_paper itself is not run here)
+    monkeypatch.setattr(scaffold, "new_paper", lambda *args: ["src/netrepro/papers.yaml"])
+    assert commands.main(["new-paper", "sixth", "--title", "T", "--source", str(outside), "--root", str(root)]) == 0
+    err = capsys.readouterr().err
+    assert "warning:" in err and "paper.txt" in err
+    assert commands.main(["new-paper", "sixth", "--title", "T", "--source", str(inside), "--root", str(root)]) == 0
+    assert "warning" not in capsys.readouterr().err

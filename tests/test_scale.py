@@ -151,3 +151,41 @@ def test_scale_step_and_panel(tmp_path, two_runs, monkeypatch):
 def test_findings_comparison_keeps_both_evidence_texts(two_runs):
     findings = scale.compare_by_scale(*two_runs, kind="findings").set_index("finding_id")
     assert findings.loc["F1", "evidence_default"] == "e" and findings.loc["F1", "evidence_paper_scale"] == "e2"
+
+
+def test_a_paper_without_a_recording_reads_no_recording_yet(tmp_path, two_runs, monkeypatch):
+    """A paper the recording does not hold (a sixth paper, added since) is neither a change nor a removal."""
+    from netrepro.report.sections import scale_html
+
+    default, reference = two_runs
+    _claims(default, "sixth", [["sixth", "C1", "1.0", "reproduced", "yes", "", ""],
+                               ["sixth", "C2", "2.0", "differs", "no", "", ""]])
+    _findings(default, "sixth", [["sixth", "F9", "e", "holds", "yes", ""]])
+    # and a recorded paper this run did not build (a run of fewer papers): not compared either
+    _claims(reference, "old", [["old", "K1", "1.0", "reproduced", "yes", "", ""]])
+    table = scale.compare_by_scale(default, reference)
+    sixth = table[table["paper"] == "sixth"]
+    assert list(sixth["what_changed"]) == [scale.NOT_RECORDED] * 2 and not sixth["changed"].any()
+    old = table[table["paper"] == "old"]
+    assert list(old["what_changed"]) == [scale.NOT_RUN] and not old["changed"].any()
+    # the recorded paper is compared as before: "gone" is still removed, "new" still added
+    p = table[table["paper"] == "p"].set_index("claim_id")
+    assert p.loc["gone", "what_changed"] == "removed" and p.loc["new", "what_changed"] == "added"
+    findings = scale.compare_by_scale(default, reference, kind="findings")
+    assert findings.set_index("finding_id").loc["F9", "what_changed"] == scale.NOT_RECORDED
+    # the panel counts only the compared claims and names the paper without a recording
+    (reference / "provenance.json").write_text(json.dumps(
+        {"commit": "abc", "config_hash": "h", "configfiles": [], "recorded": "2026", "code": {}}))
+    monkeypatch.chdir(tmp_path)
+    out = scale.scale_step({"reference": str(reference)},
+                           {"claims": [str(default / "claims" / "p.csv")], "provenance": str(reference / "provenance.json")},
+                           {})
+    assert out["provenance"]["claims_changed"] == 4 and out["provenance"]["findings_changed"] == 1
+    paths = {}
+    for name in ("table", "findings", "stale"):
+        paths[name] = str(tmp_path / f"{name}.csv")
+        out[name].to_csv(paths[name], index=False)
+    html = scale_html({**paths, "reference": str(reference)})
+    assert "4 of 6 claims and 1 of 1 findings change their verdict or robust flag" in html
+    assert "No paper-scale recording yet for sixth (2 claims, 1 findings)" in html
+    assert 'data-claim="C1"' not in html and 'data-finding="F9"' not in html and 'data-claim="K1"' not in html

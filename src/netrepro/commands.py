@@ -17,7 +17,7 @@ COMMANDS = ("new-paper", "check-paper", "register-findings", "diff", "scale-reco
 
 def _new_paper(args) -> int:
     from .errors import NetreproError
-    from .scaffold import new_paper
+    from .scaffold import new_paper, source_warnings
 
     try:
         written = new_paper(args.slug, args.title, args.source, args.root, args.authors)
@@ -25,6 +25,8 @@ def _new_paper(args) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print("\n".join(f"wrote {path}" for path in written))
+    for warning in source_warnings(args.source, args.root):
+        print(warning, file=sys.stderr)
     print(f"next: `make report` builds {args.slug}'s figure, claim and report section; "
           f"`python -m netrepro check-paper {args.slug}` checks the contract; "
           "docs/adding-a-paper.md walks through the rest")

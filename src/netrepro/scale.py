@@ -23,7 +23,7 @@ from pathlib import Path
 
 from .diff import paired_entries, same_value, tables_of
 
-__all__ = ["SCALE_COLUMNS", "FINDING_COLUMNS", "STALE_COLUMNS", "compare_by_scale", "code_fingerprint",
+__all__ = ["SCALE_COLUMNS", "FINDING_COLUMNS", "STALE_COLUMNS", "NOT_RECORDED", "NOT_RUN", "compare_by_scale", "code_fingerprint",
            "stale_sources", "record", "scale_step", "main"]
 
 # results/scale/verdicts_by_scale.csv: the interface of issue 31 first, then what explains a change
@@ -34,6 +34,10 @@ FINDING_COLUMNS = ["paper", "finding_id", "verdict_default", "verdict_paper_scal
                    "robust_paper_scale", "changed", "what_changed", "condition_paper_scale", "evidence_default",
                    "evidence_paper_scale"]
 STALE_COLUMNS = ["paper", "path", "recorded_sha256", "current_sha256"]
+# ``what_changed`` of the entries of a paper that the recording does not hold (a paper added since): not a change
+NOT_RECORDED = "no paper-scale recording yet"
+# ``what_changed`` of the entries of a recorded paper that this run did not build (a run of fewer papers)
+NOT_RUN = "not in this run"
 # result folders that hold one table per paper (file stem = slug); the others are results/<slug>/
 _PER_PAPER = ("claims", "findings", "errata", "reconstructions", "evidence")
 
@@ -62,16 +66,22 @@ def compare_by_scale(default_run, scale_run, kind: str = "claims", rel: float = 
         entry of either run; ``changed`` is True when the verdict or the robust flag differs, or
         the entry is in one run only; ``what_changed`` names every difference (``verdict``,
         ``robust``, ``value``, ``added``, ``removed``, joined by ``+``). A value-only change is
-        listed but leaves ``changed`` False: more paths move every estimate a little.
+        listed but leaves ``changed`` False: more paths move every estimate a little. The entries
+        of a paper that the recording does not hold at all (neither claims nor findings: a paper
+        added since it was recorded) read :data:`NOT_RECORDED`, and those of a recorded paper
+        this run did not build read :data:`NOT_RUN`; neither counts as a change.
     """
     import pandas as pd
 
     ident = {"claims": "claim_id", "findings": "finding_id"}[kind]
     value_col = {"claims": "reproduced_value", "findings": "evidence"}[kind]
+    recorded, built = _papers(scale_run), _papers(default_run)
     rows = []
     for paper, entry, ra, rb in paired_entries(default_run, scale_run, kind):
         what = []
-        if ra is None or rb is None:
+        if paper not in recorded or paper not in built:
+            what.append(NOT_RECORDED if paper not in recorded else NOT_RUN)
+        elif ra is None or rb is None:
             what.append("added" if ra is None else "removed")
         else:
             what += [c for c in ("verdict", "robust") if _cell(ra, c) != _cell(rb, c)]
@@ -80,7 +90,7 @@ def compare_by_scale(default_run, scale_run, kind: str = "claims", rel: float = 
         row = {"paper": paper, ident: entry, "verdict_default": _cell(ra, "verdict"),
                "verdict_paper_scale": _cell(rb, "verdict"), "robust_default": _cell(ra, "robust"),
                "robust_paper_scale": _cell(rb, "robust"),
-               "changed": bool(set(what) - {"value"}), "what_changed": "+".join(what),
+               "changed": bool(set(what) - {"value", NOT_RECORDED, NOT_RUN}), "what_changed": "+".join(what),
                "condition_paper_scale": _cell(rb, "condition")}
         if kind == "claims":
             row.update(value_default=_cell(ra, value_col), value_paper_scale=_cell(rb, value_col),
@@ -89,6 +99,17 @@ def compare_by_scale(default_run, scale_run, kind: str = "claims", rel: float = 
             row.update(evidence_default=_cell(ra, value_col), evidence_paper_scale=_cell(rb, value_col))
         rows.append(row)
     return pd.DataFrame(rows, columns=SCALE_COLUMNS if kind == "claims" else FINDING_COLUMNS)
+
+
+def _papers(run) -> set:
+    """The papers of which a run holds a claims or a findings table."""
+    out = set()
+    for kind in ("claims", "findings"):
+        try:
+            out |= set(tables_of(run, kind))
+        except FileNotFoundError:
+            pass
+    return out
 
 
 def _paper_of(sidecar: Path, results: Path, slugs) -> str | None:

@@ -11,6 +11,7 @@ import pandas as pd
 from markupsafe import Markup
 
 from ..registry import load_registry
+from ..scale import NOT_RECORDED, NOT_RUN
 from ..provenance import sidecar_path
 from ..summary import FINDING_COUNT_COLUMNS, replication_summary, summary_sentences
 from ..verdicts import TESTABLE_VERDICTS, VERDICTS
@@ -290,10 +291,22 @@ def scale_html(scale: dict) -> str:
     def changed(frame):
         return frame[frame["changed"].str.lower() == "true"]
 
+    def absent(frame, what):
+        return frame["what_changed"] == what
+
+    # a paper the recording does not hold (added since) is not compared: no change, no removal
+    unrecorded = sorted(set(claims[absent(claims, NOT_RECORDED)]["paper"])
+                        | (set(findings[absent(findings, NOT_RECORDED)]["paper"]) if findings is not None else set()))
+    compared_claims = claims[~absent(claims, NOT_RECORDED) & ~absent(claims, NOT_RUN)]
+    compared_findings = None if findings is None else findings[~absent(findings, NOT_RECORDED)
+                                                               & ~absent(findings, NOT_RUN)]
     wall = prov.get("wall_time_s")
     return render("scale.html", prov=prov, prov_path=prov_path.as_posix(),
                   wall=f"{float(wall) / 60:.1f} min" if wall else "not recorded",
-                  n_claims=len(claims), n_findings=0 if findings is None else len(findings),
+                  unrecorded=[{"paper": p, "claims": int((claims["paper"] == p).sum()),
+                               "findings": 0 if findings is None else int((findings["paper"] == p).sum())}
+                              for p in unrecorded],
+                  n_claims=len(compared_claims), n_findings=0 if findings is None else len(compared_findings),
                   claims=changed(claims).to_dict(orient="records"),
                   findings=[] if findings is None else changed(findings).to_dict(orient="records"),
                   values_only=int(((claims["changed"].str.lower() != "true")

@@ -26,9 +26,11 @@ from ..io import load_yaml
 from ..paperdata import LOCK_FILE, SKELETON_COMMIT, registry_lock_text
 from ..registry import load_registry, registry_entry_text, valid_slug
 
-__all__ = ["Plan", "plan_new_paper", "write_plan", "new_paper"]
+__all__ = ["Plan", "SOURCES_DIR", "plan_new_paper", "write_plan", "new_paper", "source_warnings"]
 
 TEMPLATES = Path(__file__).with_name("templates")
+# where the registry's ``source`` file names are found, relative to the checkout (src/netrepro/papers.yaml)
+SOURCES_DIR = "../shared/papers"
 PACKAGE_FILES = ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
                  "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml")
 TEST_FILES = ("__init__.py", "test_model.py", "test_steps.py", "test_evidence.py", "test_figures.py",
@@ -234,3 +236,29 @@ def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".",
         write_citation([str(citation)])
         written = sorted({*written, "CITATION.cff"})
     return written
+
+
+def source_warnings(source: str | Path, root: str | Path = ".") -> list[str]:
+    """Why the registry's ``source`` of a new paper would name no file, if it would.
+
+    The registry records only the source text's file name, looked up in :data:`SOURCES_DIR`
+    (``../shared/papers/`` beside the checkout); a source elsewhere leaves that name dangling.
+
+    Parameters
+    ----------
+    source : str or pathlib.Path
+        The ``--source`` file given to ``new-paper``.
+    root : str or pathlib.Path, default "."
+        The repository's root.
+
+    Returns
+    -------
+    list of str
+        One warning when ``source`` is not in :data:`SOURCES_DIR`, else empty.
+    """
+    source, expected = Path(source), (Path(root) / SOURCES_DIR).resolve()
+    if source.resolve().parent == expected:
+        return []
+    return [f"warning: {source} is not in {SOURCES_DIR}/ ({expected}), where the registry's source names are "
+            f"looked up: the registry records only {source.name!r}, which names no file there; copy the source "
+            f"text to {SOURCES_DIR}/{source.name}"]
