@@ -216,7 +216,7 @@ def test_a_configuration_key_the_data_files_name_must_exist(scratch):
     line = _append(recon, '- key: scalar.planted_choice\n'
                           '  reason: "a choice of ours"\n'
                           '  range: "0.1 and 0.2 (config evidence.no_such_key); horizon (config scalar.horizon), '
-                          'rtol (config growth_ratio_rtol), runs (config no_such_leaf)"\n')
+                          'rtol (config growth_ratio_rtol), runs (config no_such_leaf), a (config intermittent.scalar.a)"\n')
     found = _named(check_paper(SLUG, scratch), "config-reference", f"src/netrepro/papers/{SLUG}/reconstructions.yaml")
     assert {v.line for v in found} == {line + 2}
     messages = " ".join(v.message for v in found)
@@ -224,7 +224,7 @@ def test_a_configuration_key_the_data_files_name_must_exist(scratch):
     assert "'evidence.no_such_key'" in messages and "'no_such_leaf'" in messages and "scalar.planted_choice" in messages
     assert "config/config.yaml and config/test.yaml" in messages and "add the key" in messages
     # existing keys are not: a dotted path from the section, and a bare key at any depth of it
-    assert "scalar.horizon" not in messages and "growth_ratio_rtol" not in messages
+    assert "scalar.horizon" not in messages and "growth_ratio_rtol" not in messages and "scalar.a'" not in messages
     assert len(found) == 2
 
 

@@ -22,8 +22,8 @@ reading the files (nothing is imported or run), and names the file and line of e
 * ``config-key``: every configuration key the rules pick for their steps is in the paper's schema;
 * ``config-reference``: every configuration key that the paper's data files name in their text, as
   ``(config <key>`` (e.g. ``range: "... (config evidence.low_snr_db)"``), is in the paper's section of
-  ``config/config.yaml`` and ``config/test.yaml``: a dotted key as a path from the section, a bare key
-  at any depth of it. Reconstruction keys, ``at`` settings and variant labels are not configuration
+  ``config/config.yaml`` and ``config/test.yaml``: a dotted key as a path from the section (or, when it
+  starts with the slug, from the configuration's root), a bare key at any depth of the section. Reconstruction keys, ``at`` settings and variant labels are not configuration
   paths by definition (``steady_state``, ``Z22``, ``p``, ``steer_on_truth``), so they are not checked;
 * ``whole-section``: no rule's params pass the paper's configuration section (or the whole
   configuration) whole: a step gets only the keys it reads, ``pick(SECTION, "key", ...)`` (issue 39).
@@ -590,7 +590,9 @@ def _check_config_references(slug: str, pkg: Path, root: Path) -> list[Violation
         text = texts.setdefault(file, path.read_text() if path.is_file() else "")
         keys = dict.fromkeys(m.group(1) for s in _strings(entry) for m in _CONFIG_REFERENCE.finditer(s))
         for key in keys:
-            missing = [name for name, section in configs.items() if not _resolves(section, key)]
+            # "(config <slug>.evidence.x": a path from the configuration's root, i.e. from the section
+            inner = key.split(".", 1)[1] if key.startswith(f"{slug}.") else key
+            missing = [name for name, section in configs.items() if not _resolves(section, inner)]
             if not missing:
                 continue
             how = "a path from" if "." in key else "a key at any depth of"
