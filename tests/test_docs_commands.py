@@ -44,6 +44,8 @@ RULES = [
     (r"python -m pytest tests/papers/kalman_iid$", "skip", "the tests of the worked example's placeholder paper"),
     (r"(source \.venv/bin/activate|export NETREPRO_SLURM_\w+=\S+)$", "skip", "sets up the shell"),
     (r"\.venv/bin/pip install ", "skip", "installs packages"),
+    (r"(cp -a|rsync -a|mkdir -p|cd) ", "skip", "copies or moves a checkout (README: Moving and sharing a build)"),
+    (r"git (clone|add|commit) ", "skip", "clones or commits"),
 ]
 
 
