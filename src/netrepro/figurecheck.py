@@ -484,7 +484,8 @@ def compare_figures(baseline: Baseline, figures_dir, rules: dict | None = None, 
         d.reference_png = ref_png
         d.result_png = png if png.is_file() else None
         if name not in baseline.figures():
-            d.problems.append(f"figures/{name}.png: no reference (a new figure: `make update-references`, then commit)")
+            d.problems.append(f"figures/{name}.png: no reference (a new figure: its committed files are its "
+                              f"reference: commit figures/{name}.png and figures/{name}{SUFFIX})")
         elif not png.is_file():
             d.problems.append(f"figures/{name}.png: missing (the reference has it)")
         else:
