@@ -194,15 +194,24 @@ def test_the_archive_warns_about_a_dirty_tree_and_a_report_of_another_commit(scr
 
 
 @pytest.mark.slow
-def test_the_archive_of_a_built_report_holds_a_valid_crate(tmp_path):
-    """With NETREPRO_BUILT_REPORT (a checkout with a built report): archive it, validate bag and crate."""
-    built = os.environ.get("NETREPRO_BUILT_REPORT")
-    if not built:
-        pytest.skip("needs NETREPRO_BUILT_REPORT=<a checkout with a built report> (no Snakemake build here)")
+@pytest.mark.xdist_group("workflow")
+def test_the_archive_of_a_built_report_holds_a_valid_crate(built_repo, tmp_path):
+    """The built report of the test configuration, in a git checkout of its own: archive it, validate bag and crate."""
     bagit = pytest.importorskip("bagit")
     from tests.test_crate_validator import failures, validate, warm_cache
 
-    bag_dir = write_archive(built, tmp_path / "out")
+    work = tmp_path / "repo"
+    top = Path(built_repo).resolve()
+
+    def build_products(directory, names):  # at the top only: report/files/data/results/ is the report's payload
+        return [n for n in names if n in (".snakemake", "results", "logs")] if Path(directory).resolve() == top else []
+
+    shutil.copytree(built_repo, work, symlinks=True, ignore=build_products)
+    git = ["git", "-c", "user.name=test", "-c", "user.email=test@example.org"]
+    subprocess.run(["git", "init", "-q"], cwd=work, check=True)
+    subprocess.run(["git", "add", "-A", "--", ".", ":!report"], cwd=work, check=True)
+    subprocess.run([*git, "commit", "-q", "-m", "built"], cwd=work, check=True)
+    bag_dir = write_archive(work, tmp_path / "out")
     bagit.Bag(str(bag_dir)).validate()
     (tmp_path / "rocrate-cache").mkdir()
     cache = warm_cache(tmp_path / "rocrate-cache" / "cache")

@@ -181,3 +181,34 @@ def _table_step(params, inputs, outputs):
     import pandas as pd
 
     return {"table": pd.DataFrame({"x": [1.0]})}
+
+
+def test_the_starter_is_read_from_the_environment_on_this_host_only():
+    import socket
+
+    mark = processes.starter_mark()
+    host, pid, start = mark.rsplit(":", 2)
+    assert host == socket.gethostname() and int(pid) == os.getpid()
+    assert processes.starter_from_environment({processes.STARTER_VARIABLE: mark}) == (os.getpid(), start)
+    assert processes.process_alive((os.getpid(), start))
+    assert processes.starter_from_environment({processes.STARTER_VARIABLE: f"other-host:{pid}:{start}"}) is None
+    for bad in ("", "garbage", f"{host}:x:1"):
+        assert processes.starter_from_environment({processes.STARTER_VARIABLE: bad}) is None
+
+
+def test_a_job_started_after_its_snakemake_died_does_no_work(tmp_path, monkeypatch):
+    # Snakemake killed between starting the job's shell and the job's interpreter: no ancestor is left to
+    # find, but the environment names it, and the job stops before it reads or computes anything
+    from netrepro import runner
+    from netrepro.errors import OrphanedJobError
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(processes.STARTER_VARIABLE, processes.starter_mark(os.getpid()).rsplit(":", 2)[0]
+                       + f":{dead.pid}:1")
+    calls = []
+    monkeypatch.setattr(runner, "_run_and_record", lambda *args: calls.append(args))
+    with pytest.raises(OrphanedJobError):
+        runner.run_step("demo", "tests.test_build_driver:_table_step", {}, {}, {"table": "results/t.csv"})
+    assert calls == [] and not (tmp_path / "results").exists()

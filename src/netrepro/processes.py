@@ -10,7 +10,11 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["RunningBuild", "running_builds", "snakemake_ancestor", "process_alive", "is_snakemake"]
+__all__ = ["RunningBuild", "running_builds", "snakemake_ancestor", "process_alive", "is_snakemake", "STARTER_VARIABLE",
+           "starter_mark", "starter_from_environment"]
+
+# set by the workflow (workflow/rules/common.smk) in the Snakemake process that parses it, inherited by its jobs
+STARTER_VARIABLE = "NETREPRO_SNAKEMAKE"
 
 PROC = Path("/proc")
 
@@ -151,3 +155,49 @@ def process_alive(process: tuple[int, str]) -> bool:
     """
     fields = _stat_fields(process[0])
     return bool(fields) and fields[19] == process[1] and fields[0] != "Z"
+
+
+def starter_mark(pid: int | None = None) -> str:
+    """``host:pid:start time`` of a process (default: this one), for :data:`STARTER_VARIABLE`.
+
+    Parameters
+    ----------
+    pid : int, optional
+        The process; default this one.
+
+    Returns
+    -------
+    str
+        Empty where ``/proc`` is not available.
+    """
+    import socket
+
+    pid = pid or os.getpid()
+    fields = _stat_fields(pid)
+    return f"{socket.gethostname()}:{pid}:{fields[19]}" if fields else ""
+
+
+def starter_from_environment(environ=None) -> tuple[int, str] | None:
+    """The Snakemake process that started this job, from :data:`STARTER_VARIABLE`, on this host only.
+
+    Read from the environment rather than the process tree: a Snakemake killed before the job's
+    interpreter started leaves no ancestor to find. A mark of another host (a cluster job that
+    inherited the login node's environment before its own Snakemake set it) is ignored.
+
+    Parameters
+    ----------
+    environ : mapping, optional
+        Default ``os.environ``.
+
+    Returns
+    -------
+    tuple of (int, str) or None
+        ``(pid, start time)``, as :func:`process_alive` takes it.
+    """
+    import socket
+
+    mark = (os.environ if environ is None else environ).get(STARTER_VARIABLE, "")
+    parts = mark.rsplit(":", 2)
+    if len(parts) != 3 or not parts[1].isdigit() or parts[0] != socket.gethostname():
+        return None
+    return int(parts[1]), parts[2]

@@ -39,7 +39,7 @@ import time
 import warnings
 from pathlib import Path
 
-from .processes import process_alive, snakemake_ancestor
+from .processes import process_alive, snakemake_ancestor, starter_from_environment
 from .errors import LMIError, OrphanedJobError
 from .io import write_table
 from .provenance import (PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, step_environment, verify_output,
@@ -219,9 +219,10 @@ def run_step(rule: str, func_spec: str, params: dict, inputs: dict, outputs: dic
     func = resolve(func_spec)
     inputs = {k: _as_paths(v) for k, v in inputs.items()}
     outputs = {k: Path(v) for k, v in outputs.items()}
+    starter = starter_from_environment() or snakemake_ancestor()
+    _refuse_orphaned(rule, starter)  # a Snakemake killed while this job's interpreter started
     _check_inputs(inputs)
     _clear_stale(outputs, rule)
-    starter = snakemake_ancestor()
     package = _own_package()
     try:
         _run_and_record(rule, func, func_spec, params, inputs, outputs, starter, package)

@@ -1,6 +1,7 @@
 # Shared helpers for all rules. Before any job runs, the Python environment is checked (every
 # required package importable and recent enough) and the configuration is validated.
 import json
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -19,6 +20,7 @@ try:
     from netrepro.figurespec import load_figure_specs
     from netrepro.registry import paper_slugs
     from netrepro.venv_paths import interpreter
+    from netrepro.processes import STARTER_VARIABLE, starter_mark
     from netrepro.paperdata import (
         DATA_FILES,
         LOCK_FILE,
@@ -44,6 +46,10 @@ try:
             load_paper_data(_slug)
 except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
+
+# every job knows the Snakemake that started it (netrepro.processes): one whose Snakemake is gone stops
+# without writing; an environment variable, not a command-line argument, so no command changes
+os.environ[STARTER_VARIABLE] = starter_mark()
 
 # relative to the checkout when the interpreter lies inside it (.venv/bin/python): a moved checkout reruns nothing
 PYTHON = interpreter()
