@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...io import read_table
-from ...plotting import COLOURS, OKABE_ITO, new_figure, palette, save_figure
+from ...plotting import OKABE_ITO, new_figure, save_figure
 
 __all__ = ["figure_bounds", "figure_region", "figure_estimators", "figure_stationary"]
 
