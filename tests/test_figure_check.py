@@ -84,7 +84,7 @@ EDITS = {
     # the edit of the issue: twice the exact E||P_k|| curve
     "doubled_curve": ("markov", "ax.plot(sub.k, sub.mean_norm, **style)", "ax.plot(sub.k, 2 * sub.mean_norm, **style)",
                       ["markov/fig3", "markov/fig4", "markov/fig5", "markov/fig6"], "line", "'E||P_k|| exact"),
-    "dropped_legend_entry": ("markov", ', "b^", ms=7, label="Sinopoli lower bound")', ', "b^", ms=7)',
+    "dropped_legend_entry": ("markov", ', ms=7, label="Sinopoli lower bound")', ', ms=7)',
                              ["markov/fig2"], "legend", "Sinopoli lower bound"),
     "axis_scale": ("markov", '    ax.set_yscale("log")\n    ax.set_ylabel("||P_k||")',
                    '    ax.set_yscale("symlog")\n    ax.set_ylabel("||P_k||")',

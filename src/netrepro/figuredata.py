@@ -3,9 +3,11 @@
 :func:`describe_figure` walks a matplotlib figure with the artist API and returns, for every
 axes (twin axes included, in the figure's order), its title and labels, scales and limits,
 ticks' labels, legend entries, and every artist with its data: lines and markers
-(``get_xydata``), scatter offsets and sizes (``get_offsets``), filled areas and bands
-(``get_paths``), bars and other patches (their vertices), error bars (line collections),
-images (their array), and texts. :func:`netrepro.plotting.save_figure` writes it beside the PNG
+(``get_xydata``), scatter offsets, sizes and marker (``get_offsets``), filled areas and bands
+(``get_paths``), bars and other patches (their vertices and hatch), error bars (line
+collections), images (their array), and texts; with their colours, line styles and markers, and
+for the artists of a labelled bar or error-bar container that label (``container``), so a test
+can check what tells the legend entries apart (``tests/test_figure_colours.py``). :func:`netrepro.plotting.save_figure` writes it beside the PNG
 as ``<name>.data.json`` for every figure of the project, so a figure is checked by what it
 shows, not only by its pixels.
 
@@ -17,6 +19,7 @@ comparison must not rerun the figures.
 from __future__ import annotations
 
 import json
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -93,6 +96,35 @@ def _line(line) -> dict:
             "markersize": float(line.get_markersize()), "visible": bool(line.get_visible())}
 
 
+@lru_cache(maxsize=None)
+def _marker_paths() -> tuple:
+    """``(name, vertices, codes)`` of every marker matplotlib names, as ``scatter`` draws it."""
+    from matplotlib.markers import MarkerStyle
+
+    out = []
+    for name in MarkerStyle.markers:
+        if name in ("", " ", "None", "none", None):
+            continue
+        style = MarkerStyle(name)
+        path = style.get_path().transformed(style.get_transform())
+        out.append((str(name), np.asarray(path.vertices, dtype=float),
+                    None if path.codes is None else tuple(path.codes)))
+    return tuple(out)
+
+
+def _scatter_marker(coll) -> str | None:
+    """The marker a scatter draws (matplotlib's name for it), or None when it is not a named marker."""
+    paths = coll.get_paths()
+    if len(paths) != 1:
+        return None
+    vertices = np.asarray(paths[0].vertices, dtype=float)
+    codes = None if paths[0].codes is None else tuple(paths[0].codes)
+    for name, v, c in _marker_paths():
+        if v.shape == vertices.shape and c == codes and np.allclose(v, vertices, atol=1e-9):
+            return name
+    return None
+
+
 def _collection(coll) -> dict:
     from matplotlib.collections import LineCollection, PathCollection, PolyCollection, QuadMesh
 
@@ -103,6 +135,7 @@ def _collection(coll) -> dict:
     if isinstance(coll, PathCollection):  # scatter: positions and sizes
         out["offsets"] = _array(coll.get_offsets())
         out["sizes"] = _array(coll.get_sizes())
+        out["marker"] = _scatter_marker(coll)
         if coll.get_array() is not None:
             out["values"] = _array(coll.get_array())
     elif isinstance(coll, (PolyCollection, LineCollection)):  # bands, fills, error bars, segments
@@ -112,6 +145,7 @@ def _collection(coll) -> dict:
         out["offsets"] = _array(coll.get_offsets())
     out["facecolor"] = _color(coll.get_facecolor())
     out["edgecolor"] = _color(coll.get_edgecolor())
+    out["hatch"] = None if coll.get_hatch() is None else str(coll.get_hatch())
     return out
 
 
@@ -119,7 +153,7 @@ def _patch(patch) -> dict:
     from matplotlib.patches import Rectangle
 
     out = {"kind": type(patch).__name__, "label": _label(patch), "facecolor": _color(patch.get_facecolor()),
-           "visible": bool(patch.get_visible())}
+           "hatch": None if patch.get_hatch() is None else str(patch.get_hatch()), "visible": bool(patch.get_visible())}
     if isinstance(patch, Rectangle):  # bars, axvspan in data coordinates
         out["xywh"] = _array([patch.get_x(), patch.get_y(), patch.get_width(), patch.get_height()])
     else:
@@ -140,12 +174,33 @@ def _legend(legend) -> dict | None:
             "visible": bool(legend.get_visible())}
 
 
+def _container_labels(ax) -> dict:
+    """``id(artist) -> label`` of the containers (bars, error bars, stems) whose artists carry no label."""
+    out = {}
+    for container in ax.containers:
+        label = _label(container)
+        if label is None:
+            continue
+        stack = list(container)
+        while stack:
+            item = stack.pop()
+            if item is None:
+                continue
+            if isinstance(item, (list, tuple)):
+                stack.extend(item)
+            else:
+                out[id(item)] = label
+    return out
+
+
 def _axes(ax) -> dict:
     artists = []
+    containers = _container_labels(ax)
     for child in ax.get_children():
         kind = type(child).__name__
         if child in (ax.title, ax._left_title, ax._right_title, ax.patch) or child is ax.legend_:
             continue
+        start = len(artists)
         if hasattr(child, "get_xydata") and kind == "Line2D":
             artists.append(_line(child))
         elif hasattr(child, "get_paths") and hasattr(child, "get_offsets"):
@@ -157,6 +212,8 @@ def _axes(ax) -> dict:
             artists.append(_patch(child))
         elif kind in ("Text", "Annotation") and child.get_text():
             artists.append({"kind": "text", **_text(child)})
+        if len(artists) > start and id(child) in containers and artists[-1].get("label") is None:
+            artists[-1]["container"] = containers[id(child)]  # the legend entry it belongs to
     twins = [i for i, other in enumerate(ax.figure.axes)
              if other is not ax and (ax.get_shared_x_axes().joined(ax, other) or
                                      ax.get_shared_y_axes().joined(ax, other)) and

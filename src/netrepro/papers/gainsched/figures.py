@@ -5,12 +5,21 @@ from __future__ import annotations
 import numpy as np
 
 from ...io import read_table
+from ...plotting import COLOURS, OKABE_ITO
 
 __all__ = ["figure_errors", "figure_mse", "figure_sensitivity"]
 
-_COLORS = {"paper": "C3", "theorem3": "C0", "theorem3_S21I": "C9", "fixed_gain": "C1", "performance": "C2",
-           "performance_fixed": "C8", "tuned_fixed": "C4", "tuned_scheduled": "C5", "zero": "k",
-           "performance_tied": "C8", "tuned_exact": "C6"}
+# each design: an Okabe-Ito colour and a line style (designs of close colours differ in line style;
+# a design's `_flipped` variant, H -> -H, is drawn in its colour with its flipped line style)
+_O = OKABE_ITO
+_STYLES = {"paper": (COLOURS["paper"], "-"), "theorem3": (_O["blue"], "-"), "theorem3_S21I": (_O["sky_blue"], "-."),
+           "fixed_gain": (_O["orange"], "-."), "performance": (_O["bluish_green"], "-."),
+           "performance_fixed": (_O["bluish_green"], ":"), "tuned_fixed": (_O["reddish_purple"], ":"),
+           "tuned_scheduled": (_O["yellow"], "-"), "zero": (_O["black"], "-"),
+           "performance_tied": (_O["bluish_green"], ":"), "tuned_exact": (_O["black"], "--")}
+_COLORS = {d: c for d, (c, _) in _STYLES.items()}
+_LINES = {d: ls for d, (_, ls) in _STYLES.items()}
+_FLIPPED = {"-": "--", "-.": ":", ":": "-."}
 
 
 def figure_errors(params, inputs, outputs):
@@ -31,15 +40,17 @@ def figure_errors(params, inputs, outputs):
     fig, (ax1, ax2, ax3) = new_figure(1, 3, figsize=(15, 4.0), sharey=False)
     for d in show:
         pth = paths[paths["design"] == d]
-        ax1.plot(pth["k"], pth[f"e{comp}"], marker=".", ms=3, lw=1, color=_COLORS.get(d), label=d)
+        ax1.plot(pth["k"], pth[f"e{comp}"], marker=".", ms=3, lw=1, color=_COLORS.get(d), ls=_LINES.get(d, "-"),
+                 label=d)
         er = errors[(errors["design"] == d) & (errors["initial_state"] == "fixed_x0")]
         if not er.empty:
-            ax2.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), label=f"{d} mean")
+            ax2.plot(er["k"], er[f"e{comp}_mean"], lw=1.5, color=_COLORS.get(d), ls=_LINES.get(d, "-"),
+                     label=f"{d} mean")
             ax2.fill_between(er["k"], er[f"e{comp}_lo"], er[f"e{comp}_hi"], color=_COLORS.get(d), alpha=0.15)
         # x(0) ~ N(0, I): the mean error is zero for every design by symmetry; the RMS error is what differs
         er = errors[(errors["design"] == d) & (errors["initial_state"] == "gaussian")]
         if not er.empty:
-            ax3.plot(er["k"], er[f"e{comp}_rms"], lw=1.5, color=_COLORS.get(d), label=d)
+            ax3.plot(er["k"], er[f"e{comp}_rms"], lw=1.5, color=_COLORS.get(d), ls=_LINES.get(d, "-"), label=d)
     ax1.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title="one sample path, configured $x_0$")
     ax2.set(xlabel="k", ylabel=f"$e_{comp}(k)$", title=f"configured $x_0$: mean, central {params['band']:.0%} band")
     ax3.set(xlabel="k", ylabel=f"$\\sqrt{{E\\,e_{comp}(k)^2}}$",
@@ -63,8 +74,10 @@ def figure_mse(params, inputs, outputs):
     kmax = int(params.get("k_max", sel["k"].max()))
     for d, er in sel.groupby("design", sort=False):
         er = er[er["k"] <= kmax]
-        base = d.removesuffix("_flipped")  # the same filter with H -> -H: its design's colour, dashed
-        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(base), ls="--" if base != d else "-", label=d, lw=1.2)
+        base = d.removesuffix("_flipped")  # the same filter with H -> -H: its design's colour, another line style
+        ls = _LINES.get(base, "-")
+        ax1.semilogy(er["k"], er["mse"], color=_COLORS.get(base), ls=_FLIPPED.get(ls, "--") if base != d else ls,
+                     label=d, lw=1.2)
     ax1.set(xlabel="k", ylabel=r"$E\|e(k)\|^2$ (exact)",
             title=f"exact second moments, f = {f_show}, x(0) {'~ N(0, I)' if start == 'gaussian' else '= x0'}")
     ax1.legend(fontsize=7)
@@ -102,9 +115,9 @@ def figure_sensitivity(params, inputs, outputs):
     sens = read_table(inputs["sensitivity"])
     limits = read_table(inputs["limits"]).set_index("design")
     fig, (ax, ax2) = new_figure(1, 2, figsize=(12, 4.4), layout="constrained")
-    styles = {"scheduled": ("C0", "o"), "fixed_gain": ("C1", "s"), "zero": ("k", "^"), "printed_gains": ("C3", "v"),
-              "plant": ("0.4", "D"), "plant_necessary": ("0.4", "P"), "plant_componentwise": ("C5", "D"),
-              "plant_componentwise_necessary": ("C5", "P")}
+    styles = {"scheduled": (_O["blue"], "o"), "fixed_gain": (_O["orange"], "s"), "zero": (_O["black"], "^"),
+              "printed_gains": (COLOURS["paper"], "v"), "plant": ("0.4", "D"), "plant_necessary": ("0.4", "P"),
+              "plant_componentwise": (_O["sky_blue"], "d"), "plant_componentwise_necessary": (_O["sky_blue"], "X")}
     fill = {"feasible": "full", "undecided": "none", "infeasible": "none"}
     for d, (col, mk) in styles.items():
         g = sens[(sens["variant"] == d) & (sens["kind"] == "grid")].sort_values("sigma2")
@@ -123,7 +136,7 @@ def figure_sensitivity(params, inputs, outputs):
         n_ok = int((below["verdict"] == "feasible").sum())
         where = f"$\\sigma^2$ < {zoom:g}: {n_ok} of {len(below)} grid points feasible (incl. the reconstructed {params['sigma2']:g})"
     else:
-        ax.axvline(params["sigma2"], color="C3", lw=1, label=r"reconstructed $\sigma^2$")
+        ax.axvline(params["sigma2"], color=COLOURS["paper"], lw=1, label=r"reconstructed $\sigma^2$")
         where = "filled feasible, open undecided, x infeasible"
     ax.set(xlabel=r"$\sigma^2$", ylabel="solver margin t (information only)",
            title=f"verdict per grid point (filled feasible, x infeasible)\n{where}")

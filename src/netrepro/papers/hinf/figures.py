@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...plotting import new_figure, save_figure
+from ...plotting import OKABE_ITO, new_figure, palette, save_figure
 
 __all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
            "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired",
@@ -27,11 +27,11 @@ def figure_noise(params, inputs, outputs):
     for _, row in t.iterrows():
         fr, fb = row["f_r"], row["f_b"]
         ell = Ellipse((row["x"], row["y"]), 2 * scale * math.sqrt(fr), 2 * scale * math.sqrt(fb),
-                      angle=math.degrees(row["theta"]), fill=False, lw=1.5, color=f"C{int(row['sensor'])}")
+                      angle=math.degrees(row["theta"]), fill=False, lw=1.5, color=palette(int(row['sensor'])))
         ax.add_patch(ell)
-        ax.plot(row["x"], row["y"], "o", color=f"C{int(row['sensor'])}",
+        ax.plot(row["x"], row["y"], "o", color=palette(int(row['sensor'])),
                 label=f"sensor {int(row['sensor'])}: r = {row['r']:g}, f_r = {fr:.3f}, f_b = {fb:.3f}")
-        ax.plot([row["x"], 0], [row["y"], 0], ":", color=f"C{int(row['sensor'])}", lw=0.8)
+        ax.plot([row["x"], 0], [row["y"], 0], ":", color=palette(int(row['sensor'])), lw=0.8)
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
@@ -46,7 +46,7 @@ def figure_errors(params, inputs, outputs):
     err = pd.read_csv(inputs["errors"])
     single = pd.read_csv(inputs["single"])
     fig, axes = new_figure(1, 2, figsize=(11, 4), sharey=False)
-    for (scen, filt, label), color in zip(params["series"], ("C0", "C3", "C2")):
+    for (scen, filt, label), color in zip(params["series"], (OKABE_ITO["blue"], OKABE_ITO["vermillion"], OKABE_ITO["bluish_green"])):
         s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
         axes[0].plot(s["k"], s["error"], color=color, lw=1, label=label)
         e = err[(err["scenario"] == scen) & (err["filter"] == filt)]
@@ -84,7 +84,7 @@ def figure_hinf_vs_kalman(params, inputs, outputs):
                 vals.append(row["late_mean"].iloc[0] if len(row) else np.nan)
                 errs.append(2 * row["late_se"].iloc[0] if len(row) else np.nan)
             x = np.arange(len(scen)) + (2 * j + m - 2.5) * width
-            ax.bar(x, vals, width, yerr=errs, color=f"C{j}", hatch=hatch, alpha=0.8 if m == 0 else 0.45,
+            ax.bar(x, vals, width, yerr=errs, color=palette(j), hatch=hatch, alpha=0.8 if m == 0 else 0.45,
                    label=("Kalman " if m else "H-inf ") + kind)
     ax.set_xticks(np.arange(len(scen)))
     ax.set_xticklabels(scen, fontsize=8)
@@ -104,9 +104,9 @@ def figure_sensitivity(params, inputs, outputs):
     for ax, p in zip(axes[0], pars):
         for i, (scen, g) in enumerate(s[s["parameter"] == p].groupby("scenario", sort=False)):
             g = g.sort_values("value")
-            ax.plot(g["value"], g["ratio_dec_local"], "o-", color=f"C{i}", label=f"{scen} (W={g['W'].iloc[0]:g})")
+            ax.plot(g["value"], g["ratio_dec_local"], "o-", color=palette(i), label=f"{scen} (W={g['W'].iloc[0]:g})")
             nx = g[~g["exists"] | ~np.isfinite(g["ratio_dec_local"])]
-            ax.plot(nx["value"], np.ones(len(nx)), "x", color=f"C{i}")
+            ax.plot(nx["value"], np.ones(len(nx)), "x", color=palette(i))
         ax.axhline(1.0, color="k", lw=0.8, ls=":")
         ax.set_xlabel(p)
         if p == "gamma":
@@ -114,9 +114,9 @@ def figure_sensitivity(params, inputs, outputs):
     if len(ev):
         ax = axes[0][-1]
         fin = ev[np.isfinite(ev["value"]) & ev["exists"]]
-        ax.plot(fin["value"], fin["decentralized_error"], "o-", color="C2", label="H-inf (evasive)")
+        ax.plot(fin["value"], fin["decentralized_error"], "o-", color=OKABE_ITO["bluish_green"], label="H-inf (evasive)")
         nx = ev[np.isfinite(ev["value"]) & ~ev["exists"]]
-        ax.plot(nx["value"], np.full(len(nx), np.nanmin(fin["decentralized_error"]) if len(fin) else 1.0), "x", color="C2")
+        ax.plot(nx["value"], np.full(len(nx), np.nanmin(fin["decentralized_error"]) if len(fin) else 1.0), "x", color=OKABE_ITO["bluish_green"])
         kal = ev[~np.isfinite(ev["value"])]
         if len(kal):
             ax.axhline(kal["decentralized_error"].iloc[0], color="k", ls="--", label="Kalman (evasive)")
@@ -138,7 +138,7 @@ def figure_consensus(params, inputs, outputs):
     fig, axes = new_figure(1, 2, figsize=(10, 3.6))
     axes[0].plot(c["h"], c["spectral_radius"], "o-")
     axes[0].axhline(1.0, color="k", ls=":")
-    axes[0].axvline(c["h_max"].iloc[0], color="C3", ls="--", label=f"h_max = {c['h_max'].iloc[0]:.3f}")
+    axes[0].axvline(c["h_max"].iloc[0], color=OKABE_ITO["vermillion"], ls="--", label=f"h_max = {c['h_max'].iloc[0]:.3f}")
     axes[0].set_ylabel("spectral radius of (5)")
     err = c["steady_state_error"].replace(np.inf, np.nan).clip(lower=1e-16, upper=1e6)
     axes[1].semilogy(c["h"], err, "o-")
@@ -162,14 +162,14 @@ def figure_fig2(params, inputs, outputs):
     per = pd.read_csv(inputs["per_agent"])
     scen = params["scenario"]
     fig, axes = new_figure(1, 3, figsize=(16, 4.2))
-    for filt, color in (("local", "C0"), ("decentralized", "C3")):
+    for filt, color in (("local", OKABE_ITO["blue"]), ("decentralized", OKABE_ITO["vermillion"])):
         s = single[(single["scenario"] == scen) & (single["filter"] == filt)]
         axes[0].plot(s["k"], s["error"], color=color, lw=1, label=filt)
     axes[0].set_title(f"run {int(single['run'].iloc[0])}, agent {int(single['agent'].iloc[0])} (an end of the path, where "
                       "the choice matters most)", fontsize=8)
     sub = series[series["scenario"] == scen]
     for (agent, filt), g in sub.groupby(["agent", "filter"]):
-        color = "C0" if filt == "local" else "C3"
+        color = OKABE_ITO["blue"] if filt == "local" else OKABE_ITO["vermillion"]
         ls = "-" if agent == 0 else "--"
         where = "end" if agent == 0 else "interior"
         axes[1].plot(g["k"], g["error_mean"], color=color, ls=ls, lw=1.2, label=f"{filt}, agent {agent} ({where})")
@@ -188,7 +188,7 @@ def figure_fig2(params, inputs, outputs):
                 # agent -1 (the mean over agents) is drawn at x = n_agents; error bars: +- 2 paired SE / local error
                 x = np.where(g["agent"] < 0, n_agents + 0.3 * (j - 0.5), g["agent"] + 0.15 * (i - 1))
                 axes[2].errorbar(x, g["ratio"], yerr=2 * g["se"] / g["local"], marker=marker, ls="none", capsize=2,
-                                 color=f"C{i}", mfc="none" if j else None, label=f"H = {h}, K_i = {ki:g}")
+                                 color=palette(i), mfc="none" if j else None, label=f"H = {h}, K_i = {ki:g}")
     axes[2].axhline(1.0, color="k", lw=0.8)
     axes[2].set_xticks(list(range(n_agents)) + [n_agents])
     axes[2].set_xticklabels([str(a) for a in range(n_agents)] + ["mean"])
@@ -218,7 +218,7 @@ def figure_network(params, inputs, outputs):
         for i, (who, g) in enumerate(t.groupby("who", sort=True)):
             g = g.sort_values("k")
             is_t = who == "target"
-            color = "k" if is_t else f"C{i}"
+            color = "k" if is_t else palette(i)
             ax.plot(g["x"], g["y"], "-", color=color, lw=0.8, alpha=0.6)
             ax.plot(g["x"].iloc[0], g["y"].iloc[0], "s" if is_t else "o", color=color, mfc="none", ms=7)
             ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "s" if is_t else "o", color=color, ms=7,
@@ -257,7 +257,7 @@ def figure_paired(params, inputs, outputs):
     for ax, target in zip(axes[0], targets):
         for i, (kind, g) in enumerate(pe[pe["target"] == target].groupby("filter_a", sort=False)):
             g = g.sort_values("gamma_ratio")
-            ax.errorbar(g["gamma_ratio"], g["mean_diff"], yerr=2 * g["se"], fmt="o-", color=f"C{i}", capsize=3,
+            ax.errorbar(g["gamma_ratio"], g["mean_diff"], yerr=2 * g["se"], fmt="o-", color=palette(i), capsize=3,
                         label=kind)
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xscale("log")
@@ -294,7 +294,7 @@ def figure_loop_variants(params, inputs, outputs):
     same = lv[lv["comparison"] == "same_paths"].set_index("loop")
     loops = list(same.index)
     x = np.arange(len(loops))
-    ax.bar(x, same["mean_diff"], width=0.6, yerr=zc * same["se"], capsize=2, color="C0")
+    ax.bar(x, same["mean_diff"], width=0.6, yerr=zc * same["se"], capsize=2, color=OKABE_ITO["blue"])
     ax.axhline(0.0, color="k", lw=0.8)
     ax.set_xticks(x)
     ax.set_xticklabels([f"{_loop_label(lp)}\n{r.connected_fraction:.0%} / {r.topology_changes:.0f}"
@@ -303,8 +303,8 @@ def figure_loop_variants(params, inputs, outputs):
     ax.set_title(f"(a) closed loops, each on its own paths (+- {zc:.2f} SE);\nunder the labels: connected fraction / "
                  "topology changes per run", fontsize=8)
     ax = axes[0][1]
-    ax.plot(x, same["error_b"], "o-", color="C0", label="local filters (the baseline moves with the loop)")
-    ax.plot(x, same["error_a"], "s-", color="C3", label="decentralized filter")
+    ax.plot(x, same["error_b"], "o-", color=OKABE_ITO["blue"], label="local filters (the baseline moves with the loop)")
+    ax.plot(x, same["error_a"], "s-", color=OKABE_ITO["vermillion"], label="decentralized filter")
     ax.set_xticks(x)
     ax.set_xticklabels([_loop_label(lp) for lp in loops], fontsize=6.5, rotation=30, ha="right")
     ax.set_ylabel("late error |x_hat - x| (mean over runs)")
@@ -322,7 +322,7 @@ def figure_loop_variants(params, inputs, outputs):
                 continue
             g = g.set_index("design").reindex(designs)
             k = 0 if loop == "pi" else 1
-            ax.bar(xd + 0.38 * (k - 0.5), g["mean_diff"], width=0.36, yerr=zs * g["se"], capsize=2, color=f"C{k + 1}",
+            ax.bar(xd + 0.38 * (k - 0.5), g["mean_diff"], width=0.36, yerr=zs * g["se"], capsize=2, color=palette(k + 1),
                    label=f"on the {'PI' if loop == 'pi' else 'local'} loop's paths (local {g['error_b'].iloc[0]:.3f})")
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xticks(xd)
@@ -339,7 +339,8 @@ def figure_loop_variants(params, inputs, outputs):
         for j, setting in enumerate(settings):
             g = sysm[sysm["setting"] == setting].set_index("design").reindex(cd)
             ax.bar(np.arange(len(cd)) + width * (j - (len(settings) - 1) / 2), g["mean_diff"], width=width * 0.95,
-                   yerr=zs * g["se"], capsize=1.5, color=f"C{j}", label=setting)
+                   yerr=zs * g["se"], capsize=1.5, color=palette(j), label=setting,
+                   hatch=None if j < 4 else ("//", "\\\\", "xx", "..")[(j - 4) % 4])  # past 4: colours close, hatched
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xticks(np.arange(len(cd)))
         ax.set_xticklabels(cd, fontsize=7)
@@ -365,10 +366,10 @@ def figure_kalman_best(params, inputs, outputs):
         sub = kb[kb["target"] == target]
         for i, (kind, g) in enumerate(sub.groupby("kind", sort=False)):
             w = g[~g["comparison"].str.startswith("best")].sort_values("W_factor_b")
-            ax.errorbar(w["W_factor_b"], w["mean_diff"], yerr=2 * w["se"], fmt="o-", color=f"C{i}", capsize=3,
+            ax.errorbar(w["W_factor_b"], w["mean_diff"], yerr=2 * w["se"], fmt="o-", color=palette(i), capsize=3,
                         label=f"{kind}: gamma = 3 vs Kalman(W_f)")
             b = g[g["comparison"].str.startswith("best")].iloc[0]
-            ax.errorbar([b["W_factor_b"]], [b["mean_diff"]], yerr=[2 * b["se"]], fmt="*", ms=11, color=f"C{i}",
+            ax.errorbar([b["W_factor_b"]], [b["mean_diff"]], yerr=[2 * b["se"]], fmt="*", ms=11, color=palette(i),
                         capsize=3, label=f"{kind}: best vs best ({b['label_a']} vs W_f = {b['W_factor_b']:g})")
         ax.axhline(0.0, color="k", lw=0.8)
         ax.set_xscale("log")  # W_f from 1 to 50 x W
@@ -395,9 +396,9 @@ def figure_fig6_paths(params, inputs, outputs):
                 ax.plot(g["x"], g["y"], color="0.3", lw=0.8)
                 ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "ks", ms=6)
             else:
-                ax.plot(g["x"], g["y"], color=f"C{int(who)}", lw=0.7)
-                ax.plot(g["x"].iloc[0], g["y"].iloc[0], "o", mfc="none", color=f"C{int(who)}", ms=6)
-                ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "o", color=f"C{int(who)}", ms=6)
+                ax.plot(g["x"], g["y"], color=palette(int(who)), lw=0.7)
+                ax.plot(g["x"].iloc[0], g["y"].iloc[0], "o", mfc="none", color=palette(int(who)), ms=6)
+                ax.plot(g["x"].iloc[-1], g["y"].iloc[-1], "o", color=palette(int(who)), ms=6)
         r = table.loc[variant]
         ax.set_title(f"{variant}\nreversals {r['reversal_fraction']:.2%} of step pairs, {r['clipped_fraction']:.0%} "
                      "of steps clipped", fontsize=8)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...io import read_table
-from ...plotting import new_figure, save_figure
+from ...plotting import OKABE_ITO, new_figure, save_figure
 
 __all__ = ["figure_bounds", "figure_region", "figure_estimators", "figure_stationary"]
 
@@ -26,8 +26,8 @@ def figure_bounds(params, inputs, outputs):
     else:
         fig, ax = new_figure()
     k = data["k"]
-    curves = (("r", "-", "C3", "upper bound $r_k$ (9)"), ("s", "-", "C0", "lower bound $s_k$ (10)"),
-              ("report_estimate", "--", "C2", "report's estimate (corrected)"))
+    curves = (("r", "-", OKABE_ITO["vermillion"], "upper bound $r_k$ (9)"), ("s", "-", OKABE_ITO["blue"], "lower bound $s_k$ (10)"),
+              ("report_estimate", "--", OKABE_ITO["bluish_green"], "report's estimate (corrected)"))
     for col, style, color, label in curves:
         ax.plot(k, data[col], style, color=color, label=label)
     ax.fill_between(k, data["mean_lo"], data["mean_hi"], color="k", alpha=0.2, lw=0)
@@ -57,13 +57,13 @@ def figure_region(params, inputs, outputs):
     region = read_table(inputs["region"])
     dense = read_table(inputs["closed_form"]).sort_values("lambda1")
     fig, ax = new_figure(figsize=(5.0, 4.2))
-    ax.plot(dense["lambda1"], dense["lambda2c_lower"], "-", color="C0",
+    ax.plot(dense["lambda1"], dense["lambda2c_lower"], "-", color=OKABE_ITO["blue"],
             label="lower bound $\\lambda_{2c}^{lower}$ (closed form)")
     if params["show_upper"]:
-        ax.plot(region["lambda1"], region["lambda2c_upper"], "o", mfc="none", color="C3", ms=4,
+        ax.plot(region["lambda1"], region["lambda2c_upper"], "o", mfc="none", color=OKABE_ITO["vermillion"], ms=4,
                 label="LMI upper bound $\\lambda_{2c}^{upper}$ (bisection)")
         sim = read_table(inputs["simulation"])
-        for side, marker, color, word in (("stable", "^", "C2", "bounded"), ("unstable", "v", "C1", "diverges")):
+        for side, marker, color, word in (("stable", "^", OKABE_ITO["bluish_green"], "bounded"), ("unstable", "v", OKABE_ITO["orange"], "diverges")):
             pt = sim[sim["side"] == side].iloc[0]
             ax.plot(pt["lambda1"], pt["lambda2"], marker, color=color, ms=8,
                     label=f"check point, exact $E(p_k)$: {word}")
@@ -92,11 +92,11 @@ def figure_estimators(params, inputs, outputs):
         cover = {name: float(np.mean((late[f"{name}_lo"] <= late["exact_mean"])
                                      & (late["exact_mean"] <= late[f"{name}_hi"])))
                  for name in ("cond", "plain")}
-        ax.fill_between(d["k"], d["cond_lo"], d["cond_hi"], color="C0", alpha=0.3, lw=0)
-        ax.plot(d["k"], d["cond_mean"], "-", color="C0",
+        ax.fill_between(d["k"], d["cond_lo"], d["cond_hi"], color=OKABE_ITO["blue"], alpha=0.3, lw=0)
+        ax.plot(d["k"], d["cond_mean"], "-", color=OKABE_ITO["blue"],
                 label=f"conditional estimator (nominal 95 % band, covers {cover['cond']:.0%} of k)")
-        ax.fill_between(d["k"], d["plain_lo"], d["plain_hi"], color="C3", alpha=0.2, lw=0)
-        ax.plot(d["k"], d["plain_mean"], "--", color="C3",
+        ax.fill_between(d["k"], d["plain_lo"], d["plain_hi"], color=OKABE_ITO["vermillion"], alpha=0.2, lw=0)
+        ax.plot(d["k"], d["plain_mean"], "--", color=OKABE_ITO["vermillion"],
                 label=f"plain sample mean (nominal 95 % band, covers only {cover['plain']:.0%} of k)")
         ax.plot(e["k"], e["mean_exact"], "k.", ms=4, label="exact")
         ax.set_yscale("log")
@@ -113,13 +113,13 @@ def figure_stationary(params, inputs, outputs):
     curve = read_table(inputs["curve"]).sort_values("lam")
     fig, (ax, ax_t) = new_figure(1, 2, figsize=(11.0, 4.0))
     lam = curve["lam"]
-    ax.plot(lam, curve["r_limit"], "-", color="C3", label="$r^*$ (fixed point of (9))")
+    ax.plot(lam, curve["r_limit"], "-", color=OKABE_ITO["vermillion"], label="$r^*$ (fixed point of (9))")
     ax.plot(lam, curve["stationary_mean"], "k-", lw=2, label="$E(p_\\infty)$ (exact)")
-    ax.plot(lam, curve["s_limit"], "-", color="C0", label="$s^* = R_1 / (1 - (1 - \\lambda) a^2)$")
+    ax.plot(lam, curve["s_limit"], "-", color=OKABE_ITO["blue"], label="$s^* = R_1 / (1 - (1 - \\lambda) a^2)$")
     infinite_var = curve[~curve["variance_finite"].astype(bool)]
     for a_ in (ax, ax_t):
         if len(infinite_var):
-            a_.axvspan(lam.min(), infinite_var["lam"].max(), color="C1", alpha=0.12, lw=0,
+            a_.axvspan(lam.min(), infinite_var["lam"].max(), color=OKABE_ITO["orange"], alpha=0.12, lw=0,
                        label="variance of $p_\\infty$ infinite")
     if "report_setting" in curve:
         for _, row in curve[curve["report_setting"].astype(bool)].iterrows():
@@ -134,8 +134,8 @@ def figure_stationary(params, inputs, outputs):
     ax.legend(fontsize=8)
     finite = curve[np.isfinite(curve["tail_index"])]
     ax_t.plot(finite["lam"], finite["tail_index"], "k-", label="tail index $\\alpha = \\log(1/(1-\\lambda)) / \\log a^2$")
-    ax_t.axhline(1.0, color="C0", ls="--", lw=1, label="$\\alpha = 1$: mean finite above")
-    ax_t.axhline(2.0, color="C3", ls="--", lw=1, label="$\\alpha = 2$: variance finite above")
+    ax_t.axhline(1.0, color=OKABE_ITO["blue"], ls="--", lw=1, label="$\\alpha = 1$: mean finite above")
+    ax_t.axhline(2.0, color=OKABE_ITO["vermillion"], ls="--", lw=1, label="$\\alpha = 2$: variance finite above")
     ax_t.set_xlabel("$\\lambda$")
     ax_t.set_ylabel("tail index of $p_\\infty$")
     ax_t.set_title("$P(p_\\infty > x) \\sim x^{-\\alpha}$")

@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ...plotting import new_figure, save_figure
+from ...plotting import COLOURS, OKABE_ITO, new_figure, save_figure
 
 __all__ = ["figure_plane", "figure_path", "figure_mean", "figure_estimators", "figure_curves"]
 
 
-_COLORS = {"bounded": "#2ca02c", "unbounded": "#d62728", "undecided": "#bbbbbb"}
+# the stability map: colour and shape, so the verdicts are told apart without colour vision too
+_MAP_STYLE = {"bounded": (COLOURS["bounded"], "o"), "unbounded": (COLOURS["unbounded"], "x"),
+              "undecided": (COLOURS["undecided"], "s")}
 
 
 def figure_plane(params, inputs, outputs):
@@ -22,26 +24,26 @@ def figure_plane(params, inputs, outputs):
     fig, axes = new_figure(1, len(names), figsize=(5.2 * len(names), 4.6), squeeze=False)
     for ax, name in zip(axes[0], names):
         s = smap[smap.example == name]
-        for verdict, color in _COLORS.items():
+        for verdict, (color, marker) in _MAP_STYLE.items():
             sub = s[s.verdict == verdict]
-            ax.scatter(sub.q, sub.p, s=7, marker="s", color=color, alpha=0.55, linewidths=0,
+            ax.scatter(sub.q, sub.p, s=7, marker=marker, color=color, alpha=0.55, linewidths=0.8 if marker == "x" else 0,
                        label=f"map: E||P_k|| {verdict}")
         c = curves[curves.example == name]
-        ax.plot(c.q, c.p_thm5, color="k", lw=2, label="Theorem 5 lower bound p(q)")
-        ax.plot(c.q, c.p_prop1, color="tab:blue", lw=1.5, ls="--", label="Proposition 1 (eq. 8)")
+        ax.plot(c.q, c.p_thm5, color=COLOURS["exact"], lw=2, label="Theorem 5 lower bound p(q)")
+        ax.plot(c.q, c.p_prop1, color=OKABE_ITO["blue"], lw=1.5, ls=":", label="Proposition 1 (eq. 8)")
         if c.p_reference.notna().any():
             # drawn last and on top: in Example II it coincides with the Theorem 5 curve
-            ax.plot(c.q, c.p_reference, color="magenta", lw=1.6, ls=(0, (2, 2)), zorder=5,
+            ax.plot(c.q, c.p_reference, color=COLOURS["reference"], lw=1.6, ls=(0, (2, 2)), zorder=5,
                     label="reference p_c (dashed on top; = Theorem 5 in Example II)")
         qn = c.q_necessary.iloc[0]
-        ax.axvline(qn, color="tab:orange", lw=1.5, label="necessary |lambda|^2(1-q) = 1 (q in each panel)")
-        ax.annotate(f"q = {qn:.3f}", (qn, 0.92), xytext=(4, 0), textcoords="offset points", color="tab:orange",
+        ax.axvline(qn, color=COLOURS["threshold"], lw=1.5, label="necessary |lambda|^2(1-q) = 1 (q in each panel)")
+        ax.annotate(f"q = {qn:.3f}", (qn, 0.92), xytext=(4, 0), textcoords="offset points", color=COLOURS["threshold"],
                     fontsize=8, bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.9))
         ax.plot([0, 1], [1, 0], color="0.3", lw=1, ls="-.", label="i.i.d. line p + q = 1")
         r = iid.loc[name]
         ax.plot([r.q_thm5_on_iid_line], [1 - r.q_thm5_on_iid_line], "k*", ms=10, label="Thm 5 on the i.i.d. line")
-        ax.plot([r.lambda_lmi_upper], [1 - r.lambda_lmi_upper], "bv", ms=7, label="Sinopoli LMI bound")
-        ax.plot([r.lambda_lower], [1 - r.lambda_lower], "b^", ms=7, label="Sinopoli lower bound")
+        ax.plot([r.lambda_lmi_upper], [1 - r.lambda_lmi_upper], "v", color=OKABE_ITO["blue"], ms=7, label="Sinopoli LMI bound")
+        ax.plot([r.lambda_lower], [1 - r.lambda_lower], "^", color=OKABE_ITO["blue"], ms=7, label="Sinopoli lower bound")
         ax.set_xlim(0, 1)
         ax.set_ylim(0, 1.02)
         ax.set_xlabel("recovery rate q")
@@ -53,10 +55,10 @@ def figure_plane(params, inputs, outputs):
 
 
 _METHOD_STYLE = {
-    "exact": dict(color="tab:orange", lw=2.5, ls="-", label="E||P_k|| exact (all channel paths)"),
-    "estimate_conditional": dict(color="tab:red", lw=1.5, ls="-",
+    "exact": dict(color=OKABE_ITO["orange"], lw=2.5, ls="-", label="E||P_k|| exact (all channel paths)"),
+    "estimate_conditional": dict(color=OKABE_ITO["vermillion"], lw=1.5, ls="-.",
                                  label="E||P_k|| conditional estimator (validated, 95% CI)"),
-    "asymptote": dict(color="tab:purple", lw=1.5, ls="--", label="E||P_k|| continued with the derived rate (bracket)"),
+    "asymptote": dict(color=OKABE_ITO["bluish_green"], lw=1.5, ls="--", label="E||P_k|| continued with the derived rate (bracket)"),
 }
 
 
@@ -72,10 +74,10 @@ def _draw_expectations(ax, x):
     lim = x[(x.method == "asymptote") & np.isfinite(x.limit.astype(float))] if "limit" in x else x.iloc[:0]
     if len(lim):
         r = lim.iloc[0]
-        ax.axhline(r.limit, color="tab:purple", lw=1.2, ls="-.",
+        ax.axhline(r.limit, color=_METHOD_STYLE["asymptote"]["color"], lw=1.2, ls="-.",
                    label=f"stable limit of E||P_k|| (derived rate): {r.limit:.4g} [{r.limit_lo:.4g}, {r.limit_hi:.4g}]")
         if np.isfinite([r.limit_lo, r.limit_hi]).all():
-            ax.axhspan(r.limit_lo, r.limit_hi, color="tab:purple", alpha=0.1, lw=0)
+            ax.axhspan(r.limit_lo, r.limit_hi, color=_METHOD_STYLE["asymptote"]["color"], alpha=0.1, lw=0)
     bad = x[x.method == "not_trustworthy"]
     if len(bad):
         ax.axvspan(bad.k.min(), bad.k.max(), color="0.85", alpha=0.5, label="E||P_k|| not trustworthy (omitted)")
@@ -86,14 +88,14 @@ def _failed_estimates(ax, t, x, plain=False):
     trusted = set(x.k[x.method == "estimate_conditional"]) | set(x.k[x.method == "exact"])
     rb = t[t.rb_mean.notna()]
     if not set(x.method) & {"estimate_conditional"}:
-        ax.plot(rb.k, rb.rb_mean, color="tab:red", lw=0.9, ls=":",
+        ax.plot(rb.k, rb.rb_mean, color=OKABE_ITO["vermillion"], lw=0.9, ls=":",
                 label="conditional estimator: misses the parity heavy tail (not used)")
     else:
         rb = rb[~rb.k.isin(trusted)]
         if len(rb):
-            ax.plot(rb.k, rb.rb_mean, color="tab:red", lw=0.9, ls=":", label="conditional estimator (not validated)")
+            ax.plot(rb.k, rb.rb_mean, color=OKABE_ITO["vermillion"], lw=0.9, ls=":", label="conditional estimator (not validated)")
     if plain:
-        ax.plot(t.k, t.plain_mean, color="tab:blue", lw=0.9, ls="--",
+        ax.plot(t.k, t.plain_mean, color=OKABE_ITO["blue"], lw=0.9, ls="--",
                 label="plain sample mean: misses the heavy tail (not used)")
 
 
@@ -103,8 +105,8 @@ def figure_path(params, inputs, outputs):
     t = t[t.figure == params["figure"]]
     x = _setting(inputs, t)
     fig, (ax, ax2) = new_figure(2, 1, figsize=(6.4, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
-    ax.fill_between(t.k, t.q05, t.q95, color="tab:blue", alpha=0.15, label="5-95% of ||P_k|| (Monte Carlo)")
-    ax.plot(t.k, t.q50, color="tab:blue", lw=1, ls="--", label="median")
+    ax.fill_between(t.k, t.q05, t.q95, color=OKABE_ITO["blue"], alpha=0.15, label="5-95% of ||P_k|| (Monte Carlo)")
+    ax.plot(t.k, t.q50, color=OKABE_ITO["blue"], lw=1, ls="--", label="median")
     ax.plot(t.k, t.norm_path, color="k", lw=1.2, label="one sample path ||P_k||")
     _draw_expectations(ax, x)
     _failed_estimates(ax, t, x)
@@ -160,13 +162,13 @@ def figure_estimators(params, inputs, outputs):
         ok = x.method.reindex(tf.k).fillna("not_trustworthy").to_numpy()
         lo = (x.lo.reindex(tf.k) / x.mean_norm.reindex(tf.k)).to_numpy()
         hi = (x.hi.reindex(tf.k) / x.mean_norm.reindex(tf.k)).to_numpy()
-        ax.fill_between(tf.k, lo, hi, color="tab:purple", alpha=0.2, lw=0, label="trusted value: interval / bracket")
-        ax.plot(tf.k, tf.plain_mean.to_numpy() / ref, color="tab:blue", lw=1, label="plain sample mean / trusted")
-        ax.plot(tf.k, tf.rb_mean.to_numpy() / ref, color="tab:red", lw=1, label="conditional estimator / trusted")
+        ax.fill_between(tf.k, lo, hi, color=OKABE_ITO["reddish_purple"], alpha=0.2, lw=0, label="trusted value: interval / bracket")
+        ax.plot(tf.k, tf.plain_mean.to_numpy() / ref, color=OKABE_ITO["blue"], lw=1, ls="--", label="plain sample mean / trusted")
+        ax.plot(tf.k, tf.rb_mean.to_numpy() / ref, color=OKABE_ITO["vermillion"], lw=1, ls=":", label="conditional estimator / trusted")
         for method, style in _METHOD_STYLE.items():
             sel = ok == method
             if sel.any():
-                ax.plot(tf.k[sel], np.ones(sel.sum()), color=style["color"], lw=3, alpha=0.6,
+                ax.plot(tf.k[sel], np.ones(sel.sum()), color=style["color"], ls=style["ls"], lw=3, alpha=0.6,
                         label=f"trusted by: {method}")
         ax.axhline(1.0, color="k", lw=0.5)
         ax.set_yscale("log")
@@ -182,7 +184,7 @@ def figure_curves(params, inputs, outputs):
     """Fig. S2: uncapped Proposition 1 and Theorem 5 bounds (log scale) with the reference critical values p_c."""
     curves = pd.read_csv(inputs["curves"])
     fig, ax = new_figure()
-    for name, color in zip(params["examples"], ("tab:blue", "tab:green", "tab:red")):
+    for name, color in zip(params["examples"], (OKABE_ITO["blue"], OKABE_ITO["bluish_green"], OKABE_ITO["vermillion"])):
         c = curves[curves.example == name]
         ax.plot(c.q, c.p_thm5_uncapped, color=color, lw=2, label=f"Ex {name}: Theorem 5 (uncapped)")
         ax.plot(c.q, c.p_prop1_uncapped, color=color, lw=1, ls="--", label=f"Ex {name}: Proposition 1")

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...plotting import new_figure, save_figure
+from ...plotting import OKABE_ITO, new_figure, palette, save_figure
 
 __all__ = ["figure_rho_sl", "figure_rho_s_f", "figure_estimator", "figure_convergence", "figure_lag",
            "figure_estimator_ratios"]
@@ -41,7 +41,7 @@ def figure_rho_sl(params, inputs, outputs):
             ax.plot(g["snr_db"], g["rho_sl_db"], color="k", lw=1.2, ls="--", marker="o", mfc="none", ms=4,
                     markevery=(5, 10), zorder=5, label=lab)
             continue
-        ax.plot(g["snr_db"], g["rho_sl_db"], color=f"C{i}", lw=2.0 if main else 1.0, ls="-" if main else ":",
+        ax.plot(g["snr_db"], g["rho_sl_db"], color=palette(i), lw=2.0 if main else 1.0, ls="-" if main else ":",
                 marker="s" if not main else None, ms=3, markevery=(0, 10), label=lab)
     ax.axhline(5 * math.log10(2 / math.pi), color="0.5", lw=0.8, ls="-.", label=r"$\sqrt{2/\pi}$ (-0.98 dB)")
     ax.set_xlabel(r"SNR = $\sigma^2_{\theta,\infty}/\sigma^2_\eta$ [dB]")
@@ -57,16 +57,16 @@ def figure_rho_s_f(params, inputs, outputs):
     rat = pd.read_csv(inputs["ratios"])
     fig, ax = _new_fig()
     finite = sorted(a for a in rat["alpha"].unique() if a != 1.0)
-    style = {a: dict(s=c_s, f=c_f, marker=mk) for a, c_s, c_f, mk in zip(finite, ("C9", "C2", "C4"), ("C1", "C6", "C5"),
+    style = {a: dict(s=c_s, f=c_f, marker=mk) for a, c_s, c_f, mk in zip(finite, (OKABE_ITO["sky_blue"], OKABE_ITO["bluish_green"], OKABE_ITO["reddish_purple"]), (OKABE_ITO["orange"], OKABE_ITO["reddish_purple"], OKABE_ITO["yellow"]),
                                                                       ("^", "s", "D"))}
     for alpha, g in rat.groupby("alpha"):
         lim = alpha == 1.0
         lab = _alpha_label(alpha)
         st = style.get(alpha, {})
         kw = dict(lw=2.0, ls="-") if lim else dict(lw=0.9, ls=":", marker=st["marker"], ms=4, markevery=(0, 8))
-        ax.plot(g["snr_db"], g["rho_s_db"], color="C0" if lim else st["s"], label=rf"$\rho_S$, {lab}", **kw)
+        ax.plot(g["snr_db"], g["rho_s_db"], color=OKABE_ITO["blue"] if lim else st["s"], label=rf"$\rho_S$, {lab}", **kw)
         kw = dict(kw, markevery=(4, 8)) if not lim else kw
-        ax.plot(g["snr_db"], g["rho_f_db"], color="C3" if lim else st["f"], label=rf"$\rho_F$, {lab}",
+        ax.plot(g["snr_db"], g["rho_f_db"], color=OKABE_ITO["vermillion"] if lim else st["f"], label=rf"$\rho_F$, {lab}",
                 **(kw if lim else dict(kw, mfc="none")))
     ax.axhline(0.0, color="k", lw=0.8)
     ax.axhline(10 * math.log10(2 * math.sqrt(2 / math.pi)), color="k", lw=0.8, ls="--", label="+2.03 dB")
@@ -85,8 +85,8 @@ def figure_estimator(params, inputs, outputs):
         est = est[est["case_set"] == "grid"]       # the crossing SNRs are shown in Fig S4
     est = est[est["alpha"] == est["alpha"].max()]  # the simulated alpha closest to one
     fig, (ax, ax2) = new_figure(1, 2, figsize=(10.0, 4.0))
-    styles = {"filter_1bit": ("C3", "o"), "smoother_1bit": ("C0", "s"), "kalman_filter": ("C1", "^"),
-              "rts_smoother": ("C2", "v")}
+    styles = {"filter_1bit": (OKABE_ITO["vermillion"], "o"), "smoother_1bit": (OKABE_ITO["blue"], "s"), "kalman_filter": (OKABE_ITO["orange"], "^"),
+              "rts_smoother": (OKABE_ITO["bluish_green"], "v")}
     for i, (kind, g) in enumerate(est.groupby("kind", sort=False)):
         col, mk = styles[kind]
         x = g["snr_db"] + 0.3 * (i - 1.5)
@@ -116,8 +116,10 @@ def figure_convergence(params, inputs, outputs):
         sub = tr[tr["alpha"] == alpha]
         for j, (snr, g) in enumerate(sub.groupby("snr_db")):
             g = g[g["k"] > 0]
-            ax.loglog(g["k"], np.abs(g["j_f_q_ratio"] - 1) + 1e-17, color=f"C{j}", label=f"{snr:g} dB")
-            ax.loglog(g["k"], np.abs(g["var_ratio"] - 1) + 1e-17, color=f"C{j}", ls=":")
+            # past the fourth SNR the palette's colours come close under colour vision deficiencies: dashed
+            ax.loglog(g["k"], np.abs(g["j_f_q_ratio"] - 1) + 1e-17, color=palette(j), ls="-" if j < 4 else "--",
+                      label=f"{snr:g} dB")
+            ax.loglog(g["k"], np.abs(g["var_ratio"] - 1) + 1e-17, color=palette(j), ls=":")
         ax.set_xlabel("k")
         ax.set_title(_alpha_label(alpha), fontsize=9)
         ax.set_ylim(1e-16, 1e4)
@@ -134,9 +136,9 @@ def figure_lag(params, inputs, outputs):
     lag = pd.read_csv(inputs["lag"])
     fig, ax = _new_fig(figsize=(9.0, 4.0))
     for i, (alpha, g) in enumerate(lag.groupby("alpha")):
-        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", color=f"C{i}", label=_alpha_label(alpha))
+        ax.semilogy(g["snr_db"], g["delta_needed"], marker=".", color=palette(i), label=_alpha_label(alpha))
         if "delta_break_even" in g:
-            ax.semilogy(g["snr_db"], g["delta_break_even"], ls="--", color=f"C{i}",
+            ax.semilogy(g["snr_db"], g["delta_break_even"], ls="--", color=palette(i),
                         label=rf"break-even $\Delta$ ($J_{{k|k+\Delta,q}} > J_{{k|k,\infty}}$), {_alpha_label(alpha)}")
     if "crossing" in inputs:   # where the real smoother no longer breaks even: its rho_S = 0 dB crossing (issue 37)
         cr = pd.read_csv(inputs["crossing"]).set_index(["alpha", "curve"])["snr_db_crossing"]
@@ -144,8 +146,8 @@ def figure_lag(params, inputs, outputs):
             if (alpha, "estimate") not in cr.index or not np.isfinite(cr[(alpha, "estimate")]):
                 continue
             e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
-            ax.axvspan(lo, hi, color=f"C{i}", alpha=0.15, lw=0)
-            ax.axvline(e, color=f"C{i}", lw=1.2, ls="-.",
+            ax.axvspan(lo, hi, color=palette(i), alpha=0.15, lw=0)
+            ax.axvline(e, color=palette(i), lw=1.2, ls="-.",
                        label=rf"real 1-bit smoother no longer breaks even: {e:.2f} dB [{lo:.2f}, {hi:.2f}], "
                              rf"{_alpha_label(alpha)}")
     ax.set_xlabel("SNR [dB]")
@@ -171,13 +173,19 @@ def figure_estimator_ratios(params, inputs, outputs):
     a_main = allrat["alpha"].max()
     rat = allrat[allrat["alpha"] == a_main]
     fig, ax = _new_fig(figsize=(10.0, 4.4))
-    colors = {"rho_F": "C3", "rho_S": "C0", "rho_SL": "C2"}
+    colors = {"rho_F": OKABE_ITO["vermillion"], "rho_S": OKABE_ITO["blue"], "rho_SL": OKABE_ITO["bluish_green"]}
     others = allrat[(allrat["alpha"] != a_main) & (allrat["quantity"] == "rho_S")]
-    for j, (alpha, g) in enumerate(others.groupby("alpha", sort=False)):
+    ranked = sorted(set(allrat["alpha"]) | set(cross_pts["alpha"]), reverse=True)
+
+    def alpha_colour(alpha):  # one colour per alpha, the main (largest) blue; apart under CVD (issue 41)
+        order = (OKABE_ITO["blue"], OKABE_ITO["orange"], OKABE_ITO["bluish_green"], OKABE_ITO["sky_blue"])
+        return order[ranked.index(alpha) % len(order)] if alpha in ranked else OKABE_ITO["reddish_purple"]
+
+    for alpha, g in others.groupby("alpha", sort=False):
         g = g.sort_values("snr_db")
         ax.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
-                    color=f"C{4 + j}", marker="s", mfc="none", ls="none", label=rf"$\rho_S$ from MSEs, $\alpha = {alpha:g}$")
-        ax.plot(g["snr_db"], g["bound_db"], color=f"C{4 + j}", lw=0.8, ls=":", label=rf"$\rho_S$ bound, $\alpha = {alpha:g}$")
+                    color=alpha_colour(alpha), marker="s", mfc="none", ls="none", label=rf"$\rho_S$ from MSEs, $\alpha = {alpha:g}$")
+        ax.plot(g["snr_db"], g["bound_db"], color=alpha_colour(alpha), lw=0.8, ls=":", label=rf"$\rho_S$ bound, $\alpha = {alpha:g}$")
     names = {"rho_F": r"$\rho_F$", "rho_S": r"$\rho_S$", "rho_SL": r"$\rho_{SL}$"}
     for i, (qty, g) in enumerate(rat.groupby("quantity", sort=False)):
         g = g.sort_values("snr_db")
@@ -185,8 +193,8 @@ def figure_estimator_ratios(params, inputs, outputs):
         ax.errorbar(x, g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
                     color=colors[qty], marker="o", ls="none", label=f"{names[qty]} from MSEs")
         ax.plot(g["snr_db"], g["bound_db"], color=colors[qty], lw=1.0, label=f"{names[qty]} bound (47)-(49)")
-    for j, (alpha, g) in enumerate(cross_pts[cross_pts["quantity"] == "rho_S"].groupby("alpha", sort=False)):
-        col = "C0" if alpha == a_main else "C4"
+    for alpha, g in cross_pts[cross_pts["quantity"] == "rho_S"].groupby("alpha", sort=False):
+        col = alpha_colour(alpha)
         ax.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
                     color=col, marker="x", ls="none", ms=5,
                     label=rf"$\rho_S$ at the crossing SNRs, $\alpha = {alpha:g}$ ({int(g['n_runs'].min())} runs)")
@@ -198,7 +206,7 @@ def figure_estimator_ratios(params, inputs, outputs):
                 xs = np.linspace(r.fit_snr_lo, r.fit_snr_hi, 60)
                 fits[r.alpha] = (xs, np.polyval([float(c) for c in str(r.coefs).split()], xs))
         for alpha, (xs, ys) in fits.items():
-            col = "C0" if alpha == a_main else "C4"
+            col = alpha_colour(alpha)
             ax.plot(xs, ys, color=col, lw=1.0, ls="--", label=rf"local fit of $\rho_S$, $\alpha = {alpha:g}$")
     lim = None
     if "bounds" in inputs:
@@ -211,7 +219,7 @@ def figure_estimator_ratios(params, inputs, outputs):
     if "crossing" in inputs:
         cr = pd.read_csv(inputs["crossing"]).set_index(["alpha", "curve"])["snr_db_crossing"]
         for alpha in sorted({a for a, _ in cr.index}, reverse=True):
-            col = "C0" if alpha == a_main else "C4" if alpha == sorted({a for a, _ in cr.index})[-2] else "C5"
+            col = alpha_colour(alpha)
             e, lo, hi = cr[(alpha, "estimate")], cr[(alpha, "lo")], cr[(alpha, "hi")]
             if np.isfinite(e):
                 ax.errorbar([e], [0.0], xerr=[[e - lo], [hi - e]], color=col, marker="D", ms=6, capsize=3, zorder=6,
@@ -225,7 +233,7 @@ def figure_estimator_ratios(params, inputs, outputs):
         lo_x, hi_x = cross_pts["snr_db"].min() - 1.2, cross_pts["snr_db"].max() + 0.7
         rs = rs[(rs["snr_db"] >= lo_x) & (rs["snr_db"] <= hi_x)]
         for alpha, g in rs.groupby("alpha"):
-            col = "C0" if alpha == a_main else "C4"
+            col = alpha_colour(alpha)
             ins.errorbar(g["snr_db"], g["estimate_db"], yerr=[g["estimate_db"] - g["lo_db"], g["hi_db"] - g["estimate_db"]],
                          color=col, marker="x", ls="none", ms=4, lw=0.8)
             if "crossing" in inputs:
