@@ -26,7 +26,7 @@ from pathlib import Path
 
 from .processes import RunningBuild, running_builds
 
-__all__ = ["damaged_outputs", "missing_outputs", "main", "summary_rows"]
+__all__ = ["damaged_outputs", "missing_outputs", "main", "split_options", "summary_rows"]
 
 INTERRUPTED = 130  # the shell's exit status after SIGINT
 # verify's statuses that mean "this output cannot be trusted or is gone" (netrepro.provenance.verify_tree)
@@ -72,6 +72,24 @@ def damaged_outputs(paths=("results", "figures"), stream=None) -> list[Path]:
         print(f"repair: {verdict.status}: {verdict.path} (removed, to rebuild)", file=stream)
         targets.append(Path(verdict.path))
     return targets
+
+
+def split_options(argv=None) -> tuple[list[str], list[str]]:
+    """A command line split at ``--``: the command's own arguments, then the options handed to Snakemake.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The command line without the program name (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    tuple of (list of str, list of str)
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if "--" not in argv:
+        return argv, []
+    return argv[: argv.index("--")], argv[argv.index("--") + 1:]
 
 
 def summary_rows(snakemake: list[str], options: list[str]) -> list[list[str]]:
@@ -199,11 +217,7 @@ def main(argv=None) -> int:
     int
         Snakemake's exit status; 130 after an interrupt; 1 when refused.
     """
-    argv = list(sys.argv[1:] if argv is None else argv)
-    options = []
-    if "--" in argv:
-        options = argv[argv.index("--") + 1:]
-        argv = argv[: argv.index("--")]
+    argv, options = split_options(argv)
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0])
     parser.add_argument("command", choices=["build", "repair", "unlock"])
     parser.add_argument("--make-target", default=None, help="what to tell the user to rerun (default: make COMMAND)")

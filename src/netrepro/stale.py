@@ -120,11 +120,9 @@ def main(argv=None) -> int:
     int
         0; 1 with ``--check`` when there are stale files; 2 when Snakemake cannot list the outputs.
     """
-    argv = list(sys.argv[1:] if argv is None else argv)
-    options = []
-    if "--" in argv:
-        options = argv[argv.index("--") + 1:]
-        argv = argv[: argv.index("--")]
+    from .build import split_options
+
+    argv, options = split_options(argv)
     parser = argparse.ArgumentParser(prog="python -m netrepro prune", description=__doc__.splitlines()[0])
     parser.add_argument("command", choices=["prune"])
     mode = parser.add_mutually_exclusive_group()
