@@ -162,16 +162,20 @@ def test_no_serious_accessibility_violation(built_repo, browser):  # noqa: F811
     browser.set_script_timeout(120)
     try:
         with serve(report) as base:
-            for name in pages:
-                load(browser, base + name)
-                axe = axe_selenium_python.Axe(browser)
-                axe.inject()
-                results = axe.run()
-                for v in results["violations"]:
-                    if v["impact"] in ("serious", "critical"):
-                        targets = [n["target"] for n in v["nodes"][:3]]
-                        problems.append(f"{name}: {v['id']} ({v['impact']}, {len(v['nodes'])} nodes): "
-                                        f"{v['help']} {targets}")
+            for scheme in ("light", "dark"):  # the dark palette's contrasts too
+                browser.execute_cdp_cmd("Emulation.setEmulatedMedia",
+                                        {"features": [{"name": "prefers-color-scheme", "value": scheme}]})
+                for name in pages:
+                    load(browser, base + name)
+                    axe = axe_selenium_python.Axe(browser)
+                    axe.inject()
+                    results = axe.run()
+                    for v in results["violations"]:
+                        if v["impact"] in ("serious", "critical"):
+                            targets = [n["target"] for n in v["nodes"][:3]]
+                            problems.append(f"{name} ({scheme}): {v['id']} ({v['impact']}, {len(v['nodes'])} "
+                                            f"nodes): {v['help']} {targets}")
     finally:
+        browser.execute_cdp_cmd("Emulation.setEmulatedMedia", {"features": []})
         browser.execute_cdp_cmd("Page.setBypassCSP", {"enabled": False})
     assert not problems, "\n".join(problems)

@@ -358,7 +358,7 @@ def scorecard_html(score: pd.DataFrame, papers: dict, explore: bool = False, pag
         n = max(int(row["testable"]), 1)
         item = {"paper": slug, "title": None, "n": {k: int(row[k]) for k in counted},
                 "share": "" if pd.isna(row["scored_reproduced_pct"]) else f'{row["scored_reproduced_pct"]:.1f} %',
-                "bar": [(v, int(row[v]), f"{160 * int(row[v]) / n:.1f}") for v in TESTABLE_VERDICTS if int(row[v])]}
+                "bar": [(v, int(row[v]), f"{120 * int(row[v]) / n:.1f}") for v in TESTABLE_VERDICTS if int(row[v])]}
         if spec is not None:
             recon = read_csv(spec["reconstructions"]) if spec.get("reconstructions") else None
             figs = spec.get("figures", [])
