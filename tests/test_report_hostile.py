@@ -62,7 +62,7 @@ def assert_inert(page: str, name: str) -> None:
     assert live.scripts == [] and live.handlers == [], name
     assert [h for h in live.hrefs if not link_allowed(h)] == [], name
     assert len(live.policies) == 1 and "script-src 'none'" in live.policies[0], name
-    assert_shown(live, name)
+    assert_shown(live, page, name)
 
 
 def assert_index_runs_only_its_explorer(page: str) -> None:
@@ -78,7 +78,7 @@ def assert_index_runs_only_its_explorer(page: str) -> None:
     assert "PWNED" not in "".join(a for _, a in inline_scripts(page))
 
 
-def assert_shown(live: LivePage, name: str) -> None:
+def assert_shown(live: LivePage, page: str, name: str) -> None:
     text = "".join(live.text)
     assert 'document.title = "PWNED"' in text, name  # shown, as text
     assert ".. include:: /etc/passwd" in text and "root:x:0:0" not in page, name
