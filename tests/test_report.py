@@ -168,3 +168,20 @@ def test_source_pages_made_ahead_are_linked_not_remade(tmp_path, monkeypatch):
     fresh.source_link("pkg/c.py")
     fresh.write()
     assert (tmp_path / "other/source/pkg/c.py.html").read_text() == source_page("pkg/c.py", "y = 3\n")
+
+
+def test_a_notebook_page_is_titled_by_its_paper_and_shows_its_parameters_once():
+    import nbformat.v4 as nbf
+
+    from netrepro.report.notebooks import _cells, page_notebook
+
+    nb = nbf.new_notebook(cells=_cells("markov"))
+    injected = nbf.new_code_cell('# Parameters\nslug = "markov"\nroot = "."')
+    injected.metadata["tags"] = ["injected-parameters"]
+    nb.cells.insert(1, injected)
+    page_notebook(nb, "markov", title="A title")
+    assert nb.metadata["title"] == "markov: A title \u2014 notebook"
+    params = [c for c in nb.cells if 'root = "."' in c.source]
+    assert params == [injected]  # the values it ran with, once
+    plain = nbf.new_notebook(cells=_cells("markov"))  # not run by papermill: its parameters cell stays
+    assert len(page_notebook(plain, "markov", title="t").cells) == len(_cells("markov"))

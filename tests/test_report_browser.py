@@ -162,7 +162,7 @@ def test_report_in_headless_chromium(built_report, browser):
     with serve(report) as base:
         index_url = base + "index.html"
         state, problems = check_page(browser, index_url, base)
-        assert state["imgs"], "the report shows no image"
+        images = len(state["imgs"])  # the figures are on the papers' pages, linked from the index
 
         # Screenshot of the top of the report (test artefact).
         browser.execute_script("window.scrollTo(0, 0)")
@@ -175,7 +175,8 @@ def test_report_in_headless_chromium(built_report, browser):
         targets: dict[str, set[str]] = {}
         for url in internal_links(state, base):
             page, _, fragment = url.partition("#")
-            targets.setdefault(page, set()).add(fragment)
+            # "#explore?verdict=differs&paper=markov": the claims explorer (#explore) with its filters
+            targets.setdefault(page, set()).add(fragment.partition("?")[0])
         assert len(targets) > 1, "the report links to no other page"
         own_ids = set(state["ids"])
         for page, fragments in sorted(targets.items()):
@@ -194,14 +195,16 @@ def test_report_in_headless_chromium(built_report, browser):
             if page.endswith(".html"):
                 sub_state, sub_problems = check_page(browser, page, base)
                 problems += sub_problems
+                images += len(sub_state["imgs"])
                 ids = set(sub_state["ids"])
                 problems += [f"{page.removeprefix(base)}: link to missing anchor #{f}"
                              for f in fragments if f and f not in ids]
         assert not problems, "\n".join(problems)
+        assert images, "the report shows no image"
 
-        # The scorecard equals the claims tables (the CSVs and the tables shown on the page).
+        # The scorecard equals the claims tables (the CSVs and the tables shown on the papers' pages).
         load(browser, index_url)
-        shown = browser.execute_script("""
+        score = browser.execute_script("""
             const out = {};
             for (const tr of document.querySelectorAll('#scorecard-table tr[data-paper]')) {
                 const row = {};
@@ -211,15 +214,20 @@ def test_report_in_headless_chromium(built_report, browser):
                 }
                 out[tr.dataset.paper] = row;
             }
+            return out;
+        """)
+        tables = {}
+        for page in sorted(report.glob("paper-*.html")):
+            load(browser, base + page.name)
+            tables.update(browser.execute_script("""
             const tables = {};
             for (const t of document.querySelectorAll('table.claims[data-paper]')) {
                 tables[t.dataset.paper] = Array.from(t.querySelectorAll('tr.claim')).map(r => r.dataset.verdict);
             }
-            return {score: out, tables};
-        """)
+            return tables;
+            """))
     claims = {p.stem: pd.read_csv(p) for p in sorted((built_report / "results" / "claims").glob("*.csv"))}
     assert claims, "no claims table was built"
-    score, tables = shown["score"], shown["tables"]
     assert set(score) == set(claims) | {"total"}
     for slug, frame in claims.items():
         expected = {"claims": len(frame), **{v: int((frame["verdict"] == v).sum()) for v in VERDICTS}}
@@ -237,7 +245,8 @@ def test_every_figure_panel_names_an_existing_rule_and_function(built_report):
     from netrepro.runner import resolve
 
     rules = set(snakemake(built_report, "--list-rules").stdout.split())
-    text = (built_report / "report" / "index.html").read_text()
+    # every paper's page, where its figures are (report/paper-<slug>.html)
+    text = "".join(p.read_text() for p in sorted((built_report / "report").glob("paper-*.html")))
     panels = re.findall(r'<figure id="([^"]+)" data-figure="([^"]+)">.*?<div class="prov" data-rule="([^"]*)" '
                         r'data-source="([^"]*)" data-function="([^"]*)" data-line="([^"]*)"', text, re.S)
     figures = re.findall(r'<figure id="', text)

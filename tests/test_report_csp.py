@@ -126,3 +126,21 @@ def test_snakemakes_own_scripts_are_known_from_its_installed_template():
 
 def test_policy_text_keeps_the_order():
     assert policy_text({"a": ("x", "y"), "b": ("z",)}) == "a x y; b z"
+
+
+def test_a_page_with_its_own_script_allows_that_script_alone():
+    from netrepro.report.csp import page_policy
+    from netrepro.report.markup import script
+
+    explorer = str(script("explorer.js"))
+    policy = page_policy(explorer)
+    assert policy["script-src"] == (script_hash(explorer),) and page_policy()["script-src"] == ("'none'",)
+    assert {k: v for k, v in policy.items() if k != "script-src"} == {k: v for k, v in PAGE_POLICY.items()
+                                                                         if k != "script-src"}
+    page = render("index.html", css="", papers=[], run={"commit": "", "dirty": None, "config_hash": "x",
+                                                         "configfiles": [], "date": "", "machine": "", "platform": ""},
+                  versions={}, bench=None, scorecard="", scale="", references="", explorer="<section></section>",
+                  script=script("explorer.js"), csp=csp_meta(policy).split('content="')[1][:-2])
+    assert policy_of(page)["script-src"] == [script_hash(explorer)]
+    assert [text for _, text in inline_scripts(page)] == [explorer]  # the text hashed is the text the page holds
+    assert "'unsafe-inline'" not in policy_of(page)["script-src"]

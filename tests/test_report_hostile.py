@@ -4,8 +4,9 @@ from outside the checkout.
 In a scratch copy of the session's built repository: a figure caption with a raw-HTML script, an
 ``include`` of ``/etc/passwd`` and a ``javascript:`` link, and a provenance sidecar whose input is
 ``../../../etc/hostname``. The report rule refuses the sidecar naming it, and writes nothing outside
-``report/``; with the sidecar repaired, ``report/index.html`` and the paper's notebook page show
-the caption as inert text, under a content security policy that runs no script.
+``report/``; with the sidecar repaired, the paper's page ``report/paper-<slug>.html`` and its
+notebook page show the caption as inert text, under a content security policy that runs no script,
+and ``report/index.html`` runs its claims explorer alone (allowed by its hash).
 Snakemake's own report, sealed by ``relocate``, is checked on a small workflow of its own.
 """
 
@@ -61,6 +62,23 @@ def assert_inert(page: str, name: str) -> None:
     assert live.scripts == [] and live.handlers == [], name
     assert [h for h in live.hrefs if not link_allowed(h)] == [], name
     assert len(live.policies) == 1 and "script-src 'none'" in live.policies[0], name
+    assert_shown(live, page, name)
+
+
+def assert_index_runs_only_its_explorer(page: str) -> None:
+    """``report/index.html`` runs one script, its claims explorer, allowed by its hash alone."""
+    from netrepro.report.markup import script
+
+    live = LivePage(page)
+    assert live.handlers == [] and [h for h in live.hrefs if not link_allowed(h)] == []
+    assert [text for _, text in inline_scripts(page)] == [str(script("explorer.js"))]
+    assert len(live.policies) == 1
+    sources = dict((d.split()[0], d.split()[1:]) for d in live.policies[0].split("; "))
+    assert sources["script-src"] == [script_hash(str(script("explorer.js")))]
+    assert "PWNED" not in "".join(a for _, a in inline_scripts(page))
+
+
+def assert_shown(live: LivePage, page: str, name: str) -> None:
     text = "".join(live.text)
     assert 'document.title = "PWNED"' in text, name  # shown, as text
     assert ".. include:: /etc/passwd" in text and "root:x:0:0" not in page, name
@@ -108,7 +126,8 @@ def test_a_sidecar_pointing_outside_the_checkout_stops_the_report_and_nothing_is
 def test_the_hostile_caption_is_inert_text_in_the_report_and_the_notebook(hostile):
     base, work, _ = hostile
     run_snakemake(work, "-j2", "report/index.html", config=CONFIG)
-    assert_inert((work / "report" / "index.html").read_text(), "index.html")
+    assert_index_runs_only_its_explorer((work / "report" / "index.html").read_text())
+    assert_inert((work / "report" / f"paper-{PAPER}.html").read_text(), f"paper-{PAPER}.html")  # its figures' page
     assert_inert((work / "report" / f"{PAPER}.html").read_text(), f"{PAPER}.html")
     assert not [p for p in (work / "report").rglob("*") if p.is_file() and "root:x:0:0" in p.read_text(errors="ignore")]
 

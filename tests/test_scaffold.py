@@ -378,9 +378,13 @@ def test_the_new_paper_has_both_verdicts_in_its_tables_and_report(sixth):
     assert abs(claims.loc["fixed_point", "reproduced_value"] - 4.49544) < 1e-4
     index = (work / "report/index.html").read_text()
     assert f'id="{SLUG}"' in index and TITLE.split(" (")[0] in index
-    section = index[index.index(f'id="{SLUG}"'):]
+    assert f'href="paper-{SLUG}.html"' in index  # the index summarises; the paper's section is its own page
+    section = (work / "report" / f"paper-{SLUG}.html").read_text()
+    section = section[section.index(f'id="{SLUG}"'):]
     assert "lambda_c" in section and "fixed_point" in section
     assert "reproduced" in section and "differs" in section
+    explored = index[index.index('id="explore"'):]  # and its rows are in the index's claims explorer
+    assert f'data-paper="{SLUG}" data-kind="claim" data-verdict="differs"' in explored and "fixed_point" in explored
     assert (work / "report" / f"{SLUG}.html").is_file()
     assert (work / "figures" / SLUG / "fig1.png").is_file()
 

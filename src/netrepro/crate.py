@@ -55,8 +55,9 @@ MAINTAINERS = {"@id": "#netrepro-maintainers", "@type": "Organization", "name": 
 README = """# RO-Crate of a netrepro report
 
 This folder is a Workflow Run Crate (and a Provenance Run Crate): `ro-crate-metadata.json`
-describes how one run of the netrepro Snakemake workflow made the report (`index.html`, one page
-per paper) and every result table and figure copied under `files/data/`, job by job: the rule
+describes how one run of the netrepro Snakemake workflow made the report (`index.html`: the
+scorecard and the claims explorer; `paper-<slug>.html`: one page per paper; `<slug>.html`: the
+papers' executed notebooks) and every result table and figure copied under `files/data/`, job by job: the rule
 each job ran, the tables it read, what it wrote, when, and the package versions. The workflow's
 sources and configuration are under `files/workflow/`. Open `index.html` to read the report.
 """
@@ -182,7 +183,7 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     workflow_files, config_files : list of str
         Crate-relative copies of the Snakefiles (the first is the main one) and configuration files.
     pages : list of str
-        Crate-relative report pages (``index.html``, the notebooks).
+        Crate-relative report pages (``index.html``, the papers' pages ``paper-<slug>.html``, the notebooks).
     versions : dict
         Package -> version of the software that computed the results (``None`` versions are left out).
     out : str or Path, optional

@@ -72,6 +72,8 @@ rule report:
         source_pages=rules.report_sources.output.pages,
     output:
         html="report/index.html",
+        # one page per paper (the index holds the summary, the scorecard and the claims explorer)
+        **{f"page_{slug}": f"report/paper-{slug}.html" for slug in PAPER_OUTPUTS},
         files_data=directory("report/files/data"),
         files_workflow=directory("report/files/workflow"),
         crate="report/ro-crate-metadata.json",

@@ -1,5 +1,6 @@
-"""The report rule's step: ``report/index.html``, the copies under ``report/files/`` and the
-Workflow Run Crate ``report/ro-crate-metadata.json`` (written by :mod:`netrepro.crate`)."""
+"""The report rule's step: ``report/index.html`` (summary, scorecard, claims explorer), one page per
+paper (``report/paper-<slug>.html``), the copies under ``report/files/`` and the Workflow Run Crate
+``report/ro-crate-metadata.json`` (written by :mod:`netrepro.crate`)."""
 
 from __future__ import annotations
 
@@ -17,18 +18,21 @@ from ..figurespec import load_figure_specs
 from ..io import atomic_path
 from ..provenance import git_state, package_versions
 from ..references import crate_citations, references_html
+from ..registry import load_registry
 from ..summary import scorecard
-from .markup import read_csv, relocate_json, render, stylesheet
+from .csp import page_policy, policy_attribute
+from .markup import read_csv, relocate_json, render, script, stylesheet
 from .sections import table_view
 from .panel import provenance_chain, rule_name
-from .sections import paper_section, scale_html, scorecard_html
+from .sections import (explorer_html, explorer_rows, paper_brief, paper_page_name, paper_section, scale_html,
+                       scorecard_html)
 from .site import Site
 
 __all__ = ["build_index"]
 
 
 def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
-    """Pipeline step: write ``report/index.html`` from claims, errata, figures and sidecars.
+    """Pipeline step: write ``report/index.html`` and the papers' pages from claims, errata, figures and sidecars.
 
     Parameters
     ----------
@@ -45,7 +49,7 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
         ``source_pages``, the folder ``report/files/source`` of pages highlighted ahead by ``report_sources``
         (optional: without it, the linked source files are highlighted here).
     outputs : dict
-        ``html``, and optionally ``files_data`` and ``files_workflow`` (``report/files/data`` and
+        ``html``, ``page_<slug>`` (each paper's page; default ``paper-<slug>.html`` beside ``html``), and optionally ``files_data`` and ``files_workflow`` (``report/files/data`` and
         ``report/files/workflow``: the copies of the tables and of the workflow files, so that the report is
         self-contained), and ``crate``.
 
@@ -81,10 +85,21 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     bench = None if bench_frame is None else {
         "path": bench_path, "html": Markup(render("table.html", table=table_view(bench_frame),
                                                   table_id="benchmarks-table"))}
-    page = render("index.html", css=stylesheet(), papers=list(papers), run=run, versions=versions, bench=bench,
-                  scorecard=Markup(scorecard_html(score, papers)), scale=Markup(scale_html(params.get("scale") or {})),
-                  sections=[Markup(paper_section(slug, spec, claims[slug], ctx)) for slug, spec in papers.items()],
-                  references=Markup(references_html(papers)))
+    explorer = script("explorer.js")
+    css = stylesheet()
+    page = render("index.html", css=css, papers=list(papers), run=run, versions=versions, bench=bench, pages=True,
+                  scorecard=Markup(scorecard_html(score, papers, explore=True, pages=True)),
+                  scale=Markup(scale_html(params.get("scale") or {})),
+                  explorer=Markup(explorer_html(papers, explorer_rows(papers, claims))),
+                  briefs=[Markup(paper_brief(slug, spec, claims[slug])) for slug, spec in papers.items()],
+                  references=Markup(references_html(papers)), script=explorer,
+                  csp=policy_attribute(page_policy(explorer)))
+    paper_pages = {}
+    for slug, spec in papers.items():
+        path = Path(outputs.get(f"page_{slug}") or Path(outputs["html"]).parent / paper_page_name(slug))
+        paper_pages[path] = render("paper_page.html", css=css, slug=slug, papers=list(papers),
+                                   title=load_registry().get(slug, {}).get("title", slug),
+                                   section=Markup(paper_section(slug, spec, claims[slug], ctx)))
     sidecars = _run_sidecars(papers, extra=[p for k, p in (params.get("scale") or {}).items() if k != "reference"])
     workflow_files = _workflow_sources(root)
     configs = list(dict.fromkeys(["config/config.yaml", *configfiles]))
@@ -96,10 +111,13 @@ def build_index(params: dict, inputs: dict, outputs: dict) -> dict:
     site.write()
     with atomic_path(outputs["html"]) as tmp:
         tmp.write_text(page)
+    for path, text in paper_pages.items():
+        with atomic_path(path) as tmp:
+            tmp.write_text(text)
     if outputs.get("crate") and files_dir is not None:
         crate_root = Path(outputs["crate"]).parent
         prefix = files_dir.relative_to(crate_root).as_posix() if files_dir.is_relative_to(crate_root) else "files"
-        pages = [Path(outputs["html"]).name] + [Path(spec["notebook"]).name for spec in papers.values()
+        pages = [Path(outputs["html"]).name] + [p.name for p in paper_pages] + [Path(spec["notebook"]).name for spec in papers.values()
                                                 if spec.get("notebook") and Path(spec["notebook"]).is_file()]
         write_crate(crate_root, sidecars={p: relocate_json(m, root) for p, m in sidecars.items()},
                     rule_of=rule_name,

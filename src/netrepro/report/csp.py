@@ -5,8 +5,9 @@ is what the browser lets the page load and run whatever text ends up in it:
 
 * our pages (``report/index.html``, the source pages, the notebook pages) run no script at all,
   load images from their own folder or ``data:`` only and nothing from the network
-  (:data:`PAGE_POLICY`); a page that ships a script would add the script's hash
-  (:func:`script_hash`) to ``script-src``;
+  (:data:`PAGE_POLICY`); a page that ships a script of its own (``report/index.html``'s claims
+  explorer, ``templates/explorer.js``) allows that script alone, by its hash
+  (:func:`page_policy`, :func:`script_hash`), never ``'unsafe-inline'``;
 * Snakemake's report (``report/snakemake_report.html``, sealed by ``python -m netrepro.report
   relocate``) is a JavaScript application: its policy (:func:`snakemake_report_policy`) allows
   exactly the scripts that Snakemake's installed template and libraries put there, and the data
@@ -26,7 +27,7 @@ from pathlib import Path
 
 from markupsafe import Markup
 
-__all__ = ["PAGE_POLICY", "policy_text", "policy_attribute", "script_hash", "csp_meta", "with_csp", "inline_scripts",
+__all__ = ["PAGE_POLICY", "page_policy", "policy_text", "policy_attribute", "script_hash", "csp_meta", "with_csp", "inline_scripts",
            "is_data_script", "snakemake_known_scripts", "snakemake_report_policy"]
 
 # Our pages: no script, no network, images and styles of the page itself.
@@ -84,6 +85,25 @@ def script_hash(text: str) -> str:
     """
     normalised = text.replace("\r\n", "\n").replace("\r", "\n")
     return "'sha256-" + base64.b64encode(hashlib.sha256(normalised.encode()).digest()).decode() + "'"
+
+
+def page_policy(*scripts: str) -> dict[str, tuple[str, ...]]:
+    """:data:`PAGE_POLICY` allowing exactly the inline ``scripts`` (by their hashes).
+
+    Parameters
+    ----------
+    *scripts : str
+        The texts of the page's own inline scripts, as between ``<script>`` and ``</script>``.
+
+    Returns
+    -------
+    dict
+        Directive -> sources: ``script-src`` lists the scripts' hashes (``'none'`` without a script);
+        everything else is :data:`PAGE_POLICY`'s. An event handler attribute, a ``javascript:`` link
+        or any other inline script stays blocked (no ``'unsafe-inline'``, no ``'unsafe-hashes'``).
+    """
+    hashes = tuple(dict.fromkeys(script_hash(text) for text in scripts))
+    return {**PAGE_POLICY, "script-src": hashes or ("'none'",)}
 
 
 def csp_meta(policy: dict = PAGE_POLICY) -> Markup:

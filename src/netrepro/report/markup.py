@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # pandas is imported where a table is read: the notebook driv
     import pandas as pd
 
 __all__ = ["NO_FAVICON", "strip_external_scripts", "with_empty_favicon", "relocate", "relocate_json", "render", "read_csv",
-           "rst_html", "img", "num", "fmt_value", "short", "blank"]
+           "rst_html", "img", "num", "fmt_value", "short", "blank", "stylesheet", "script"]
 
 _EXTERNAL = re.compile(r"<script[^>]*\bsrc=\"https?://[^\"]*\"[^>]*>\s*</script>|<link[^>]*\bhref=\"https?://[^\"]*\"[^>]*>",
                        re.I)
@@ -373,3 +373,31 @@ def stylesheet() -> Markup:
         The CSS.
     """
     return Markup(_ENV.loader.get_source(_ENV, "report.css")[0])
+
+
+def script(name: str) -> Markup:
+    """A script of ``templates/`` (``explorer.js``), its text exactly as the page will hold it.
+
+    The page allows it by the hash of this text (:func:`netrepro.report.csp.page_policy`), so it is
+    inserted as it is: not through a template (whose line joining would change it). A script that
+    holds ``</script`` would end its element early and is refused.
+
+    Parameters
+    ----------
+    name : str
+        The file's name in ``templates/``.
+
+    Returns
+    -------
+    markupsafe.Markup
+        The script's text.
+
+    Raises
+    ------
+    ValueError
+        The text holds ``</script``.
+    """
+    text = _ENV.loader.get_source(_ENV, name)[0]
+    if "</script" in text.lower():
+        raise ValueError(f"{name}: a script holding '</script' cannot be inlined")
+    return Markup(text)

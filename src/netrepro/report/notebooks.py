@@ -26,7 +26,7 @@ from .csp import with_csp
 from .markup import relocate, strip_external_scripts
 
 __all__ = ["EXECUTION_TIMEOUT_S", "NotebookError", "make_notebook", "figure_captions", "figure_sort_key",
-           "show_figures", "figure_heading_html", "show_table", "execute_notebook"]
+           "show_figures", "figure_heading_html", "show_table", "execute_notebook", "page_notebook"]
 
 # Seconds one cell may run. The slowest cell of the five notebooks (the figures, embedded as
 # PNG) takes about 2 s; ten minutes only stops a cell that hangs.
@@ -238,10 +238,46 @@ def execute_notebook(slug: str, notebook: str | Path, html_out: str | Path, root
         with tempfile.TemporaryDirectory(prefix=SOCKET_FOLDER_PREFIX, dir=_socket_parent()) as sockets:
             _run_papermill(slug, notebook, executed, root, timeout, sockets)
         exporter = exporter.result()
-    body, _ = exporter.from_notebook_node(nbformat.read(str(executed), as_version=4))
+    body, _ = exporter.from_notebook_node(page_notebook(nbformat.read(str(executed), as_version=4), slug))
     with atomic_path(html_out) as tmp:
         tmp.write_text(with_csp(relocate(strip_external_scripts(body), root)))
     return html_out
+
+
+def page_notebook(nb, slug: str, title: str | None = None):
+    """The executed notebook as its page shows it: titled by its paper, its parameters cell once.
+
+    papermill keeps the notebook's own ``parameters`` cell (its defaults) and adds the values it
+    ran with in an ``injected-parameters`` cell right after it: the page showed the parameters
+    twice. The page keeps the injected cell (what ran) and drops the defaults it replaced; the
+    executed ``.ipynb`` beside the page keeps both. The page's ``<title>`` (nbconvert's lab
+    template reads ``metadata.title``) is ``<slug>: <paper's title> — notebook``.
+
+    Parameters
+    ----------
+    nb : nbformat.NotebookNode
+        The executed notebook (changed in place).
+    slug : str
+        The paper.
+    title : str, optional
+        The paper's title (default: from the paper registry; the slug if it has none).
+
+    Returns
+    -------
+    nbformat.NotebookNode
+        ``nb``.
+    """
+    def tags(cell):
+        return set(cell.get("metadata", {}).get("tags", []))
+
+    if any("injected-parameters" in tags(c) for c in nb.cells):
+        nb.cells = [c for c in nb.cells if "parameters" not in tags(c) or "injected-parameters" in tags(c)]
+    if title is None:
+        from ..registry import load_registry
+
+        title = load_registry().get(slug, {}).get("title") or slug
+    nb.metadata["title"] = f"{slug}: {title} \u2014 notebook"
+    return nb
 
 
 # A Unix socket's path must fit in sun_path: 108 bytes on Linux, 104 on macOS, including the final NUL.

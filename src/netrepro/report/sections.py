@@ -14,12 +14,13 @@ from ..registry import load_registry
 from ..scale import NOT_RECORDED, NOT_RUN
 from ..provenance import sidecar_path
 from ..summary import FINDING_COUNT_COLUMNS, replication_summary, summary_sentences
-from ..verdicts import TESTABLE_VERDICTS, VERDICTS
+from ..verdicts import FINDING_VERDICTS, TESTABLE_VERDICTS, VERDICTS
 from .markup import img, read_csv, render, rst_html
 from .notebooks import figure_captions, figure_sort_key
 from .panel import provenance_panel, rule_name
 
-__all__ = ["table_view", "claims_html", "summary_html", "figure_html", "paper_section", "scorecard_html", "scale_html"]
+__all__ = ["table_view", "claims_html", "summary_html", "figure_html", "paper_section", "paper_brief", "paper_page_name",
+           "explorer_rows", "explorer_html", "scorecard_html", "scale_html"]
 
 # Text tables shown cell by cell (besides the claims, which have their own layout)
 _TEXT_TABLES = (
@@ -221,7 +222,114 @@ def paper_section(slug: str, spec: dict, frame: pd.DataFrame | None, ctx: dict) 
         tables=[_table_row(p, ctx) for p in dict.fromkeys(spec.get("tables", []))])
 
 
-def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
+def paper_page_name(slug: str) -> str:
+    """The file name of a paper's page in ``report/``: ``paper-<slug>.html``.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+
+    Returns
+    -------
+    str
+        The name (the notebook page is ``<slug>.html``).
+    """
+    return f"paper-{slug}.html"
+
+
+def paper_brief(slug: str, spec: dict, frame: pd.DataFrame | None) -> str:
+    """A paper's summary on ``report/index.html`` (``<section id=slug>``): its title, authors, the
+    replication summary's sentences and links to its page, its notebook and its rows in the explorer.
+
+    Parameters
+    ----------
+    slug : str
+        The paper.
+    spec : dict
+        Its registered outputs.
+    frame : pandas.DataFrame or None
+        Its claims table.
+
+    Returns
+    -------
+    str
+        The ``<section>``.
+    """
+    meta = load_registry().get(slug, {})
+    sentences = []
+    if frame is not None:
+        errata = read_csv(spec["errata"]) if spec.get("errata") else None
+        findings = read_csv(spec["findings"]) if spec.get("findings") else None
+        table = replication_summary(frame, [Path(f).stem for f in spec.get("figures", [])])
+        sentences = summary_sentences(frame, errata, findings, table)
+    notebook = spec.get("notebook")
+    return render("brief.html", slug=slug, title=meta.get("title", slug), authors=meta.get("authors", ""),
+                  page=paper_page_name(slug), notebook=Path(notebook).name if notebook else None, sentences=sentences)
+
+
+def explorer_rows(papers: dict, claims: dict) -> list[dict]:
+    """Every claim, finding and erratum of every paper, as rows of the claims explorer.
+
+    Parameters
+    ----------
+    papers : dict
+        Slug -> registered outputs (``findings``, ``errata``).
+    claims : dict
+        Slug -> claims table (or None).
+
+    Returns
+    -------
+    list of dict
+        ``paper``, ``kind`` (``claim``, ``finding``, ``erratum``), ``id``, ``statement``, ``verdict``
+        (``""`` for an erratum), ``detail`` and ``href`` (the row or table on the paper's page).
+    """
+    rows = []
+    for slug, spec in papers.items():
+        page = paper_page_name(slug)
+        frame = claims.get(slug)
+        for _, row in (frame.iterrows() if frame is not None else ()):
+            ident = _cell(row, "claim_id")
+            rows.append({"paper": slug, "kind": "claim", "id": ident, "statement": _cell(row, "statement"),
+                         "verdict": str(_cell(row, "verdict")).strip(), "detail": _cell(row, "location"),
+                         "href": f"{page}#{slug}-claim-{ident}"})
+        findings = read_csv(spec["findings"]) if spec.get("findings") else None
+        for _, row in (findings.iterrows() if findings is not None else ()):
+            rows.append({"paper": slug, "kind": "finding", "id": _cell(row, "finding_id"),
+                         "statement": _cell(row, "statement"), "verdict": str(_cell(row, "verdict")).strip(),
+                         "detail": "", "href": f"{page}#{slug}-findings"})
+        errata = read_csv(spec["errata"]) if spec.get("errata") else None
+        for _, row in (errata.iterrows() if errata is not None else ()):
+            printed, corrected = _cell(row, "printed"), _cell(row, "corrected")
+            rows.append({"paper": slug, "kind": "erratum", "id": _cell(row, "erratum_id"),
+                         "statement": f"{_cell(row, 'location')}: printed {printed}; corrected {corrected}",
+                         "verdict": "", "detail": _cell(row, "kind"), "href": f"{page}#{slug}-errata"})
+    return rows
+
+
+def explorer_html(papers: dict, rows: list[dict]) -> str:
+    """The claims explorer (``<section id="explore">``): one table of ``rows`` with its filters.
+
+    Parameters
+    ----------
+    papers : dict
+        Slug -> registered outputs (the paper filter's choices, in order).
+    rows : list of dict
+        :func:`explorer_rows`.
+
+    Returns
+    -------
+    str
+        The section; its script is ``templates/explorer.js``.
+    """
+    found = {r["verdict"] for r in rows if r["verdict"]}
+    order = list(dict.fromkeys([*VERDICTS, *FINDING_VERDICTS]))
+    verdicts = [v for v in order if v in found] + sorted(found - set(order))
+    kinds = [k for k in ("claim", "finding", "erratum") if any(r["kind"] == k for r in rows)]
+    return render("explorer.html", papers=list(papers), rows=rows, verdicts=verdicts, kinds=kinds)
+
+
+def scorecard_html(score: pd.DataFrame, papers: dict, explore: bool = False, pages: bool = False) -> str:
     """The scorecard: verdict counts per paper and in total, with the share reproduced.
 
     Parameters
@@ -230,6 +338,10 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
         :func:`netrepro.summary.scorecard` (its last row is the total).
     papers : dict
         Slug -> registered outputs.
+    explore : bool, default False
+        The page has the claims explorer: each count links to its rows there.
+    pages : bool, default False
+        Each paper has its own page (:func:`paper_page_name`): the claims links go there.
 
     Returns
     -------
@@ -247,7 +359,7 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
         n = max(int(row["testable"]), 1)
         item = {"paper": slug, "title": None, "n": {k: int(row[k]) for k in counted},
                 "share": "" if pd.isna(row["scored_reproduced_pct"]) else f'{row["scored_reproduced_pct"]:.1f} %',
-                "bar": [(v, int(row[v]), f"{160 * int(row[v]) / n:.1f}") for v in TESTABLE_VERDICTS if int(row[v])]}
+                "bar": [(v, int(row[v]), f"{120 * int(row[v]) / n:.1f}") for v in TESTABLE_VERDICTS if int(row[v])]}
         if spec is not None:
             recon = read_csv(spec["reconstructions"]) if spec.get("reconstructions") else None
             figs = spec.get("figures", [])
@@ -260,7 +372,7 @@ def scorecard_html(score: pd.DataFrame, papers: dict) -> str:
     return render("scorecard.html", total={k: int(total[k]) for k in counted}, shown=shown,
                   finding_verdicts=finding_verdicts,
                   untestable=[v for v in shown if v not in TESTABLE_VERDICTS], show_other=int(total["other"]) > 0,
-                  rows=rows, pct="" if pd.isna(pct) else f"{pct:.1f} %")
+                  rows=rows, pct="" if pd.isna(pct) else f"{pct:.1f} %", explore=explore, pages=pages)
 
 
 def scale_html(scale: dict) -> str:
