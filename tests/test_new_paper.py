@@ -1,5 +1,6 @@
 """``new-paper`` refuses a bad request with a message naming the problem, and writes nothing."""
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -43,17 +44,17 @@ def test_the_command_refuses_and_writes_nothing(tmp_path):
 def test_the_plan_creates_every_role_and_registers_the_paper(tmp_path):
     source = tmp_path / "paper.txt"
     source.write_text("text")
-    plan = plan_new_paper("kalman_iid", "A title", source, ROOT)
-    pkg = "src/netrepro/papers/kalman_iid/"
+    plan = plan_new_paper("plan_probe", "A title", source, ROOT)
+    pkg = "src/netrepro/papers/plan_probe/"
     for name in ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
                  "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml"):
         assert pkg + name in plan.create, name
     for role in ("model", "steps", "evidence", "figures", "checks"):
-        assert f"tests/papers/kalman_iid/test_{role}.py" in plan.create, role
-    assert "workflow/rules/kalman_iid.smk" in plan.create
-    assert "kalman_iid:" in plan.rewrite["src/netrepro/papers.yaml"]
-    assert 'kalman_iid: {$ref: "kalman_iid.schema.yaml"}' in plan.rewrite["workflow/schemas/config.schema.yaml"]
-    assert "papers: [intermittent, markov, onebit, gainsched, hinf, kalman_iid]" in plan.rewrite["config/test.yaml"]
+        assert f"tests/papers/plan_probe/test_{role}.py" in plan.create, role
+    assert "workflow/rules/plan_probe.smk" in plan.create
+    assert "plan_probe:" in plan.rewrite["src/netrepro/papers.yaml"]
+    assert 'plan_probe: {$ref: "plan_probe.schema.yaml"}' in plan.rewrite["workflow/schemas/config.schema.yaml"]
+    assert re.search(r"^papers: \[intermittent, markov, onebit, gainsched, hinf(, \w+)*, plan_probe\]$", plan.rewrite["config/test.yaml"], re.M)
 
 
 def test_a_source_outside_the_shared_papers_folder_is_warned_about(tmp_path, monkeypatch, capsys):
