@@ -109,6 +109,22 @@ def test_a_missing_reference_folder_is_a_violation(scratch):
     assert [v for v in found if v.check == "roles" and v.path == f"tests/reference/{SLUG}"], found
 
 
+def test_a_citation_whose_authors_are_not_the_papers_is_a_violation(scratch):
+    # what tests/test_release_files.py checks, said by check-paper (a new paper's citation left as TODO
+    # while its authors line was filled in passed check-paper and failed the tests)
+    registry = scratch / "src/netrepro/papers.yaml"
+    text = registry.read_text()
+    start = text.index(f"\n{SLUG}:")
+    end = text.index("\ngainsched:")
+    section = text[start:end]
+    family = re.search(r"family-names: ([^\n,}]+)", section).group(1).strip()
+    registry.write_text(text[:start] + section.replace(f"family-names: {family}", "family-names: Nobody", 1) + text[end:])
+    found = check_paper(SLUG, scratch)
+    assert [v for v in found if v.check == "citation" and "Nobody" in v.message and v.line > 0], found
+    registry.write_text(text)
+    assert not [v for v in check_paper(SLUG, scratch) if v.check == "citation"]
+
+
 def test_an_unregistered_paper_is_a_violation(scratch):
     registry = scratch / "src/netrepro/papers.yaml"
     text = registry.read_text()

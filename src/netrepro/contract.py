@@ -121,8 +121,18 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
     out += [Violation(_rel(path, root), 0, "roles", f"missing: {what}") for path, what in required.items()
             if not path.exists()]
     registry = root / "src/netrepro/papers.yaml"
-    if slug not in load_registry(registry):
+    entries = load_registry(registry)
+    if slug not in entries:
         out.append(Violation(_rel(registry, root), 0, "roles", f"paper {slug!r} is not registered"))
+    else:
+        # the check of tests/test_release_files.py: the citation's authors are the registry's authors
+        entry = entries[slug]
+        family = [a.get("family-names", "") for a in entry.get("citation", {}).get("authors", [])]
+        if family and not any(name and name in str(entry.get("authors", "")) for name in family):
+            out.append(Violation(_rel(registry, root), _line_of(registry.read_text(), f"{slug}:"), "citation",
+                                 f"{slug}: the citation's authors ({', '.join(family)}) do not appear in its "
+                                 f"authors line ({entry.get('authors')!r}): fill in citation.authors too, then "
+                                 "`python -m netrepro.references CITATION.cff`"))
     schema_file = root / "workflow/schemas/config.schema.yaml"
     schema = yaml.safe_load(schema_file.read_text())
     out += [Violation(_rel(schema_file, root), 0, "roles", msg)

@@ -192,8 +192,11 @@ def citation_cff() -> dict:
     idents = load_identifiers()
     references = []
     for slug, ref in refs.items():
-        references.append(cff_reference(ref, idents.get(slug, [])))
-        references.extend(cff_reference(u) for u in ref.get("underlying", []))
+        for entry in [cff_reference(ref, idents.get(slug, [])), *(cff_reference(u) for u in ref.get("underlying", []))]:
+            # a work two papers share (one reproduced, one underlying another) is listed once: the CFF
+            # schema wants unique references
+            if entry not in references:
+                references.append(entry)
     return {
         "cff-version": "1.2.0",
         "message": ("If you use this reproduction, please cite it as below, and cite the original papers "

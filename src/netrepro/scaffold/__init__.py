@@ -13,6 +13,9 @@ identifier, or a missing source file stops the command with a message and no fil
 
 from __future__ import annotations
 
+import contextlib
+import os
+
 import re
 from dataclasses import dataclass
 from datetime import date
@@ -233,7 +236,8 @@ def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".",
 
     citation = Path(root) / "CITATION.cff"
     if citation.is_file() and Path(REGISTRY_FILE).resolve() == (Path(root) / "src/netrepro/papers.yaml").resolve():
-        write_citation([str(citation)])
+        with open(os.devnull, "w") as quiet, contextlib.redirect_stdout(quiet):  # new-paper lists what it wrote
+            write_citation([str(citation)])
         written = sorted({*written, "CITATION.cff"})
     return written
 
