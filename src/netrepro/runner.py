@@ -244,12 +244,14 @@ def _own_package(cwd: Path | None = None) -> str:
     provenance recorded this checkout's files (issue 40); ``make`` repoints it (src/netrepro/venv_paths.py).
     """
     imported = Path(__file__).resolve().parent
-    own = (cwd or Path.cwd()).resolve() / "src" / "netrepro"
+    here = (cwd or Path.cwd()).resolve()
+    own = here / "src" / "netrepro"
     if own.is_dir() and own != imported:
         raise ImportError(f"this job imported netrepro from {imported}, not from its own checkout's {own}: the "
                           "environment belongs to another checkout. Run `make` (it repoints .venv/ at this "
                           "checkout), or set PYTHONPATH to this checkout's src/")
-    return str(imported)
+    # relative inside the checkout: provenance (and the report) must not name the build machine's folders
+    return imported.relative_to(here).as_posix() if imported.is_relative_to(here) else str(imported)
 
 
 def _refuse_orphaned(rule: str, starter) -> None:
