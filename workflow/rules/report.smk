@@ -71,9 +71,9 @@ rule report:
         scale=rules.scale_verdicts.output if SCALE_RECORDED else [],
         source_pages=rules.report_sources.output.pages,
     output:
-        html="report/index.html",
         # one page per paper (the index holds the summary, the scorecard and the claims explorer)
         **{f"page_{slug}": f"report/paper-{slug}.html" for slug in PAPER_OUTPUTS},
+        html="report/index.html",
         files_data=directory("report/files/data"),
         files_workflow=directory("report/files/workflow"),
         crate="report/ro-crate-metadata.json",
