@@ -96,11 +96,13 @@ lint: $(STAMP_TEST) venv-paths
 # results/regeneration/index.html and summary.json/summary.md (what was compared) and fails on a difference (README: "Checking that figures regenerate").
 # Then the stale outputs (files in results/ and figures/ no rule of this workflow produces, with the
 # same CONFIG/PROFILE as the build): listed with `make prune`, and they fail the check, since a stale
-# table could be frozen into the references by `make update-references`.
+# table could be frozen into the references by `make update-references`. Last, the README's results table
+# against this build (`make readme` rewrites it).
 check: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro verify
 	status=0; $(BIN)/python -m netrepro.regression compare --reference tests/reference --results results \
-		|| status=$$?; $(BIN)/python -m netrepro prune --check -- $(SMK_OPTS) || status=1; exit $$status
+		|| status=$$?; $(BIN)/python -m netrepro prune --check -- $(SMK_OPTS) || status=1; \
+		$(BIN)/python -m netrepro.readme --check README.md || status=1; exit $$status
 
 # Removes the stale outputs (netrepro.stale): files in results/ and figures/ that no rule of the current
 # workflow produces (a renamed or removed step's), with their sidecars; `make prune PRUNE_ARGS=--dry-run` lists them.

@@ -228,7 +228,8 @@ def interrupt(work, how):
         deadline = time.monotonic() + 600
         while not list((work / "logs/intermittent").glob("monte_carlo*.log")):
             assert proc.poll() is None, (work / "interrupted.txt").read_text()[-3000:]
-            assert time.monotonic() < deadline, "the Monte Carlo step never started"
+            if time.monotonic() > deadline:  # a hang guard, not a speed requirement
+                pytest.fail("the Monte Carlo step never started")
             time.sleep(0.1)
         # signal while a Monte Carlo job process runs: with a warm compile cache the shard takes well
         # under a second, so a fixed wait could miss it (the signal then came after the step)
@@ -312,7 +313,8 @@ def test_a_job_whose_snakemake_is_killed_stops_without_writing(built, reference,
     interrupt(work, "KILL-snakemake")
     deadline = time.monotonic() + 300
     while job_processes(work):
-        assert time.monotonic() < deadline, "the orphaned job never ended"
+        if time.monotonic() > deadline:
+            pytest.fail("the orphaned job never ended")
         time.sleep(0.1)
     shard = work / "results/intermittent/shards/monte_carlo_0.npz"
     assert not shard.exists() and not (shard.parent / (shard.name + ".meta.json")).exists()

@@ -92,14 +92,6 @@ def test_mare_fixed_point_is_the_limit_of_the_upper_bound():
     assert np.isinf(model.mare_fixed_point(A, R1, R2, LAM_C - 0.1))
 
 
-def test_fast():
-    import time
-    start = time.perf_counter()
-    for lam in (LAM_C + 0.1, LAM_C - 0.1):
-        exact.exact_mean(P0, A, R1, [R2], [lam], 60)
-    assert time.perf_counter() - start < 5.0
-
-
 def test_cheb_coeffs_cached_cosines_equal_direct_dct():
     from netrepro.papers.intermittent import exact as ex
 

@@ -46,7 +46,7 @@ __all__ = [
     "zero_gains",
     "realisation",
     "augmented_initial_moment",
-    "plant_ms_radius",
+   
     "lyapunov_difference_bounds",
 ]
 
@@ -948,25 +948,6 @@ def augmented_initial_moment(cov, n: int):
     X0 = np.zeros((2 * n, 2 * n))
     X0[:n, :n] = cov  # x_f(0) = 0
     return X0
-
-
-def plant_ms_radius(sys: System) -> float:
-    """Largest frozen second-moment radius of the plant (1) alone over the sector vertices (p-independent).
-
-    The plant block of (10) is :math:`x(k+1) = (A + BFZ)x + Dx\\,w`; its second moment is MS stable
-    iff the radius of :math:`(A+BFZ)\\otimes(A+BFZ) + \\sigma^2 D\\otimes D` is below 1.
-
-    Parameters
-    ----------
-    sys : System
-        The plant.
-
-    Returns
-    -------
-    float
-        The maximum over the diagonal sector vertices F of that radius (computed with zero gains).
-    """
-    return max(frozen_radius(sys, zero_gains(sys), sys.p1, F) for F in sector_cases(sys).values())
 
 
 def lyapunov_difference_bounds(sys: System, gains: Gains, Q0, Qp, p: float, pn: float, zbar, f):

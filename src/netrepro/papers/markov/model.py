@@ -20,7 +20,7 @@ from ...errors import InputError
 __all__ = [
     "LinearSystem", "spectral_abs", "observability_index", "stacked_output", "prop1_bound", "loss_factor",
     "H_matrix", "h_radius", "phi_lyapunov", "L_operator", "riccati_h", "riccati_g", "sym_norm", "batched_trace",
-    "gilbert_elliott_stationary_loss", "parity_bound_example2", "parity_ceiling", "norm_relaxation_bound",
+    "gilbert_elliott_stationary_loss", "parity_bound_example2", "parity_ceiling",
     "prop1_closed_form", "defective_unit_circle_eigenvalues",
 ]
 
@@ -614,35 +614,3 @@ def prop1_closed_form(lam_abs: float, q):
     return (1.0 - lam_abs ** 2 * (1.0 - q)) / (lam_abs ** 4 * q)
 
 
-def norm_relaxation_bound(A, q, K=None, i_max: int = 4000):
-    """Largest ``p`` with ``q sum_j (1-q)^{j-1} ||A^j||^2 * p ||A + K C||^2 < 1`` (last line after eq. 8, l_o = 2).
-
-    The norm relaxation by which the paper says its Theorem 1 covers the criteria of [15-17];
-    with ``K = 0`` it is our proxy for the criterion of [16] (which we cannot recompute from the text).
-
-    Parameters
-    ----------
-    A : array_like
-        ``(n, n)`` system matrix.
-    q : float
-        Recovery rate.
-    K : array_like, optional
-        ``K C`` added to ``A`` (``None``: ``K = 0``).
-    i_max : int
-        Maximum number of series terms.
-
-    Returns
-    -------
-    float
-        The largest ``p`` of the relaxation.
-    """
-    A = np.atleast_2d(A)
-    M = A if K is None else A + K
-    s, Aj = 0.0, np.eye(A.shape[0])
-    for j in range(1, i_max + 1):
-        Aj = Aj @ A
-        term = q * (1 - q) ** (j - 1) * np.linalg.norm(Aj, 2) ** 2
-        s += term
-        if term < 1e-14 * s:
-            break
-    return 1.0 / (s * np.linalg.norm(M, 2) ** 2)
