@@ -284,6 +284,7 @@ def plan_filters(sc: Scenario) -> FilterPlan:
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
 
     Returns
     -------
@@ -401,7 +402,9 @@ def initial_state(sc: Scenario, plan: FilterPlan, rng0: np.random.Generator, rng
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     rng0, rng_t : numpy.random.Generator
         The initial estimate's and the target's streams.
 
@@ -440,6 +443,7 @@ def move_target(sc: Scenario, k: int, x, P, rng_t: np.random.Generator, Wt_facto
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     k : int
         The step (1 to ``K``).
     x : ndarray, shape ``(R, 2)``
@@ -491,6 +495,7 @@ def measure(x, P, model: NoiseModel, rng_m: np.random.Generator):
     P : ndarray, shape ``(R, N, 2)``
         Agent positions.
     model : NoiseModel
+        The noise model (2)-(4).
     rng_m : numpy.random.Generator
         The measurements' stream (``sample_noise``'s draws, ``R x N x 2`` normals).
 
@@ -518,12 +523,14 @@ def consensus_round(plan: FilterPlan, st: LoopState, Minv, yinfo, psd_floor: flo
     Parameters
     ----------
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     st : LoopState
         Its ``v``, ``w`` (advanced), ``Ct``, ``yt`` (set) and ``n_psd_fix`` (counted, own consensus only) change;
         ``adj``, ``lap``, ``reset`` are read.
     Minv, yinfo : ndarray
         :func:`measure`'s output.
     psd_floor : float
+        Smallest eigenvalue kept in ``C~``.
     lap_complete : ndarray, shape ``(R, N, N)``, optional
         The complete graph's Laplacian (a ``complete`` design only).
 
@@ -573,7 +580,9 @@ def update_filters(sc: Scenario, plan: FilterPlan, st: LoopState, Minv, yinfo):
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     st : LoopState
         Its ``est``, ``cov`` and ``delta`` are replaced; ``Ct``, ``yt`` read.
     Minv, yinfo : ndarray
@@ -616,6 +625,7 @@ def move_agents(sc: Scenario, plan: FilterPlan, st: LoopState, Minv):
     sc : Scenario
         A mobile scenario.
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     st : LoopState
         Its ``P``, ``dsig``, ``adj``, ``lap``, ``reset``, ``changes`` and ``max_degree`` change; the driver's
         ``est``, ``delta`` and the own consensus's ``Ct`` are read.
@@ -688,7 +698,9 @@ def new_record(sc: Scenario, plan: FilterPlan, st: LoopState) -> Record:
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     st : LoopState
         The state of :func:`initial_state`.
 
@@ -726,12 +738,17 @@ def record_step(sc: Scenario, plan: FilterPlan, st: LoopState, rec: Record, k: i
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     plan : FilterPlan
+        The filters of :func:`plan_filters`.
     st : LoopState
+        The loop's state after the step's phases.
     rec : Record
         Filled in place.
     k : int
+        The step (1 to ``K``).
     Minv : ndarray, shape ``(R, N, 2, 2)``
+        This step's information ``C_i^T M_i^{-1} C_i`` (:func:`measure`).
 
     Returns
     -------
@@ -764,8 +781,11 @@ def initial_fused_trace(sc: Scenario, x0, P0):
     Parameters
     ----------
     sc : Scenario
+        The resolved scenario.
     x0 : ndarray, shape ``(R, 2)``
+        Target positions at ``k = 0``.
     P0 : ndarray, shape ``(R, N, 2)``
+        Agent positions at ``k = 0``.
 
     Returns
     -------
