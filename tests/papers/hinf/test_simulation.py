@@ -212,8 +212,9 @@ def test_move_agents_is_the_gradient_law_12_by_hand():
             rh, th = np.hypot(*d), np.arctan2(d[1], d[0])
             Delta = sc.A @ (sc.P0 * I2) @ sc.A.T + sc.W_filter
             Sig = np.linalg.inv(np.linalg.inv(Delta) + Minv[r, i] - g2 * sc.Lbar)
-            dS_r = (np.linalg.inv(_hand_covariance(rh + eps, th)) - np.linalg.inv(_hand_covariance(rh - eps, th))) / (2 * eps)
-            dS_t = (np.linalg.inv(_hand_covariance(rh, th + eps)) - np.linalg.inv(_hand_covariance(rh, th - eps))) / (2 * eps)
+            info = lambda r_, t_: np.linalg.inv(_hand_covariance(r_, t_))  # noqa: E731
+            dS_r = (info(rh + eps, th) - info(rh - eps, th)) / (2 * eps)
+            dS_t = (info(rh, th + eps) - info(rh, th - eps)) / (2 * eps)
             gr, gt = -np.trace(Sig @ dS_r @ Sig), -np.trace(Sig @ dS_t @ Sig)
             T = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
             u = sc.control["Gamma"] * T @ np.array([gr, gt / rh])
@@ -247,7 +248,8 @@ def test_record_starts_from_the_initial_estimate_and_the_loop_is_the_phases_in_o
     out = simulate(dict(agents0=sc.agents0, target0=sc.target0, target="random", W_true=sc.W_true,
                         W_filter=sc.W_filter, A=sc.A, gamma=3.0, Lbar=sc.Lbar, P0=sc.P0, model=MODEL, radius=20.0,
                         consensus=dict(sc.consensus), filters=["local"], horizon=3, runs=3, seed=11))
-    plan, st, rng_t, rng_m = _setup(S.Scenario.from_mapping({**{f.name: getattr(sc, f.name) for f in dataclasses.fields(sc)}, "filters": ["local"]}))
+    fields = {f.name: getattr(sc, f.name) for f in dataclasses.fields(sc)}
+    plan, st, rng_t, rng_m = _setup(S.Scenario.from_mapping({**fields, "filters": ["local"]}))
     for k in range(1, 4):  # a hand loop over runs of the random walk, the measurements and eq (6)
         st.x, _ = S.move_target(sc, k, st.x, st.P, rng_t, S.gaussian_factor(sc.W_true))
         Minv, yinfo = S.measure(st.x, st.P, MODEL, rng_m)

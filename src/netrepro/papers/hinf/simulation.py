@@ -160,20 +160,22 @@ class Scenario:
         if sc["target"] not in TARGET_MODES:
             raise InputError(f"unknown target mode {sc['target']!r}")
         path = sc.get("target_path")
+        variants = sc.get("consensus_variants") or {}
         return cls(
             agents0=np.asarray(sc["agents0"], dtype=float), target0=np.asarray(sc["target0"], dtype=float),
             target=str(sc["target"]), W_true=np.asarray(sc["W_true"], dtype=float),
             W_filter=np.asarray(sc["W_filter"], dtype=float), A=np.asarray(sc["A"], dtype=float),
             gamma=float(sc["gamma"]), Lbar=np.asarray(sc["Lbar"], dtype=float), P0=float(sc["P0"]),
-            model=sc["model"], radius=sc["radius"], consensus=_frozen(sc["consensus"]), mobile=bool(sc.get("mobile", False)),
-            filters=tuple(sc["filters"]), horizon=int(sc["horizon"]), runs=int(sc["runs"]), seed=int(sc["seed"]),
-            control=_frozen(sc.get("control")), evader=_frozen(sc.get("evader")),
-            driver=sc.get("driver", "decentralized"), psd_floor=float(sc.get("psd_floor", 1e-9)),
-            filter_base=_frozen(sc.get("filter_base")), filter_gamma=_frozen(sc.get("filter_gamma")),
-            filter_W_factor=_frozen(sc.get("filter_W_factor")),
-            consensus_variants=MappingProxyType({k: _frozen(v) for k, v in (sc.get("consensus_variants") or {}).items()}),
+            model=sc["model"], radius=sc["radius"], consensus=_frozen(sc["consensus"]),
+            mobile=bool(sc.get("mobile", False)), filters=tuple(sc["filters"]), horizon=int(sc["horizon"]),
+            runs=int(sc["runs"]), seed=int(sc["seed"]), control=_frozen(sc.get("control")),
+            evader=_frozen(sc.get("evader")), driver=sc.get("driver", "decentralized"),
+            psd_floor=float(sc.get("psd_floor", 1e-9)), filter_base=_frozen(sc.get("filter_base")),
+            filter_gamma=_frozen(sc.get("filter_gamma")), filter_W_factor=_frozen(sc.get("filter_W_factor")),
+            consensus_variants=MappingProxyType({k: _frozen(v) for k, v in variants.items()}),
             record_information=bool(sc.get("record_information", False)),
-            target_path=None if path is None else np.asarray(path, dtype=float), fused_all=bool(sc.get("fused_all", True)),
+            target_path=None if path is None else np.asarray(path, dtype=float),
+            fused_all=bool(sc.get("fused_all", True)),
         )
 
     @property
