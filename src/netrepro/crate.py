@@ -164,6 +164,50 @@ def _job_key(meta: dict) -> str:
     return json.dumps([meta.get("rule"), meta.get("params_hash"), inputs])
 
 
+def _job_actions(root: Path, sidecars: dict, rule_of, run: dict, workflow_files: list, main: str):
+    """One ``CreateAction`` per Snakemake job (the sidecars grouped by job), its rule and its files.
+
+    Returns ``(actions, rules, files, starts, ends)``: the actions in the order of their sorted outputs,
+    rule name -> its ``SoftwareApplication``, pipeline path -> its file entity, and the actions' start and end
+    times (ISO 8601).
+    """
+    jobs: dict[str, list[tuple[str, dict]]] = {}
+    for path, meta in sidecars.items():
+        jobs.setdefault(_job_key(meta), []).append((path, meta))
+    actions, rules, files = [], {}, {}
+    starts, ends = [], []
+    for index, (_, members) in enumerate(sorted(jobs.items(), key=lambda kv: sorted(p for p, _ in kv[1]))):
+        meta = members[0][1]
+        rule = rule_of(meta)
+        rules.setdefault(rule, {"@id": f"#rule-{rule}", "@type": "SoftwareApplication", "name": rule,
+                                "description": f"Snakemake rule {rule}: calls {meta.get('function', '?')}",
+                                "url": _rule_source(root, rule, workflow_files),
+                                "version": str(run.get("commit")), "isPartOf": {"@id": main}})
+        results = [data_id(p) for p, _ in sorted(members)]
+        objects = sorted({data_id(item["path"]) for _, m in members for item in (m.get("inputs") or {}).values()
+                          if item.get("path") in sidecars})
+        action = {"@id": action_id(rule, index), "@type": "CreateAction", "name": f"rule {rule}",
+                  "instrument": {"@id": f"#rule-{rule}"}, "object": _ref(objects), "result": _ref(results),
+                  "actionStatus": COMPLETED}
+        end = meta.get("finished")  # sidecars before "finished" was recorded: the file's time
+        first = Path(sorted(members)[0][0])
+        if not end and first.is_file():
+            end = iso(first.stat().st_mtime)
+        if end:
+            action["endTime"] = end
+            wall = float(meta.get("wall_time_s") or 0)
+            start = iso(_dt.datetime.fromisoformat(end).timestamp() - wall)
+            action["startTime"] = start
+            starts.append(start)
+            ends.append(end)
+        if meta.get("params_hash"):
+            action["description"] = f"{meta.get('function', '?')}, parameters hash {meta['params_hash']}"
+        actions.append(action)
+        for path, m in members:
+            files[path] = _file_entity(root, data_id(path), path, description=f"written by rule {rule}")
+    return actions, rules, files, starts, ends
+
+
 def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, run: dict,
                 workflow_files: list[str], config_files: list[str], pages: list[str],
                 versions: dict, out: str | Path | None = None, citations: list[dict] | None = None) -> Path:
@@ -208,40 +252,7 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
                          "version": str(version), "url": _software_id(name, str(version))})
 
     # one action per job, from the sidecars
-    jobs: dict[str, list[tuple[str, dict]]] = {}
-    for path, meta in sidecars.items():
-        jobs.setdefault(_job_key(meta), []).append((path, meta))
-    actions, rules, files = [], {}, {}
-    starts, ends = [], []
-    for index, (_, members) in enumerate(sorted(jobs.items(), key=lambda kv: sorted(p for p, _ in kv[1]))):
-        meta = members[0][1]
-        rule = rule_of(meta)
-        rules.setdefault(rule, {"@id": f"#rule-{rule}", "@type": "SoftwareApplication", "name": rule,
-                                "description": f"Snakemake rule {rule}: calls {meta.get('function', '?')}",
-                                "url": _rule_source(root, rule, workflow_files),
-                                "version": str(run.get("commit")), "isPartOf": {"@id": main}})
-        results = [data_id(p) for p, _ in sorted(members)]
-        objects = sorted({data_id(item["path"]) for _, m in members for item in (m.get("inputs") or {}).values()
-                          if item.get("path") in sidecars})
-        action = {"@id": action_id(rule, index), "@type": "CreateAction", "name": f"rule {rule}",
-                  "instrument": {"@id": f"#rule-{rule}"}, "object": _ref(objects), "result": _ref(results),
-                  "actionStatus": COMPLETED}
-        end = meta.get("finished")  # sidecars before "finished" was recorded: the file's time
-        first = Path(sorted(members)[0][0])
-        if not end and first.is_file():
-            end = iso(first.stat().st_mtime)
-        if end:
-            action["endTime"] = end
-            wall = float(meta.get("wall_time_s") or 0)
-            start = iso(_dt.datetime.fromisoformat(end).timestamp() - wall)
-            action["startTime"] = start
-            starts.append(start)
-            ends.append(end)
-        if meta.get("params_hash"):
-            action["description"] = f"{meta.get('function', '?')}, parameters hash {meta['params_hash']}"
-        actions.append(action)
-        for path, m in members:
-            files[path] = _file_entity(root, data_id(path), path, description=f"written by rule {rule}")
+    actions, rules, files, starts, ends = _job_actions(root, sidecars, rule_of, run, workflow_files, main)
     run_id = "#run"
     run_action = {
         "@id": run_id, "@type": "CreateAction", "name": run.get("name", "netrepro workflow run"),

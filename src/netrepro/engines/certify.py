@@ -960,6 +960,68 @@ class CertifiedBracket:
         return max(self.infeasible_end, self.feasible_end) if self.certified else np.nan
 
 
+def _outward_from_guess(v, n: int, c: int, half: int):
+    """The lattice indices a warm-started :func:`bisect_certified` evaluates first: outward from the guess
+    index ``c`` in doubling steps (as ``bisect_bracketed``), up until a feasible point or ``n``, then down
+    until an infeasible point or 0.
+
+    Parameters
+    ----------
+    v : callable
+        ``v(k)``: the verdict at lattice index ``k`` (evaluated and cached by the caller).
+    n, c, half : int
+        The last index, the guess's index, the first step.
+
+    Returns
+    -------
+    up, down : list of int
+        The indices visited going up, then going down.
+    """
+    up, down = [], []
+    k, step = min(n, c + half), half
+    while True:
+        up.append(k)
+        if v(k) == FEASIBLE or k == n:
+            break
+        step *= 2
+        k = min(n, k + step)
+    k, step = max(0, min(c - half, up[-1] - 1)), half
+    while True:
+        down.append(k)
+        if v(k) == INFEASIBLE or k == 0:
+            break
+        step *= 2
+        k = max(0, k - step)
+    return up, down
+
+
+def _bisect_lattice(v, a: int, b: int, verdict: str):
+    """Bisect the lattice indices ``a < b`` to adjacent ones, keeping ``verdict`` on its side: with
+    ``FEASIBLE`` the feasible end is ``b`` (feasible above), with ``INFEASIBLE`` the infeasible end is ``a``.
+
+    Parameters
+    ----------
+    v : callable
+        ``v(k)``: the verdict at lattice index ``k``.
+    a, b : int
+        The bracket.
+    verdict : str
+        ``FEASIBLE`` or ``INFEASIBLE``.
+
+    Returns
+    -------
+    a, b : int
+        ``b = a + 1`` (or the bracket if already adjacent).
+    """
+    while b - a > 1:
+        mid = (a + b) // 2
+        if (v(mid) == verdict) == (verdict == FEASIBLE):
+            b = mid
+        else:
+            a = mid
+    return a, b
+
+
 def bisect_certified(decide: Callable[[float], Verdict], lo: float, hi: float, tol: float = 1e-4,
                      max_evals: int = 80, feasible_above: bool = True, guess: float | None = None,
                      width: float = 0.0) -> CertifiedBracket:
@@ -1040,21 +1102,7 @@ def bisect_certified(decide: Callable[[float], Verdict], lo: float, hi: float, t
         c = int(round((min(max(float(guess), lo), hi) - lo) / cell))
         c = c if feasible_above else n - c
         half = max(1, int(np.ceil(float(width) / cell))) if cell > 0 else 1
-        up, down = [], []
-        k, step = min(n, c + half), half
-        while True:
-            up.append(k)
-            if v(k) == FEASIBLE or k == n:
-                break
-            step *= 2
-            k = min(n, k + step)
-        k, step = max(0, min(c - half, up[-1] - 1)), half
-        while True:
-            down.append(k)
-            if v(k) == INFEASIBLE or k == 0:
-                break
-            step *= 2
-            k = max(0, k - step)
+        up, down = _outward_from_guess(v, n, c, half)
     for k in up + down:
         v(k)
     # bounds from everything known so far
@@ -1073,14 +1121,7 @@ def bisect_certified(decide: Callable[[float], Verdict], lo: float, hi: float, t
             if v(0) == FEASIBLE:
                 return result(None, 0)
             a = 0
-        b = hiF
-        while b - a > 1:
-            mid = (a + b) // 2
-            if v(mid) == FEASIBLE:
-                b = mid
-            else:
-                a = mid
-        hiF = b
+        a, hiF = _bisect_lattice(v, a, hiF, FEASIBLE)
         I_ = [k for k, s in cache.items() if s == INFEASIBLE]  # the search above may have found more
         loI = max(I_) if I_ else None
     if loI is not None:
@@ -1090,12 +1131,5 @@ def bisect_certified(decide: Callable[[float], Verdict], lo: float, hi: float, t
             if v(n) == INFEASIBLE:
                 return result(n, None)
             b = n
-        a = loI
-        while b - a > 1:
-            mid = (a + b) // 2
-            if v(mid) == INFEASIBLE:
-                a = mid
-            else:
-                b = mid
-        loI = a
+        loI, b = _bisect_lattice(v, loI, b, INFEASIBLE)
     return result(loI, hiF)

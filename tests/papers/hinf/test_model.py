@@ -400,7 +400,7 @@ def test_fit_noise_model_recovers_exact_parameters():
     np.testing.assert_allclose([fit["a0"], fit["a1"], fit["a2"], fit["alpha"]], [a0, a1, a2, alpha], rtol=1e-9)
 
 
-MATH_MODULES = ["algebra", "noise", "consensus", "filters", "motion", "evader", "model"]
+MATH_MODULES = ["algebra", "noise", "consensus", "filters", "motion", "evader", "simulation", "model"]
 
 
 @pytest.mark.parametrize("name", MATH_MODULES)
@@ -422,11 +422,11 @@ def test_math_modules_public_api_has_numpydoc_sections(name):
 
 
 def test_connected_matches_the_laplacian_spectrum():
-    """model._connected (reachability) against the algebraic connectivity lambda_2 > 1e-9 it replaced."""
+    """simulation._connected (reachability) against the algebraic connectivity lambda_2 > 1e-9 it replaced."""
     from itertools import product
 
     from netrepro.papers.hinf.consensus import laplacian
-    from netrepro.papers.hinf.model import _connected
+    from netrepro.papers.hinf.simulation import _connected
 
     def by_spectrum(adj):
         return np.linalg.eigvalsh(laplacian(adj))[..., 1] > 1e-9

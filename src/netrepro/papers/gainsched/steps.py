@@ -164,6 +164,39 @@ def _mc_errors(sys, gains, p_seq, x0, seed, nonlinearity, xf0=None):
 
 
 # ----------------------------------------------------------------------------- steps
+def _append_tuned_designs(params, sys, tables: list, rows: list) -> None:
+    """Append the tuned filters' gains tables and design rows: Monte Carlo tuned fixed and scheduled gains
+    (Nelder-Mead, the scheduled search from the fixed optimum) and a filter tuned on the exact cost."""
+    tune = params["tuning"]
+    p_seq = p_sequence(params, sys, tune["horizon"])
+    tuned = None
+    for dname, sched in (("tuned_fixed", False), ("tuned_scheduled", True)):
+        start = time.perf_counter()
+        # the scheduled search starts from the fixed optimum, so it can only improve on it
+        tuned, info = tune_gains(sys, p_seq, int(tune["n_runs"]), int(tune["seed"]),
+                                 params["simulation"]["nonlinearity"], sched, int(tune["maxiter"]), start=tuned)
+        tables.append(gains_table(dname, tuned))
+        rows.append({"design": dname, "method": "Monte Carlo tuned (Nelder-Mead)", "status": "tuned",
+                     "margin": np.nan, "objective": info["cost"], "solver_feasible": np.nan,
+                     "solve_time_s": time.perf_counter() - start, "n_scalar_variables": len(MATRICES) and
+                     (tuned.G0.size + tuned.H0.size) * (2 if sched else 1), "realisation": "direct",
+                     "n_evaluations": info["n_eval"]})
+    # a filter tuned on the exact cost (f = (F1+F2)/2 z, x(0) ~ N(0, I), the configured p(k)), from the
+    # performance design: what the structure (9) achieves for one f, without a guarantee for the others
+    start = time.perf_counter()
+    p_full = p_sequence(params, sys)
+    mid = 0.5 * (sys.F1 + sys.F2)
+    perf = gains_from_table(pd.concat(tables, ignore_index=True), "performance", sys)
+    tuned_ex, info = tune_gains_exact(sys, p_full, mid, augmented_initial_moment(np.eye(sys.n), sys.n), True,
+                                      int(tune["maxiter"]), start=perf)
+    tables.append(gains_table("tuned_exact", tuned_ex))
+    rows.append({"design": "tuned_exact", "method": "tuned on the exact sum E||e||^2 (f = mid, x0 ~ N(0, I)), "
+                 "Nelder-Mead from the performance design", "status": "tuned", "margin": np.nan,
+                 "objective": info["cost"], "solver_feasible": np.nan, "solve_time_s": time.perf_counter() - start,
+                 "n_scalar_variables": 2 * (tuned_ex.G0.size + tuned_ex.H0.size), "realisation": "direct",
+                 "n_evaluations": info["n_eval"]})
+
+
 def design_step(params, inputs, outputs):
     """All designs: paper gains, Theorem 3 (24)-(26) variants, performance-aware, MC-tuned, zero (x_f = 0).
 
@@ -254,34 +287,7 @@ def design_step(params, inputs, outputs):
                          "objective": sol.objective, "solver_feasible": sol.solver_feasible,
                          "solve_time_s": sol.solve_time_s, "n_scalar_variables": sol.n_scalar_variables,
                          "realisation": real, "verdict": verdict, "certified_slack": slack})
-    tune = params["tuning"]
-    p_seq = p_sequence(params, sys, tune["horizon"])
-    tuned = None
-    for dname, sched in (("tuned_fixed", False), ("tuned_scheduled", True)):
-        start = time.perf_counter()
-        # the scheduled search starts from the fixed optimum, so it can only improve on it
-        tuned, info = tune_gains(sys, p_seq, int(tune["n_runs"]), int(tune["seed"]),
-                                 params["simulation"]["nonlinearity"], sched, int(tune["maxiter"]), start=tuned)
-        tables.append(gains_table(dname, tuned))
-        rows.append({"design": dname, "method": "Monte Carlo tuned (Nelder-Mead)", "status": "tuned",
-                     "margin": np.nan, "objective": info["cost"], "solver_feasible": np.nan,
-                     "solve_time_s": time.perf_counter() - start, "n_scalar_variables": len(MATRICES) and
-                     (tuned.G0.size + tuned.H0.size) * (2 if sched else 1), "realisation": "direct",
-                     "n_evaluations": info["n_eval"]})
-    # a filter tuned on the exact cost (f = (F1+F2)/2 z, x(0) ~ N(0, I), the configured p(k)), from the
-    # performance design: what the structure (9) achieves for one f, without a guarantee for the others
-    start = time.perf_counter()
-    p_full = p_sequence(params, sys)
-    mid = 0.5 * (sys.F1 + sys.F2)
-    perf = gains_from_table(pd.concat(tables, ignore_index=True), "performance", sys)
-    tuned_ex, info = tune_gains_exact(sys, p_full, mid, augmented_initial_moment(np.eye(sys.n), sys.n), True,
-                                      int(tune["maxiter"]), start=perf)
-    tables.append(gains_table("tuned_exact", tuned_ex))
-    rows.append({"design": "tuned_exact", "method": "tuned on the exact sum E||e||^2 (f = mid, x0 ~ N(0, I)), "
-                 "Nelder-Mead from the performance design", "status": "tuned", "margin": np.nan,
-                 "objective": info["cost"], "solver_feasible": np.nan, "solve_time_s": time.perf_counter() - start,
-                 "n_scalar_variables": 2 * (tuned_ex.G0.size + tuned_ex.H0.size), "realisation": "direct",
-                 "n_evaluations": info["n_eval"]})
+    _append_tuned_designs(params, sys, tables, rows)
     tables.append(gains_table("zero", zero_gains(sys)))
     rows.append({"design": "zero", "method": "x_f = 0 (trivial estimate)", "status": "given", "margin": np.nan, "objective": np.nan,
                  "solver_feasible": np.nan, "solve_time_s": np.nan, "n_scalar_variables": 0, "realisation": ""})
@@ -588,6 +594,87 @@ def exact_moments_step(params, inputs, outputs):
     return {"table": summary, "per_k": per_k, "performance": pd.DataFrame(comp)}
 
 
+# the method and sector class of each certified threshold of feasibility_limit.csv
+_LIMIT_METHODS = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
+                  "zero": "Theorem 3 with all gains 0 (x_f = 0)",
+                  "printed_gains": "vertex LMIs (24) with the printed gains, general slack S",
+                  "plant": "plant Lyapunov + S-procedure LMI, scalar multiplier (lossless for one quadratic constraint)",
+                  "plant_componentwise": "plant Lyapunov + S-procedure LMI, diagonal multiplier"}
+_LIMIT_CLASSES = {"plant_componentwise": "componentwise sectors"}
+
+
+def _limit_row(name, lo, hi, certified, between, n_solves, infeasible_by, role="sufficient"):
+    """One row of feasibility_limit.csv: the certified bracket ``[lo, hi]`` of a design's threshold in sigma^2."""
+    return {"design": name, "sigma2_max": lo, "sigma2_lo": lo, "sigma2_hi": hi, "certified": bool(certified),
+            "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
+            "n_solves": n_solves, "method": _LIMIT_METHODS[name], "infeasible_by": infeasible_by,
+            "sector_class": _LIMIT_CLASSES.get(name, "condition (3)"), "role": role}
+
+
+def _necessary_limits(base, nec) -> list:
+    """The rows of the necessary ends of feasibility_limit.csv: the worst linear gain of each sector class
+    (closed-form limit, radius checked at both ends)."""
+    from .feasibility import worst_sector_gain
+
+    worst = worst_sector_gain(base)
+    limits = []
+    for name, sector, text in (
+            ("plant_necessary", "condition3",
+             f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal ({'reflection' if worst['reflect'] else 'rotation'}"
+             f" by {worst['theta']:.6f} rad; K = [" + "; ".join(", ".join(f"{x:.5g}" for x in r) for r in worst["K"])
+             + "]), "
+             f"closed-form limit {worst['value']:.9g}"),
+            ("plant_componentwise_necessary", "componentwise", "diagonal sector vertices F = diag(F1_ii or F2_ii)")):
+        below, above = nec[sector]
+        ok = bool(np.isfinite(above))  # necessary_limit's bisection keeps radius >= 1 + RADIUS_MARGIN at `above`
+        limits.append({"design": name, "sigma2_max": np.nan, "sigma2_lo": below, "sigma2_hi": above,
+                       "certified": ok, "undecided_from": np.nan, "n_undecided": 0, "n_solves": 0,
+                       "method": text,
+                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
+                                        "gain of the class (not mean-square stable for that f)",
+                       "sector_class": "condition (3)" if sector == "condition3" else "componentwise sectors",
+                       "role": "necessary"})
+    return limits
+
+
+def _z22_limits(base, params, common, guesses) -> list:
+    """The rows of feasibility_limit.csv for the other readings of Z[1][1] (reconstruction Z22): the plant
+    bracket for class (3) and Theorem 3's certified end, designs ``"<design> Z22=<value>"``."""
+    from ...engines.certify import bisect_certified
+
+    from .design import Theorem3
+    from .feasibility import PlantLMI, necessary_limit
+
+    lmi, sens = params["lmi"], params["sensitivity"]
+    lo0, hi0, tol = float(sens["sigma2_lo"]), float(sens["sigma2_hi"]), float(sens["tol"])
+    limits = []
+    for z22 in sorted({float(z) for z in sens.get("z22_readings", [])} - {float(base.Z[1, 1])}):
+        Zz = base.Z.copy()
+        Zz[1, 1] = z22
+        sysz = dataclasses.replace(base, Z=Zz)
+        tag = f" Z22={z22:g}"
+        below, above = necessary_limit(sysz, lo0, hi0, sector="condition3")
+        plant = PlantLMI(sysz, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]), multiplier="scalar")
+        prob = Theorem3(sysz, scheduled=True, **common)
+        top = above if np.isfinite(above) else hi0
+        for name, decide in (("plant", plant.certify), ("scheduled", lambda s2, prob=prob: prob.certify(s2)[0])):
+            b = bisect_certified(decide, lo0, top, tol=tol, feasible_above=False, guess=guesses.get("condition3"),
+                                 width=2 * tol)
+            ends = (b.feasible_end, b.infeasible_end)
+            between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
+            row = _limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
+                             b.verdicts[b.infeasible_end].evidence if b.certified else "")
+            limits.append(dict(row, design=name + tag, Z22=z22))
+        limits.append({"design": "plant_necessary" + tag, "sigma2_max": np.nan, "sigma2_lo": below,
+                       "sigma2_hi": above, "certified": bool(np.isfinite(above)), "undecided_from": np.nan,
+                       "n_undecided": 0, "n_solves": 0,
+                       "method": f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal, with Z22 = {z22:g}",
+                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
+                                        "gain of the class (not mean-square stable for that f)",
+                       "sector_class": "condition (3)", "role": "necessary", "Z22": z22})
+    return limits
+
+
 def sensitivity_step(params, inputs, outputs):
     """Certified feasibility against sigma^2: Theorem 3 (scheduled, fixed gain, zero filter), the printed
     gains' vertex LMIs, and the plant's own limit for the paper's class (3) and for componentwise sectors.
@@ -628,7 +715,7 @@ def sensitivity_step(params, inputs, outputs):
     from ...engines.certify import bisect_certified
 
     from .design import FixedGainsVertexLMI, Theorem3
-    from .feasibility import PlantLMI, necessary_condition, necessary_limit, worst_sector_gain
+    from .feasibility import PlantLMI, necessary_condition, necessary_limit
 
     base = _sys(params)
     lmi = params["lmi"]
@@ -663,19 +750,7 @@ def sensitivity_step(params, inputs, outputs):
                 return v, sol.margin
         return decide
 
-    methods = {"scheduled": "Theorem 3 (24)-(25), gain-scheduled", "fixed_gain": "Theorem 3 with Gf = Hf = 0",
-               "zero": "Theorem 3 with all gains 0 (x_f = 0)",
-               "printed_gains": "vertex LMIs (24) with the printed gains, general slack S",
-               "plant": "plant Lyapunov + S-procedure LMI, scalar multiplier (lossless for one quadratic constraint)",
-               "plant_componentwise": "plant Lyapunov + S-procedure LMI, diagonal multiplier"}
-    classes = {"plant_componentwise": "componentwise sectors"}
     rows, limits = [], []
-
-    def limit_row(name, lo, hi, certified, between, n_solves, infeasible_by, role="sufficient"):
-        return {"design": name, "sigma2_max": lo, "sigma2_lo": lo, "sigma2_hi": hi, "certified": bool(certified),
-                "undecided_from": min(between) if between else np.nan, "n_undecided": len(between),
-                "n_solves": n_solves, "method": methods[name], "infeasible_by": infeasible_by,
-                "sector_class": classes.get(name, "condition (3)"), "role": role}
 
     # the plants first (small LMIs): the class-(3) plant's threshold is then the guess of the Theorem 3
     # bisections (a guess changes the number of solves, never the answer)
@@ -702,62 +777,20 @@ def sensitivity_step(params, inputs, outputs):
             guesses.setdefault(sector, b.feasible_end)
         ends = (b.feasible_end, b.infeasible_end)
         between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
-        limits.append(limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
-                                b.verdicts[b.infeasible_end].evidence if b.certified else ""))
+        limits.append(_limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
+                                 b.verdicts[b.infeasible_end].evidence if b.certified else ""))
     # the printed gains (grid in vertex_lmis.csv): certified feasible at the plant's feasible end, infeasible from
     # the class-(3) necessary end on ((24) implies mean-square stability of the plant); feasibility of (24) is
     # monotone in sigma^2 > 0 (sigma^2 enters through sigma^2 S^T D̄ N Λ^{-1} N^T D̄^T S >= 0 by a Schur complement)
     s2_ok = guesses.get("condition3", np.nan)
     v_ok = decider("printed_gains")(s2_ok)[0] if np.isfinite(s2_ok) else None
     ok = v_ok is not None and v_ok.feasible and np.isfinite(nec["condition3"][1])
-    limits.append(limit_row("printed_gains", s2_ok if ok else np.nan, nec["condition3"][1], ok, [], 1,
-                            "necessary condition: the plant for the worst linear gain of class (3) (plant_necessary)"))
-    # the necessary ends: the worst linear gain of each class (closed-form limit, radius checked at both ends)
-    worst = worst_sector_gain(base)
-    for name, sector, text in (
-            ("plant_necessary", "condition3",
-             f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal ({'reflection' if worst['reflect'] else 'rotation'}"
-             f" by {worst['theta']:.6f} rad; K = [" + "; ".join(", ".join(f"{x:.5g}" for x in r) for r in worst["K"])
-             + "]), "
-             f"closed-form limit {worst['value']:.9g}"),
-            ("plant_componentwise_necessary", "componentwise", "diagonal sector vertices F = diag(F1_ii or F2_ii)")):
-        below, above = nec[sector]
-        ok = bool(np.isfinite(above))  # necessary_limit's bisection keeps radius >= 1 + RADIUS_MARGIN at `above`
-        limits.append({"design": name, "sigma2_max": np.nan, "sigma2_lo": below, "sigma2_hi": above,
-                       "certified": ok, "undecided_from": np.nan, "n_undecided": 0, "n_solves": 0,
-                       "method": text,
-                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
-                                        "gain of the class (not mean-square stable for that f)",
-                       "sector_class": "condition (3)" if sector == "condition3" else "componentwise sectors",
-                       "role": "necessary"})
+    limits.append(_limit_row("printed_gains", s2_ok if ok else np.nan, nec["condition3"][1], ok, [], 1,
+                             "necessary condition: the plant for the worst linear gain of class (3) (plant_necessary)"))
+    limits += _necessary_limits(base, nec)
     for row in limits:
         row["Z22"] = float(base.Z[1, 1])
-    # the other readings of Z[1][1] (reconstruction Z22): the plant bracket for class (3) (scalar-multiplier LMI,
-    # worst linear gain) and Theorem 3's certified end, rows "<design> Z22=<value>"
-    for z22 in sorted({float(z) for z in sens.get("z22_readings", [])} - {float(base.Z[1, 1])}):
-        Zz = base.Z.copy()
-        Zz[1, 1] = z22
-        sysz = dataclasses.replace(base, Z=Zz)
-        tag = f" Z22={z22:g}"
-        below, above = necessary_limit(sysz, lo0, hi0, sector="condition3")
-        plant = PlantLMI(sysz, margin_cap=float(lmi["margin_cap"]), bound=float(lmi["bound"]), multiplier="scalar")
-        prob = Theorem3(sysz, scheduled=True, **common)
-        top = above if np.isfinite(above) else hi0
-        for name, decide in (("plant", plant.certify), ("scheduled", lambda s2, prob=prob: prob.certify(s2)[0])):
-            b = bisect_certified(decide, lo0, top, tol=tol, feasible_above=False, guess=guesses.get("condition3"),
-                                 width=2 * tol)
-            ends = (b.feasible_end, b.infeasible_end)
-            between = [x for x in b.undecided if ends[0] < x < ends[1]] if b.certified else list(b.undecided)
-            row = limit_row(name, b.feasible_end, b.infeasible_end, b.certified, between, b.n_evals,
-                            b.verdicts[b.infeasible_end].evidence if b.certified else "")
-            limits.append(dict(row, design=name + tag, Z22=z22))
-        limits.append({"design": "plant_necessary" + tag, "sigma2_max": np.nan, "sigma2_lo": below,
-                       "sigma2_hi": above, "certified": bool(np.isfinite(above)), "undecided_from": np.nan,
-                       "n_undecided": 0, "n_solves": 0,
-                       "method": f"worst linear gain K = (F1+F2)/2 + U(F2-F1)/2, U orthogonal, with Z22 = {z22:g}",
-                       "infeasible_by": f"plant second-moment radius >= 1 + 1e-9 at sigma2 = {above:.9g} for a linear "
-                                        "gain of the class (not mean-square stable for that f)",
-                       "sector_class": "condition (3)", "role": "necessary", "Z22": z22})
+    limits += _z22_limits(base, params, common, guesses)
     return {"table": pd.DataFrame(rows), "limits": pd.DataFrame(limits)}
 
 

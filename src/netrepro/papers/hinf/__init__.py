@@ -19,8 +19,11 @@ Modules
     The evasive target, eqs (19)-(24).
 ``evader_kernels``
     Compiled inner loops of the evader's solver.
+``simulation``
+    The frozen scenario type and the named phases of one simulation step (target, measurements, consensus,
+    filters, agents).
 ``model``
-    The multi-agent system of Section VI: scenarios and their Monte Carlo simulation.
+    The multi-agent system of Section VI: scenarios and their Monte Carlo simulation (the loop over the phases).
 ``steps``
     Pipeline steps writing ``results/hinf/*.csv``.
 ``analysis``

@@ -875,6 +875,69 @@ def _reconstruction_rows(cfg, sens, ev_conv) -> list[dict]:
     return rows
 
 
+def _consensus_filter_rows(inputs, cfg, at) -> list:
+    """The consensus (5) (zero steady-state error, stable for small h) and the filters (6), (9) (Kalman limit,
+    no filter below gamma_0, exact decentralized = centralized) from their check tables."""
+    # consensus (5)
+    rows = []
+    cc = pd.read_csv(inputs["consensus"])
+    stable = cc[cc["stable"]]
+    hmax = float(cc["h_max"].iloc[0])
+    rows.append({"quantity": "consensus.zero_steady_state_error",
+                 "value": bool(len(stable) > 0 and stable["steady_state_error"].max()
+                               < float(at["consensus_zero_steady_state_error"]["max_error"])),
+                 "note": f"max steady-state error over the stable h: {stable['steady_state_error'].max():.2e}"})
+    small = bool(cc.loc[cc["h"] <= hmax, "stable"].all() and (~cc.loc[cc["h"] > hmax, "stable"]).all()
+                 and (cc["h"] > hmax).any())
+    rows.append({"quantity": "consensus.stable_small_h", "value": small,
+                 "note": f"stability range on the Fig-2 path graph: 0 < h <= {hmax:.4f} (gamma_c={cfg['consensus']['gamma_c']}, "
+                         f"K_p={cfg['consensus']['K_p']}, K_i={cfg['consensus']['K_i']}); unstable runs diverge"})
+    # filters (6), (9)
+    att = pd.read_csv(inputs["attenuation"]).set_index("filter")
+    chk = pd.read_csv(inputs["checks"]).set_index("check")["value"]
+    rows += [
+        {"quantity": "filter.hinf_to_kalman", "value": bool(chk["hinf_vs_kalman_max_abs_diff"] < float(at["hinf_to_kalman"]["max_diff"])),
+         "note": f"max abs difference {chk['hinf_vs_kalman_max_abs_diff']:.2e}"},
+        {"quantity": "filter.no_filter_below_gamma0", "value": bool((att["status_below"] == "does_not_exist").all()),
+         "note": "gamma_0: " + ", ".join(f"{f} {g:.3f}" for f, g in att["gamma0"].items())},
+        {"quantity": "filter.exact_decentralized_is_centralized",
+         "value": bool(chk["decentralized_exact_vs_centralized_max_abs_diff"]
+                       < float(at["decentralized_exact_equals_centralized"]["max_diff"])),
+         "note": f"max abs difference {chk['decentralized_exact_vs_centralized_max_abs_diff']:.2e}"},
+    ]
+    return rows
+
+
+def _fig45_rows(inputs, cfg, summ, paired, z_sig) -> list:
+    """Figs 4-5: settling, the mobile agents' smoother and smaller errors, the attribution and the control sweep."""
+    # Fig 4-5
+    rows = []
+    errors = pd.read_csv(inputs["errors"])
+    thresholds = sorted(set(float(t) for t in cfg["claims"]["settle_variants"]) | {float(cfg["claims"]["settle_threshold"])})
+    settle_rows, settle_txt = _settle_rows(errors, thresholds, float(cfg["claims"]["settle_threshold"]))
+    rows += settle_rows
+    sl, md = summ.loc[("static_fixed", "local")], summ.loc[("static_mobile", "decentralized")]
+    rows.append({"quantity": "fig4.mobile_smoother", "value": bool(md["total_variation"] < sl["total_variation"]),
+                 "note": f"total variation per step: stationary local {sl['total_variation']:.4f}, mobile decentralized "
+                         f"{md['total_variation']:.4f}"})
+    per_run = {s: pd.read_csv(inputs[f"per_run_{s}"]) for s in ("static_fixed", "static_mobile")}
+    rows.append({"quantity": "fig4.attribution", "value": "",
+                 "note": _fig4_attribution(summ, per_run, z_sig, settle_txt)})
+    z5 = float(paired.loc["fig5_mobile_vs_stationary", "z"])
+    sd = summ.loc[("static_fixed", "decentralized")]
+    f5 = pd.read_csv(inputs["fig5_control"])
+    rows.append({"quantity": "fig5.mobile_beats_stationary", "value": _z_rule(z5, z_sig),
+                 "note": f"late mean error stationary {sd['late_mean']:.4f}, mobile {md['late_mean']:.4f} (paired z = {z5:.1f}, "
+                         f"{int(md['n_runs'])} runs); control sweep (fig5_control.csv, {int(f5['runs'].iloc[0])} runs, "
+                         f"horizon {int(f5['horizon'].iloc[0])}): stationary {f5['stationary'].iloc[0]:.4f}, mobile "
+                         + ", ".join(f"{r.parameter}={r.value:g} {r.mobile:.4f} (z = {r.z:.1f})" for r in f5.itertuples())})
+    for r in f5.itertuples():
+        rows.append({"quantity": "fig5.mobile_beats_stationary",
+                     "variant": f"control.{r.parameter}={r.value:g} (H={r.horizon})",
+                     "value": _z_rule(r.z, z_sig)})
+    return rows
+
+
 def evidence_step(params, inputs, outputs):
     """Step of rule ``hinf_evidence``: the evidence table ``results/evidence/hinf.csv``.
 
@@ -911,32 +974,7 @@ def evidence_step(params, inputs, outputs):
     at = {c.claim_id: c.at for c in load_claims(inputs["claims"])}  # the claims' settings (their YAML 'at' fields)
     finding_settings = {f.finding_id: f.at for f in load_findings(inputs["findings"])}  # the findings' decision settings
     rows = _errata_rows(cfg)
-    # consensus (5)
-    cc = pd.read_csv(inputs["consensus"])
-    stable = cc[cc["stable"]]
-    hmax = float(cc["h_max"].iloc[0])
-    rows.append({"quantity": "consensus.zero_steady_state_error",
-                 "value": bool(len(stable) > 0 and stable["steady_state_error"].max()
-                               < float(at["consensus_zero_steady_state_error"]["max_error"])),
-                 "note": f"max steady-state error over the stable h: {stable['steady_state_error'].max():.2e}"})
-    small = bool(cc.loc[cc["h"] <= hmax, "stable"].all() and (~cc.loc[cc["h"] > hmax, "stable"]).all()
-                 and (cc["h"] > hmax).any())
-    rows.append({"quantity": "consensus.stable_small_h", "value": small,
-                 "note": f"stability range on the Fig-2 path graph: 0 < h <= {hmax:.4f} (gamma_c={cfg['consensus']['gamma_c']}, "
-                         f"K_p={cfg['consensus']['K_p']}, K_i={cfg['consensus']['K_i']}); unstable runs diverge"})
-    # filters (6), (9)
-    att = pd.read_csv(inputs["attenuation"]).set_index("filter")
-    chk = pd.read_csv(inputs["checks"]).set_index("check")["value"]
-    rows += [
-        {"quantity": "filter.hinf_to_kalman", "value": bool(chk["hinf_vs_kalman_max_abs_diff"] < float(at["hinf_to_kalman"]["max_diff"])),
-         "note": f"max abs difference {chk['hinf_vs_kalman_max_abs_diff']:.2e}"},
-        {"quantity": "filter.no_filter_below_gamma0", "value": bool((att["status_below"] == "does_not_exist").all()),
-         "note": "gamma_0: " + ", ".join(f"{f} {g:.3f}" for f, g in att["gamma0"].items())},
-        {"quantity": "filter.exact_decentralized_is_centralized",
-         "value": bool(chk["decentralized_exact_vs_centralized_max_abs_diff"]
-                       < float(at["decentralized_exact_equals_centralized"]["max_diff"])),
-         "note": f"max abs difference {chk['decentralized_exact_vs_centralized_max_abs_diff']:.2e}"},
-    ]
+    rows += _consensus_filter_rows(inputs, cfg, at)
     summ = pd.read_csv(inputs["summary"]).set_index(["scenario", "filter"])
     paired = pd.read_csv(inputs["paired"]).set_index("comparison")
     pa = pd.read_csv(inputs["per_agent"])
@@ -977,30 +1015,7 @@ def evidence_step(params, inputs, outputs):
         f"advantage (local/decentralized late error) at W={cfg['scenarios']['fig2']['W']:g}: "
         f"{adv['fig2']:.3f}, at W={cfg['scenarios']['fig3']['W']:g}: {adv['fig3']:.3f}; residual = how "
         f"far the order each form states is violated")
-    # Fig 4-5
-    errors = pd.read_csv(inputs["errors"])
-    thresholds = sorted(set(float(t) for t in cfg["claims"]["settle_variants"]) | {float(cfg["claims"]["settle_threshold"])})
-    settle_rows, settle_txt = _settle_rows(errors, thresholds, float(cfg["claims"]["settle_threshold"]))
-    rows += settle_rows
-    sl, md = summ.loc[("static_fixed", "local")], summ.loc[("static_mobile", "decentralized")]
-    rows.append({"quantity": "fig4.mobile_smoother", "value": bool(md["total_variation"] < sl["total_variation"]),
-                 "note": f"total variation per step: stationary local {sl['total_variation']:.4f}, mobile decentralized "
-                         f"{md['total_variation']:.4f}"})
-    per_run = {s: pd.read_csv(inputs[f"per_run_{s}"]) for s in ("static_fixed", "static_mobile")}
-    rows.append({"quantity": "fig4.attribution", "value": "",
-                 "note": _fig4_attribution(summ, per_run, z_sig, settle_txt)})
-    z5 = float(paired.loc["fig5_mobile_vs_stationary", "z"])
-    sd = summ.loc[("static_fixed", "decentralized")]
-    f5 = pd.read_csv(inputs["fig5_control"])
-    rows.append({"quantity": "fig5.mobile_beats_stationary", "value": _z_rule(z5, z_sig),
-                 "note": f"late mean error stationary {sd['late_mean']:.4f}, mobile {md['late_mean']:.4f} (paired z = {z5:.1f}, "
-                         f"{int(md['n_runs'])} runs); control sweep (fig5_control.csv, {int(f5['runs'].iloc[0])} runs, "
-                         f"horizon {int(f5['horizon'].iloc[0])}): stationary {f5['stationary'].iloc[0]:.4f}, mobile "
-                         + ", ".join(f"{r.parameter}={r.value:g} {r.mobile:.4f} (z = {r.z:.1f})" for r in f5.itertuples())})
-    for r in f5.itertuples():
-        rows.append({"quantity": "fig5.mobile_beats_stationary",
-                     "variant": f"control.{r.parameter}={r.value:g} (H={r.horizon})",
-                     "value": _z_rule(r.z, z_sig)})
+    rows += _fig45_rows(inputs, cfg, summ, paired, z_sig)
     ev = summ.loc[("evasive_hinf", "decentralized")]
     rows.append({"quantity": "fig6.agents_align", "value": bool(ev["range_error_end"] < ev["range_error_start"]),
                  "note": f"mean |r_i - a1|: start {ev['range_error_start']:.2f}, end {ev['range_error_end']:.2f}"})
