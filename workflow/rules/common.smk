@@ -18,6 +18,7 @@ try:
     )
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
+    from netrepro.stepspec import compose_config, load_step_specs
     from netrepro.registry import paper_slugs
     from netrepro.venv_paths import interpreter
     from netrepro.processes import STARTER_VARIABLE, starter_mark
