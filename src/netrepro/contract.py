@@ -553,8 +553,8 @@ def _picks(config):
             yield from _picks(part)
     elif isinstance(config, dict):
         yield config.get("from"), config.get("keys")
-        for name in config.get("merge") or []:
-            yield None, [name]
+        for part in config.get("merge") or []:
+            yield from ([(None, [part])] if isinstance(part, str) else _picks(part))
 
 
 def _check_steps(slug: str, pkg: Path, root: Path) -> list[Violation]:

@@ -26,7 +26,7 @@ declared once (issue 39). The workflow (``workflow/rules/steps.smk``) generates 
 
 ``config`` is a list of keys (``$<group>`` names a key group), read as ``pick(section, *keys)``,
 or a mapping: ``{from: <entry>, keys: [...], merge: [<entry>, ...]}`` picks the keys of one entry
-of the section and merges whole entries into it; ``{fields: {<name>: {from: <entry>, keys: [...]}}}``
+of the section and merges into them whole entries (or picks ``{from: <entry>, keys: [...]}``); ``{fields: {<name>: {from: <entry>, keys: [...]}}}``
 nests such picks (without ``keys``: the whole entry). A step with ``over: <wildcard>`` runs once
 per value of ``wildcards.<wildcard>``; its params are ``{<wildcard>: value, "cfg": ...}`` where
 ``narrow: <key>`` keeps only the value's entry of that key.
@@ -221,6 +221,9 @@ def _resolve_config(config, groups: dict, where: str):
     if "fields" in config:
         config["fields"] = {name: _resolve_config(part, groups, f"{where}: field {name!r}")
                             for name, part in config["fields"].items()}
+    if "merge" in config:
+        config["merge"] = [part if isinstance(part, str) else _resolve_config(part, groups, where)
+                           for part in config["merge"]]
     return config
 
 
@@ -249,8 +252,8 @@ def compose_config(section: dict, config) -> dict:
         return {name: compose_config(section, part) for name, part in config["fields"].items()}
     entry = section.get(config["from"], {}) if "from" in config else section
     out = _pick(entry, config["keys"]) if "keys" in config else dict(entry)
-    for name in config.get("merge", []):
-        out.update(section.get(name, {}))
+    for part in config.get("merge", []):
+        out.update(section.get(part, {}) if isinstance(part, str) else compose_config(section, part))
     return out
 
 
@@ -277,7 +280,8 @@ def config_keys(config) -> list[tuple[tuple, str]]:
     if "from" in config:
         out.append(((), config["from"]))
         out += [((config["from"],), k) for k in config.get("keys", [])]
-    out += [((), name) for name in config.get("merge", [])]
+    for part in config.get("merge", []):
+        out += [((), part)] if isinstance(part, str) else config_keys(part)
     return out
 
 
