@@ -160,12 +160,7 @@ def _run_sidecars(papers: dict, extra=()) -> dict[str, dict]:
 
 
 def _workflow_sources(root: Path) -> list[str]:
-    """The Snakefiles of the workflow, the root entry point first, then the papers' step lists (repository-relative).
-
-    The step lists (``src/netrepro/papers/<slug>/steps.yaml``) declare the compute rules that
-    ``workflow/rules/steps.smk`` generates, so they are part of the workflow's text.
-    """
+    """The Snakefiles of the workflow, the root entry point first (repository-relative)."""
     files = ["Snakefile", "workflow/Snakefile", *sorted(p.relative_to(root).as_posix()
                                                          for p in (root / "workflow" / "rules").glob("*.smk"))]
-    files += sorted(p.relative_to(root).as_posix() for p in (root / "src/netrepro/papers").glob("*/steps.yaml"))
     return [f for f in files if (root / f).is_file()]
