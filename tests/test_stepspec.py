@@ -1,5 +1,6 @@
 """The per-paper step lists (issue 39): loader, schema and the rules the workflow generates from them."""
 
+import json
 import re
 import shutil
 import subprocess
@@ -205,3 +206,26 @@ def test_every_declared_step_yields_a_rule_with_its_outputs():
                 (path,) = spec.shard.outputs.values()
                 assert jobs.get(spec.shard_rule) and all(re.fullmatch(path.replace("{shard}", r"\d+"), p)
                                                          for p in jobs[spec.shard_rule]), spec.shard_rule
+
+
+@pytest.mark.slow
+@pytest.mark.xdist_group("workflow")
+def test_every_built_output_was_written_by_its_declared_function(built_repo):
+    """The command a job ran (the output's sidecar) names the step's rule and function.
+
+    Snakemake evaluates a rule's ``shell:`` again when the job runs, after the generating loop has
+    moved on; a dry run shows the command of the definition only, so this reads what ran.
+    """
+    for slug in paper_slugs():
+        paper = load_step_specs(slug, root=ROOT)
+        for spec in paper.steps:
+            pairs = [(spec.rule, spec.func, path) for path in spec.outputs.values()]
+            if spec.shard:
+                pairs += [(spec.shard_rule, spec.shard.func, path.replace("{shard}", "0"))
+                          for path in spec.shard.outputs.values()]
+            for rule, func, path in pairs:
+                if spec.over:
+                    path = path.format(**{spec.over: paper.wildcards[spec.over][0]})
+                sidecar = built_repo / f"{path}.meta.json"
+                command = json.loads(sidecar.read_text())["command"]
+                assert f"--rule {rule} --func {func} " in command, (sidecar, command[:200])

@@ -6,6 +6,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from snakemake.common import RULEFUNC_CONTEXT_MARKER
 from snakemake.exceptions import WorkflowError
 
 try:

@@ -4,6 +4,25 @@
 # rules (the figures and the report pick the enabled ones); PAPER_TABLES lists the enabled papers.
 
 
+# rule name -> its step function (module:function), for the shell command of each generated rule
+STEP_FUNCS = {}
+
+
+def step_func(namespace, defining):
+    """The step function of the rule whose ``shell:`` expression is being evaluated.
+
+    Snakemake evaluates a rule's ``shell:`` expression twice: once when the rule is defined (the
+    text its code rerun trigger compares, here ``defining``'s) and again when a job runs, inside the
+    rule's run function, after this loop has moved on (``_spec`` and ``_step_rule`` are then
+    another rule's, so the expression may not touch ``_spec``'s attributes). The run
+    function's locals carry the job's ``rule`` name (and Snakemake's run-function marker), so the
+    job looks its own function up: the command is ``step(func)`` with the function spelled out, as
+    the hand-written rules had it, and a changed function still reruns the rule.
+    """
+    name = namespace["rule"] if namespace.get(RULEFUNC_CONTEXT_MARKER) else defining
+    return STEP_FUNCS[name]
+
+
 def step_list(slug):
     """The paper's step list, validated before any job runs, or a clear error."""
     try:
@@ -71,7 +90,10 @@ for _slug in paper_slugs():
     _paper = step_list(_slug)
     _section = config.get(_slug, {})
     for _spec in _paper.steps:
+        STEP_FUNCS[_spec.rule] = _spec.func
         if _spec.shard:
+            STEP_FUNCS[_spec.shard_rule] = _spec.shard.func
+            _step_rule = _spec.shard_rule
 
             rule:
                 name:
@@ -94,7 +116,9 @@ for _slug in paper_slugs():
                     rule=_spec.shard_rule,
                     io=io_json,
                 shell:
-                    step(_spec.shard.func)
+                    step(step_func(locals(), _step_rule))
+
+        _step_rule = _spec.rule
 
         rule:
             name:
@@ -122,7 +146,7 @@ for _slug in paper_slugs():
                 rule=_spec.rule,
                 io=io_json,
             shell:
-                step(_spec.func)
+                step(step_func(locals(), _step_rule))
 
     if enabled(_slug):
         PAPER_TABLES[_slug] = [step_output(_slug, ref) for ref in _paper.tables]
