@@ -76,7 +76,9 @@ class ShardSpec:
     wrap : str or None
         Nest the picked keys under this name in the params (else merged flat).
     threads : int or None
+        The shard rule's threads (None: Snakemake's default, 1).
     resources : dict
+        The shard rule's resources (``mem_mb``, ``runtime`` in minutes).
     """
 
     func: str
@@ -155,7 +157,23 @@ class StepSpec:
 
 @dataclass(frozen=True)
 class PaperSteps:
-    """A paper's step list: the steps in declared order, key groups, wildcard values, tables."""
+    """A paper's step list: the steps in declared order, key groups, wildcard values, tables.
+
+    Attributes
+    ----------
+    slug : str
+        The paper.
+    path : Path
+        Its ``steps.yaml``.
+    steps : list of StepSpec
+        The steps, in declared order (a step names only steps above it).
+    key_groups : dict
+        Group name -> the configuration keys it stands for (``$<group>`` in a ``config``).
+    wildcards : dict
+        Wildcard name -> its values (for the steps with ``over``).
+    tables : list of str
+        The paper's result tables, ``<step>[.<output>]``, in the notebook's order.
+    """
 
     slug: str
     path: Path
@@ -165,7 +183,18 @@ class PaperSteps:
     tables: list = field(default_factory=list)
 
     def step(self, name: str) -> StepSpec:
-        """The step called ``name``."""
+        """The step called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The step's name (its rule without the slug prefix).
+
+        Returns
+        -------
+        StepSpec
+            The declaration.
+        """
         for spec in self.steps:
             if spec.name == name:
                 return spec
