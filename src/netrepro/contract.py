@@ -3,7 +3,7 @@
 ``docs/adding-a-paper.md`` describes the shape every paper has. :func:`check_paper` checks it by
 reading the files (nothing is imported or run), and names the file and line of each violation:
 
-* ``roles``: the package roles, data files, rules file, captions, schema section, registry entry,
+* ``roles``: the package roles, data files, step list (steps.yaml), captions, schema section, registry entry,
   tests and committed reference tables are present;
 * ``figures-imports``: ``figures.py`` imports neither the model nor the steps;
 * ``math-io``: math modules do no file IO and import no pandas;
