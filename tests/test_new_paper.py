@@ -47,11 +47,12 @@ def test_the_plan_creates_every_role_and_registers_the_paper(tmp_path):
     plan = plan_new_paper("plan_probe", "A title", source, ROOT)
     pkg = "src/netrepro/papers/plan_probe/"
     for name in ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
-                 "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml"):
+                 "steps.yaml", "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml"):
         assert pkg + name in plan.create, name
     for role in ("model", "steps", "evidence", "figures", "checks"):
         assert f"tests/papers/plan_probe/test_{role}.py" in plan.create, role
-    assert "workflow/rules/plan_probe.smk" in plan.create
+    # no rules file: the workflow generates the paper's rules from its steps.yaml
+    assert not [p for p in plan.create if p.startswith("workflow/rules/")]
     assert "plan_probe:" in plan.rewrite["src/netrepro/papers.yaml"]
     assert 'plan_probe: {$ref: "plan_probe.schema.yaml"}' in plan.rewrite["workflow/schemas/config.schema.yaml"]
     assert re.search(r"^papers: \[intermittent, markov, onebit, gainsched, hinf(, \w+)*, plan_probe\]$", plan.rewrite["config/test.yaml"], re.M)

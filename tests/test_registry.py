@@ -29,7 +29,8 @@ def test_every_registered_paper_has_its_package_rules_and_source():
     shared = ROOT.parent / "shared" / "papers"
     for slug, entry in load_registry().items():
         assert (ROOT / "src/netrepro/papers" / slug / "__init__.py").is_file(), slug
-        assert (ROOT / "workflow/rules" / f"{slug}.smk").is_file(), slug
+        # the paper's compute rules are generated from its step list (workflow/rules/steps.smk)
+        assert (ROOT / "src/netrepro/papers" / slug / "steps.yaml").is_file(), slug
         if shared.is_dir():  # the texts are beside the checkout here, not in a clone
             assert (shared / entry["source"]).is_file(), entry["source"]
 

@@ -214,53 +214,24 @@ FINDINGS = '''
   figure: fig1
 '''
 
-RULES = '''
-KALMAN_IID_CFG = config.get("kalman_iid", {})
-
-
-rule kalman_iid_fixed_point_curve:
-    input:
-        code=code("netrepro.papers.kalman_iid.steps:fixed_point_curve_step"),
-    output:
-        table="results/kalman_iid/fixed_point_curve.csv",
-    log:
-        "logs/kalman_iid/fixed_point_curve.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(pick(KALMAN_IID_CFG, "system", "curve")),
-        rule="kalman_iid_fixed_point_curve",
-        io=io_json,
-    shell:
-        step("netrepro.papers.kalman_iid.steps:fixed_point_curve_step")
-
-
-rule kalman_iid_evidence:
-    input:
-        code=code("netrepro.papers.kalman_iid.evidence:evidence_step"),
-        curve=rules.kalman_iid_fixed_point_curve.output.table,
-        claims_file="src/netrepro/papers/kalman_iid/claims.yaml",
-    output:
-        table="results/evidence/kalman_iid.csv",
-    log:
-        "logs/kalman_iid/evidence.log",
-    localrule: True
-    conda:
-        CONDA_ENV
-    params:
-        cfg=as_json(pick(KALMAN_IID_CFG, "system")),
-        rule="kalman_iid_evidence",
-        io=io_json,
-    shell:
-        step("netrepro.papers.kalman_iid.evidence:evidence_step")
-
-
-if enabled("kalman_iid"):
-    PAPER_TABLES["kalman_iid"] = [
-        rules.kalman_iid_fixed_point_curve.output.table,
-        rules.kalman_iid_evidence.output.table,
-    ]
+STEP_LIST = '''
+tables: [fixed_point_curve, evidence]
+steps:
+  fixed_point_curve:
+    func: steps:fixed_point_curve_step
+    outputs:
+      table: results/kalman_iid/fixed_point_curve.csv
+    config: [system, curve]
+    local: true
+  evidence:
+    func: evidence:evidence_step
+    inputs:
+      curve: fixed_point_curve
+      claims_file: src/netrepro/papers/kalman_iid/claims.yaml
+    outputs:
+      table: results/evidence/kalman_iid.csv
+    config: [system]
+    local: true
 '''
 
 SCHEMA = '''
@@ -313,9 +284,8 @@ def _fill_in(work: Path) -> None:
     pkg = work / "src/netrepro/papers" / SLUG
     for name, text in {"model.py": MODEL, "steps.py": STEPS, "evidence.py": EVIDENCE, "figures.py": FIGURES,
                        "figures.yaml": FIGURES_YAML, "claims.yaml": CLAIMS, "findings.yaml": FINDINGS,
-                       "errata.yaml": "[]\n", "reconstructions.yaml": "[]\n"}.items():
+                       "errata.yaml": "[]\n", "reconstructions.yaml": "[]\n", "steps.yaml": STEP_LIST}.items():
         (pkg / name).write_text(textwrap.dedent(text).lstrip())
-    (work / "workflow/rules" / f"{SLUG}.smk").write_text(textwrap.dedent(RULES).lstrip())
     (work / "workflow/schemas" / f"{SLUG}.schema.yaml").write_text(textwrap.dedent(SCHEMA).lstrip())
     tests = work / "tests/papers" / SLUG
     for old in tests.glob("test_*.py"):

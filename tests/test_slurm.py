@@ -40,7 +40,9 @@ from pathlib import Path
 import pytest
 import yaml
 
+from netrepro.registry import paper_slugs
 from netrepro.regression import compare_tables
+from netrepro.stepspec import load_step_specs
 from tests.conftest import copy_repo
 from tests.slurm.cluster import PARTITION, LocalSlurm, SlurmUnavailable, unavailable_reason
 from tests.slurm.measure import TARGETS, submissions
@@ -110,6 +112,9 @@ def _local_rules(workdir: Path) -> set[str]:
         for name, body in re.findall(r"^rule (\w+):\n(.*?)(?=^\S|\Z)", text, re.MULTILINE | re.DOTALL):
             if re.search(r"^\s+localrule:\s*True", body, re.MULTILINE):
                 names.add(name)
+    # the generated compute rules: a step declared `local: true` in its paper's steps.yaml
+    for slug in paper_slugs():
+        names.update(spec.rule for spec in load_step_specs(slug).steps if spec.local)
     return names
 
 
@@ -142,8 +147,10 @@ def cluster():
 
 
 def _shard_rules(workdir: Path) -> set[str]:
-    return {name for smk in (Path(workdir) / "workflow" / "rules").glob("*.smk")
-            for name in re.findall(r"^rule (\w+_shard):", smk.read_text(), re.MULTILINE)}
+    hand_written = {name for smk in (Path(workdir) / "workflow" / "rules").glob("*.smk")
+                    for name in re.findall(r"^rule (\w+_shard):", smk.read_text(), re.MULTILINE)}
+    return hand_written | {spec.shard_rule for slug in paper_slugs() for spec in load_step_specs(slug).steps
+                           if spec.shard}
 
 
 def test_sharded_tables_through_slurm_as_job_arrays(cluster, tmp_path_factory):

@@ -3,7 +3,7 @@
 ``docs/adding-a-paper.md`` describes the shape every paper has. :func:`check_paper` checks it by
 reading the files (nothing is imported or run), and names the file and line of each violation:
 
-* ``roles``: the package roles, data files, rules file, captions, schema section, registry entry,
+* ``roles``: the package roles, data files, step list (steps.yaml), captions, schema section, registry entry,
   tests and committed reference tables are present;
 * ``figures-imports``: ``figures.py`` imports neither the model nor the steps;
 * ``math-io``: math modules do no file IO and import no pandas;
@@ -18,15 +18,19 @@ reading the files (nothing is imported or run), and names the file and line of e
   statement types a number that is one of its evidence values, and no numeric rule that agrees
   with our value lacks an independent source of its threshold (issue 37);
 * ``figure-spec``: every figure of ``figures.yaml`` has its plotting function and a caption;
-* ``rule-name``: every rule of ``workflow/rules/<slug>.smk`` starts with the slug;
-* ``config-key``: every configuration key the rules pick for their steps is in the paper's schema;
+* ``steps``: the step list ``steps.yaml`` loads as the workflow loads it (schema, every input naming a
+  step declared above and an output of it, no output path twice, every function defined in its module);
+* ``rule-name``: every rule of a hand-written ``workflow/rules/<slug>.smk`` (optional) starts with the slug;
+* ``config-key``: every configuration key a step of ``steps.yaml`` reads (and every key a hand-written
+  rule picks) is in the paper's schema;
 * ``config-reference``: every configuration key that the paper's data files name in their text, as
   ``(config <key>`` (e.g. ``range: "... (config evidence.low_snr_db)"``), is in the paper's section of
   ``config/config.yaml`` and ``config/test.yaml``: a dotted key as a path from the section (or, when it
   starts with the slug, from the configuration's root), a bare key at any depth of the section. Reconstruction keys, ``at`` settings and variant labels are not configuration
   paths by definition (``steady_state``, ``Z22``, ``p``, ``steer_on_truth``), so they are not checked;
-* ``whole-section``: no rule's params pass the paper's configuration section (or the whole
-  configuration) whole: a step gets only the keys it reads, ``pick(SECTION, "key", ...)`` (issue 39).
+* ``whole-section``: no step of ``steps.yaml`` reads the paper's configuration section whole (a
+  ``config`` mapping with neither ``from`` nor ``keys``), and no hand-written rule's params pass the
+  section (or the whole configuration) whole: a step gets only the keys it reads (issue 39).
 """
 
 from __future__ import annotations
@@ -110,7 +114,7 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
     out = [Violation(_rel(pkg / name, root), 0, "roles", f"missing: the paper's {name}")
            for name in (*ROLES, *DATA_FILES) if not (pkg / name).is_file()]
     required = {
-        root / "workflow/rules" / f"{slug}.smk": "the paper's rules file",
+        pkg / "steps.yaml": "the paper's step list (its compute rules are generated from it)",
         root / "workflow/schemas" / f"{slug}.schema.yaml": "the paper's configuration schema",
         root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.report make-notebook)",
         root / "tests/papers" / slug: "the paper's tests (tests/papers/<slug>/)",
@@ -533,6 +537,75 @@ def _check_whole_section(slug: str, root: Path) -> list[Violation]:
     return out
 
 
+def _step_configs(entry: dict):
+    """(where, declaration) of the configuration a step of steps.yaml reads, and of its shard's."""
+    yield "", entry.get("config", [])
+    if isinstance(entry.get("shard"), dict):
+        yield "shard ", entry["shard"].get("config", [])
+
+
+def _picks(config):
+    """Every pick of a ``config`` declaration: ``(from, keys)``; ``keys`` None for a whole entry."""
+    if isinstance(config, list):
+        yield None, config
+    elif isinstance(config, dict) and "fields" in config:
+        for part in (config["fields"] or {}).values():
+            yield from _picks(part)
+    elif isinstance(config, dict):
+        yield config.get("from"), config.get("keys")
+        for part in config.get("merge") or []:
+            yield from ([(None, [part])] if isinstance(part, str) else _picks(part))
+
+
+def _check_steps(slug: str, pkg: Path, root: Path) -> list[Violation]:
+    """The step list: it loads (``steps``), reads no whole section (``whole-section``) and only the schema's keys."""
+    from .errors import NetreproError
+    from .stepspec import load_step_specs
+
+    path = pkg / "steps.yaml"
+    if not path.is_file():
+        return []
+    rel, text = _rel(path, root), path.read_text()
+    out = []
+    try:
+        load_step_specs(slug, pkg.parents[1], root=root)
+    except NetreproError as exc:
+        out.append(Violation(rel, 0, "steps", str(exc).replace(str(path), rel)))
+    data = yaml.safe_load(text) or {}
+    steps = data.get("steps") if isinstance(data.get("steps"), dict) else {}
+    groups = data.get("key_groups") if isinstance(data.get("key_groups"), dict) else {}
+    schema_path = root / "workflow/schemas" / f"{slug}.schema.yaml"
+    schema = yaml.safe_load(schema_path.read_text()) if schema_path.is_file() else None
+    for name, entry in steps.items():
+        if not isinstance(entry, dict):
+            continue
+        line = _line_of(text, f"\n  {name}:") + 1
+        for label, config in _step_configs(entry):
+            for source, keys in _picks(config):
+                if source is None and keys is None:
+                    out.append(Violation(rel, line, "whole-section",
+                                         f"step {name!r}: the {label}config reads the section {slug!r} whole: "
+                                         "list only the keys the step reads (config: [key, ...])"))
+                    continue
+                if schema is None:
+                    continue
+                expanded = []
+                for key in keys or []:
+                    expanded += groups.get(key[1:], []) if str(key).startswith("$") else [key]
+                props = schema.get("properties") or {}
+                checks = [((), source)] if source is not None else []
+                node = props.get(source, {}) if source is not None else None
+                inner = (node.get("properties") or {}) if node is not None else props
+                checks += [((source,) if source is not None else (), k) for k in expanded]
+                for where, key in checks:
+                    if key not in (inner if where else props):
+                        dotted = ".".join([slug, *where, key])
+                        out.append(Violation(rel, line, "config-key",
+                                             f"step {name!r}: the {label}config reads {dotted}, but "
+                                             f"{_rel(schema_path, root)} does not define it"))
+    return out
+
+
 # a configuration key named in the text of a data file: "(config evidence.low_snr_db", "(config growth_ratio_rtol"
 _CONFIG_REFERENCE = re.compile(r"\(config\s+([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)")
 _CONFIG_FILES = ("config/config.yaml", "config/test.yaml")
@@ -638,7 +711,8 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
             *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_findings_gate(slug, pkg, root),
             *_check_figures(slug, pkg, root), *_check_config_references(slug, pkg, root),
-            *_check_rule_names(slug, root), *_check_config_keys(slug, root), *_check_whole_section(slug, root)]
+            *_check_steps(slug, pkg, root), *_check_rule_names(slug, root), *_check_config_keys(slug, root),
+            *_check_whole_section(slug, root)]
 
 
 def main(slugs, root: str | Path = ".") -> int:

@@ -6,6 +6,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from snakemake.common import RULEFUNC_CONTEXT_MARKER
 from snakemake.exceptions import WorkflowError
 
 try:
@@ -18,6 +19,7 @@ try:
     )
     from netrepro.errors import NetreproError
     from netrepro.figurespec import load_figure_specs
+    from netrepro.stepspec import compose_config, load_step_specs
     from netrepro.registry import paper_slugs
     from netrepro.venv_paths import interpreter
     from netrepro.processes import STARTER_VARIABLE, starter_mark
@@ -179,6 +181,89 @@ def report_inputs(wildcards):
         named[f"{slug}_figure_list"] = spec["figure_list"]
         named[f"{slug}_notebook"] = spec["notebook"]
     return named
+
+
+# ----- the compute steps generated from each paper's steps.yaml (workflow/rules/steps.smk)
+# step functions (module:function) by the name of the generated rule that runs each one
+STEP_FUNCS = {}
+
+
+def step_func(namespace, defining):
+    """The step function of the job or rule whose shell command is being evaluated.
+
+    Snakemake evaluates a rule's ``shell:`` expression twice: once when the rule is defined (the
+    text its code rerun trigger compares, here ``defining``'s) and again when a job runs, inside the
+    rule's run function, after this loop has moved on (``_spec`` and ``_step_rule`` are then
+    another rule's, so the expression may not touch ``_spec``'s attributes). The run
+    function's locals carry the job's ``rule`` name (and Snakemake's run-function marker), so the
+    job looks its own function up: the command is ``step(func)`` with the function spelled out, as
+    the hand-written rules had it, and a changed function still reruns the rule.
+    """
+    name = namespace["rule"] if namespace.get(RULEFUNC_CONTEXT_MARKER) else defining
+    return STEP_FUNCS[name]
+
+
+def step_list(slug):
+    """The paper's step list, validated before any job runs, or a clear error."""
+    try:
+        return load_step_specs(slug, root=Path("."))
+    except NetreproError as exc:
+        raise WorkflowError(str(exc)) from None
+
+
+def step_output(slug, ref):
+    """``<step>[.<output>]`` of paper ``slug`` as the output of the rule that writes it."""
+    name, _, output = ref.partition(".")
+    return getattr(getattr(rules, f"{slug}_{name}").output, output or "table")
+
+
+def step_inputs(paper, spec):
+    """Named inputs of a step: the step's code, then its declared inputs, then its shard files."""
+    named = {"code": code(spec.func)}
+    for name, ref in spec.inputs.items():
+        if isinstance(ref, str):
+            named[name] = ref if "/" in ref else step_output(paper.slug, ref)
+        elif "shards" in ref:
+            named[name] = getattr(rules, f"{paper.slug}_{ref['shards']}").input.shards
+        elif "each" in ref:
+            source = paper.step(ref["each"])
+            for kind, path in source.outputs.items():
+                for value in paper.wildcards[source.over]:
+                    named[f"{kind}_{value}"] = expand(path, **{source.over: value})[0]
+        else:
+            source = paper.step(ref["step"])
+            named[name] = expand(source.outputs[ref["output"]], **{source.over: ref["value"]})[0]
+    if spec.shard:
+        named["shards"] = expand(list(spec.shard.outputs.values())[0], shard=shards(spec.rule))
+    return named
+
+
+def wrapped(cfg, wrap, extra):
+    """The params' configuration: the picked keys (nested under ``wrap`` if set) and ``extra``."""
+    return {wrap: cfg, **extra} if wrap else {**cfg, **extra}
+
+
+def shard_params(section, spec):
+    """Params of one shard job: the keys the shard reads, its index and the shard count."""
+
+    def cfg(wildcards):
+        extra = {"shard": int(wildcards.shard), "n_shards": len(shards(spec.rule))}
+        return as_json(wrapped(compose_config(section, spec.shard.config), spec.shard.wrap, extra))
+
+    return cfg
+
+
+def over_params(section, spec):
+    """Params of a step run per wildcard value: that value, and only its entry of ``narrow``."""
+
+    def cfg(wildcards):
+        value = wildcards[spec.over]
+        picked = compose_config(section, spec.config)
+        if spec.narrow:
+            picked[spec.narrow] = pick(section.get(spec.narrow, {}), value)
+        return as_json(wrapped(picked, spec.wrap, {spec.over: value}))
+
+    return cfg
 
 
 # the recorded paper-scale run (issue 31): `python -m netrepro scale-record`; the report's panel

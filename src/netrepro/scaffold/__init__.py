@@ -3,7 +3,7 @@
 The skeleton follows the paper contract (``docs/adding-a-paper.md``, checked by
 ``python -m netrepro check-paper``): the package with every role and one example each (an
 equation, a step, the evidence, a figure, a claim, an erratum, a reconstruction, a finding), its
-rules file, configuration section and schema, caption, notebook, tests (one per role) and the
+step list (``steps.yaml``, from which the workflow generates its rules), configuration section and schema, caption, notebook, tests (one per role) and the
 registry entry. Right after it, ``make report`` builds the new paper's figure, judges its claim
 and shows its section in the report. The templates are in ``templates/`` beside this module.
 
@@ -35,7 +35,7 @@ TEMPLATES = Path(__file__).with_name("templates")
 # where the registry's ``source`` file names are found, relative to the checkout (src/netrepro/papers.yaml)
 SOURCES_DIR = "../shared/papers"
 PACKAGE_FILES = ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py", "figures.yaml",
-                 "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml")
+                 "steps.yaml", "claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml")
 TEST_FILES = ("__init__.py", "test_model.py", "test_steps.py", "test_evidence.py", "test_figures.py",
               "test_checks.py")
 
@@ -137,11 +137,10 @@ def plan_new_paper(slug: str, title: str, source: str | Path, root: str | Path =
     source = Path(source)
     if not source.is_file():
         raise InputError(f"new-paper: source file {source} does not exist")
-    values = {"slug": slug, "title": title.strip(), "source": source.name, "CFG": f"{slug.upper()}_CFG",
+    values = {"slug": slug, "title": title.strip(), "source": source.name,
               "authors": authors.strip() or "authors to be named (TODO in the registry)"}
     create = {f"src/netrepro/papers/{slug}/{name}": _render(f"package/{name}.tmpl", values) for name in PACKAGE_FILES}
     create |= {f"tests/papers/{slug}/{name}": _render(f"tests/{name}.tmpl", values) for name in TEST_FILES}
-    create[f"workflow/rules/{slug}.smk"] = _render("rules.smk.tmpl", values)
     create[f"workflow/schemas/{slug}.schema.yaml"] = _render("schema.yaml.tmpl", values)
     create[f"workflow/report/{slug}/fig1.rst"] = _render("caption.rst.tmpl", values)
     create[f"workflow/notebooks/{slug}.ipynb"] = ""  # written by the report's notebook template
