@@ -6,7 +6,6 @@ import shlex
 import sys
 from pathlib import Path
 
-from snakemake.common import RULEFUNC_CONTEXT_MARKER
 from snakemake.exceptions import WorkflowError
 
 try:
@@ -102,8 +101,10 @@ def code(func):
 def step(func="{params.func}"):
     """Shell command of a pipeline step: one call into the package.
 
-    Rules generated in a loop pass ``params.func`` (their shell command is formatted when the
-    job runs, after the loop has moved on); hand-written rules pass the function here. The rule's
+    Rules generated in a loop (steps.smk, figures.smk) pass ``params.func``: Snakemake evaluates
+    a rule's shell expression again when its job runs, after the loop has moved on, so the
+    function must come from the job's own params (which also rerun the rule when it changes);
+    hand-written rules may pass the function here. The rule's
     name is its ``params.rule`` (Snakemake formats ``{rule}`` only in shell commands, and
     ``snakemake --lint`` reports that as a variable from outside the rule); the runner records it
     in every output's sidecar, which is where the report reads it. ``tests/test_codedeps.py``
@@ -184,25 +185,6 @@ def report_inputs(wildcards):
 
 
 # ----- the compute steps generated from each paper's steps.yaml (workflow/rules/steps.smk)
-# step functions (module:function) by the name of the generated rule that runs each one
-STEP_FUNCS = {}
-
-
-def step_func(namespace, defining):
-    """The step function of the job or rule whose shell command is being evaluated.
-
-    Snakemake evaluates a rule's ``shell:`` expression twice: once when the rule is defined (the
-    text its code rerun trigger compares, here ``defining``'s) and again when a job runs, inside the
-    rule's run function, after this loop has moved on (``_spec`` and ``_step_rule`` are then
-    another rule's, so the expression may not touch ``_spec``'s attributes). The run
-    function's locals carry the job's ``rule`` name (and Snakemake's run-function marker), so the
-    job looks its own function up: the command is ``step(func)`` with the function spelled out, as
-    the hand-written rules had it, and a changed function still reruns the rule.
-    """
-    name = namespace["rule"] if namespace.get(RULEFUNC_CONTEXT_MARKER) else defining
-    return STEP_FUNCS[name]
-
-
 def step_list(slug):
     """The paper's step list, validated before any job runs, or a clear error."""
     try:

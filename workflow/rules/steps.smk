@@ -8,10 +8,7 @@ for _slug in paper_slugs():
     _paper = step_list(_slug)
     _section = config.get(_slug, {})
     for _spec in _paper.steps:
-        STEP_FUNCS[_spec.rule] = _spec.func
         if _spec.shard:
-            STEP_FUNCS[_spec.shard_rule] = _spec.shard.func
-            _step_rule = _spec.shard_rule
 
             rule:
                 name:
@@ -30,13 +27,12 @@ for _slug in paper_slugs():
                 resources:
                     **_spec.shard.resources,
                 params:
+                    func=_spec.shard.func,
                     cfg=shard_params(_section, _spec),
                     rule=_spec.shard_rule,
                     io=io_json,
                 shell:
-                    step(step_func(locals(), _step_rule))
-
-        _step_rule = _spec.rule
+                    step()
 
         rule:
             name:
@@ -56,6 +52,7 @@ for _slug in paper_slugs():
             resources:
                 **_spec.resources,
             params:
+                func=_spec.func,
                 cfg=(
                     over_params(_section, _spec)
                     if _spec.over
@@ -64,7 +61,7 @@ for _slug in paper_slugs():
                 rule=_spec.rule,
                 io=io_json,
             shell:
-                step(step_func(locals(), _step_rule))
+                step()
 
     if enabled(_slug):
         PAPER_TABLES[_slug] = [step_output(_slug, ref) for ref in _paper.tables]
