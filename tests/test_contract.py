@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from netrepro.contract import check_paper
-from netrepro.registry import paper_slugs
+from netrepro.judging.contract import check_paper
+from netrepro.pipeline.registry import paper_slugs
 
 ROOT = Path(__file__).resolve().parents[1]
 SLUG = "intermittent"
@@ -195,7 +195,7 @@ def test_params_passing_a_whole_section_are_named_with_file_and_line(hinf_checko
 
 def _unpicked(text: str) -> str:
     """The hinf rules as they were before issue 39: every ``pick(HCFG, ...)`` replaced by ``HCFG``."""
-    from netrepro.contract import _calls
+    from netrepro.judging.contract import _calls
     calls = [(offset, source) for offset, source in _calls(text, "pick") if re.match(r"pick\(\s*HCFG\s*,", source)]
     for offset, source in reversed(calls):
         text = text[:offset] + "HCFG" + text[offset + len(source):]

@@ -20,7 +20,7 @@ import pytest
 import yaml
 
 from netrepro import locations
-from netrepro.registry import paper_slugs
+from netrepro.pipeline.registry import paper_slugs
 
 from .conftest import _ignore
 
@@ -85,7 +85,9 @@ CHECK = textwrap.dedent("""
     import yaml
 
     import netrepro
-    from netrepro import config, figurespec, locations, paperdata, registry, regression
+    from netrepro.pipeline import config, figurespec, registry
+    from netrepro import locations
+    from netrepro.judging import paperdata, regression
     from netrepro.report import markup
     from netrepro.scaffold import TEMPLATES
 

@@ -25,9 +25,9 @@ from string import Template
 import yaml
 
 from ..errors import InputError
-from ..io import load_yaml
-from ..paperdata import LOCK_FILE, SKELETON_COMMIT, registry_lock_text
-from ..registry import load_registry, registry_entry_text, valid_slug
+from ..pipeline.io import load_yaml
+from ..judging.paperdata import LOCK_FILE, SKELETON_COMMIT, registry_lock_text
+from ..pipeline.registry import load_registry, registry_entry_text, valid_slug
 
 __all__ = ["Plan", "SOURCES_DIR", "plan_new_paper", "write_plan", "new_paper", "source_warnings"]
 
@@ -232,7 +232,7 @@ def new_paper(slug: str, title: str, source: str | Path, root: str | Path = ".",
     """
     written = write_plan(plan_new_paper(slug, title, source, root, authors), root)
     # CITATION.cff lists every paper of the registry; it is written from the registry the package reads
-    from ..references import REGISTRY_FILE, main as write_citation
+    from ..release.citations import REGISTRY_FILE, main as write_citation
 
     citation = Path(root) / "CITATION.cff"
     if citation.is_file() and Path(REGISTRY_FILE).resolve() == (Path(root) / "src/netrepro/papers.yaml").resolve():

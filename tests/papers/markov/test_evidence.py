@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 
 from netrepro.papers.markov import enumeration, evidence, exact, model, stability
-from netrepro.paperdata import load_paper_data
-from netrepro.verdicts import claims_table, errata_table, findings_table, read_evidence
+from netrepro.judging.paperdata import load_paper_data
+from netrepro.judging.verdicts import claims_table, errata_table, findings_table, read_evidence
 
 from .systems import EX1, EX2
 from .tables import PKG

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...io import read_table
-from ...paperdata import load_paper_data
-from ...verdicts import erratum_evidence, evidence_frame
+from ...pipeline.io import read_table
+from ...judging.paperdata import load_paper_data
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .feasibility import plant_vertex_radius, with_sigma2
 from .model import gains_from_dict, p_schedule, system_from_config
 from .steps import MATRICES, gains_from_table, load_solutions, p_sequence
-from .verification import (
+from .analysis import (
     convergence_rate,
     eq15_residuals,
     frozen_ms_radius,
@@ -118,7 +118,7 @@ def evidence_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame}`` from :func:`netrepro.verdicts.evidence_frame`.
+        ``{"table": DataFrame}`` from :func:`netrepro.judging.verdicts.evidence_frame`.
     """
     from .design import certificate_from_solution, congruence_residual
 

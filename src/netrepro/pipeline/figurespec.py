@@ -25,7 +25,7 @@ from pathlib import Path
 
 import yaml
 
-from .errors import ConfigError
+from ..errors import ConfigError
 from .io import load_yaml
 
 __all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]

@@ -29,7 +29,7 @@ from .processes import RunningBuild, running_builds
 __all__ = ["damaged_outputs", "missing_outputs", "main", "split_options", "summary_rows"]
 
 INTERRUPTED = 130  # the shell's exit status after SIGINT
-# verify's statuses that mean "this output cannot be trusted or is gone" (netrepro.provenance.verify_tree)
+# verify's statuses that mean "this output cannot be trusted or is gone" (netrepro.pipeline.provenance.verify_tree)
 DAMAGED = ("corrupt", "no-sidecar", "unfinished", "partial", "missing")
 
 

@@ -1,6 +1,6 @@
 """The results table of ``README.md``, generated from the claims and errata tables of a build.
 
-``python -m netrepro.readme README.md`` (``make readme``) rewrites the part of README.md between
+``python -m netrepro readme README.md`` (``make readme``) rewrites the part of README.md between
 the markers ``<!-- results:start -->`` and ``<!-- results:end -->`` with one row per paper: its
 figures (the paper's and ours), its claims by verdict (every category; testable ones counted
 apart), its errata of substance, findings and reconstructions, read from ``results/claims/``,
@@ -19,15 +19,15 @@ from pathlib import Path
 
 import pandas as pd
 
-from .figurespec import load_figure_specs
-from .registry import load_registry
-from .summary import scorecard
-from .verdicts import VERDICTS
+from ..pipeline.figurespec import load_figure_specs
+from ..pipeline.registry import load_registry
+from ..judging.summary import scorecard
+from ..judging.verdicts import VERDICTS
 
 __all__ = ["START", "END", "FIG_START", "FIG_END", "results_table", "figure_table", "rewrite", "rewrite_figures",
            "main"]
 
-START = "<!-- results:start (written by `make readme`: python -m netrepro.readme README.md) -->"
+START = "<!-- results:start (written by `make readme`: python -m netrepro readme README.md) -->"
 END = "<!-- results:end -->"
 FIG_START = "<!-- figures:start (written by `make readme` from src/netrepro/papers.yaml and each figures.yaml) -->"
 FIG_END = "<!-- figures:end -->"
@@ -45,7 +45,7 @@ def _rows(path: Path) -> pd.DataFrame | None:
 def results_table(root: str | Path = ".", papers=None) -> str:
     """The Markdown table: per paper figures, claims by verdict (testable and not), errata, findings, reconstructions.
 
-    The counts are :func:`netrepro.summary.scorecard`'s, so README and report agree.
+    The counts are :func:`netrepro.judging.summary.scorecard`'s, so README and report agree.
 
     Parameters
     ----------
@@ -165,7 +165,7 @@ def rewrite_figures(readme: str, table: str) -> str:
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.readme [README] [--root DIR] [--check]``: rewrite the results and figure tables.
+    """``python -m netrepro readme [README] [--root DIR] [--check]``: rewrite the results and figure tables.
 
     Parameters
     ----------
@@ -177,7 +177,7 @@ def main(argv=None) -> int:
     int
         Exit status: 0, or 1 with ``--check`` when the README is out of date.
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.readme", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m netrepro readme", description=__doc__.split("\n")[0])
     parser.add_argument("readme", nargs="?", default="README.md")
     parser.add_argument("--root", default=".", help="checkout whose results/ and figures/ are read")
     parser.add_argument("--check", action="store_true", help="exit 1 if the README differs, write nothing")

@@ -4,7 +4,7 @@ Everything a reader sees in the report's scorecard and in the replication summar
 each paper's section is counted here from the tables of a build, never typed (issue 15):
 
 * :func:`scorecard`: per paper, every verdict category; only the testable verdicts
-  (:data:`netrepro.verdicts.TESTABLE_VERDICTS`) are scored, and only errata of kind ``equation``
+  (:data:`netrepro.judging.verdicts.TESTABLE_VERDICTS`) are scored, and only errata of kind ``equation``
   or ``prose`` count as errata (notation and typesetting slips are listed, not counted).
 * :func:`replication_summary`: per figure of the paper and per claim group, ``replicated``,
   ``partially``, ``not replicated`` or ``not testable``, and why.

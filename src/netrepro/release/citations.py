@@ -1,8 +1,8 @@
 """The original papers, for citing: the report's "Cite the originals" section and CITATION.cff.
 
 The data are the ``citation`` entries of the paper registry (``papers.yaml``,
-:mod:`netrepro.registry`; titles and authors from the source texts). :func:`citation_cff` builds the whole ``CITATION.cff`` (this software, with the papers
-as ``references``); ``python -m netrepro.references CITATION.cff`` rewrites it, and
+:mod:`netrepro.pipeline.registry`; titles and authors from the source texts). :func:`citation_cff` builds the whole ``CITATION.cff`` (this software, with the papers
+as ``references``); ``python -m netrepro citations CITATION.cff`` rewrites it, and
 ``tests/test_release_files.py`` checks that the committed file is this output and that it
 validates against the Citation File Format 1.2.0 schema.
 """
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import yaml
 
-from .registry import REGISTRY_FILE, identifier_url, load_registry
+from ..pipeline.registry import REGISTRY_FILE, identifier_url, load_registry
 
 __all__ = ["load_references", "load_identifiers", "format_reference", "references_html", "cff_reference",
            "citation_cff", "crate_citations", "SOFTWARE", "main"]
@@ -253,7 +253,7 @@ def crate_citations(slugs) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.references [OUT]``: write ``CITATION.cff`` from the paper registry.
+    """``python -m netrepro citations [OUT]``: write ``CITATION.cff`` from the paper registry.
 
     Parameters
     ----------
@@ -265,11 +265,11 @@ def main(argv=None) -> int:
     int
         Exit status 0.
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.references",
+    parser = argparse.ArgumentParser(prog="python -m netrepro citations",
                                      description="write CITATION.cff from the paper registry (papers.yaml)")
     parser.add_argument("out", nargs="?", default="CITATION.cff")
     args = parser.parse_args(argv)
-    text = ("# Written by `python -m netrepro.references` from src/netrepro/papers.yaml: edit that, not this.\n"
+    text = ("# Written by `python -m netrepro citations` from src/netrepro/papers.yaml: edit that, not this.\n"
             + yaml.safe_dump(citation_cff(), sort_keys=False, allow_unicode=True, width=100))
     Path(args.out).write_text(text)
     print(args.out)

@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ConfigError, DependencyError
-from .locations import PAPERS_DIR, SCHEMA_DIR
+from ..errors import ConfigError, DependencyError
+from ..locations import PAPERS_DIR, SCHEMA_DIR
 
 __all__ = [
     "ConfigError",

@@ -1,13 +1,13 @@
 """Figures regenerate: compare a run's result tables and figures with the committed references.
 
-``python -m netrepro.regression compare`` (what CI and ``make check`` run) checks every table
+``python -m netrepro regression compare`` (what CI and ``make check`` run) checks every table
 under ``tests/reference/`` against the same path under ``results/`` (a result table without a
 reference is a difference too), and every figure under ``figures/`` against its committed
-version (:mod:`netrepro.figurecheck`: what it draws, with the tables' tolerances, and its
+version (:mod:`netrepro.figures.check`: what it draws, with the tables' tolerances, and its
 pixels); on any difference it writes ``results/regeneration/index.html``. String
 columns exactly, numeric columns within ``rtol``/``atol`` (seeds are fixed, so
 differences only come from floating-point details of the platform).
-``python -m netrepro.regression update`` refreshes the reference tables from ``results/`` and
+``python -m netrepro regression update`` refreshes the reference tables from ``results/`` and
 prints what changed (the figures' references are the committed files under ``figures/``);
 ``--paper SLUG`` (repeatable; ``make update-references PAPER=slug``) touches only that paper's
 tables: ``<slug>/...`` and the shared ``claims/<slug>.csv``, ``errata/<slug>.csv``, ... .
@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from .locations import checkout_file
+from ..locations import checkout_file
 
 __all__ = ["TIMING_COLUMNS", "compare_tables", "compare_trees", "is_timing_column", "load_platform_rules", "main",
            "paper_of", "update_tables", "write_check_summary"]
@@ -84,7 +84,7 @@ def _without_timings(data: bytes) -> bytes:
     if not rows or not any(is_timing_column(c) for c in rows[0]):
         return data
     keep = [i for i, c in enumerate(rows[0]) if not is_timing_column(c)]
-    out = _Lines()  # not io.StringIO: `import io` would read as netrepro.io to the byte-code test of codedeps
+    out = _Lines()  # not io.StringIO: `import io` would read as netrepro.pipeline.io to the byte-code test of codedeps
     writer = csv.writer(out, lineterminator="\r\n" if "\r\n" in text else "\n")
     writer.writerows([row[i] for i in keep if i < len(row)] for row in rows)
     return "".join(out).encode()
@@ -101,7 +101,7 @@ def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, l
 
     Every rule names its table, columns, check and reason; a malformed rule stops the
     comparison with a message naming it. Figure entries (a ``figure`` and no ``table``) are
-    skipped: :func:`netrepro.figurecheck.load_figure_rules` reads them.
+    skipped: :func:`netrepro.figures.check.load_figure_rules` reads them.
 
     Parameters
     ----------
@@ -122,7 +122,7 @@ def load_platform_rules(path: Path | str | None = PLATFORM_RULES) -> dict[str, l
         return {}
     rules = {}
     for i, rule in enumerate(yaml.safe_load(Path(path).read_text()) or []):
-        if "figure" in rule and "table" not in rule:  # figure entries: netrepro.figurecheck.load_figure_rules
+        if "figure" in rule and "table" not in rule:  # figure entries: netrepro.figures.check.load_figure_rules
             continue
         missing = {"table", "columns", "check", "reason"} - set(rule)
         if missing or rule["check"] not in CHECKS:
@@ -252,7 +252,7 @@ _UNCHECKED_RESULT_DIRS = ("shards", "scale", "regeneration")
 SHARED_TABLE_DIRS = ("claims", "errata", "evidence", "findings", "reconstructions")
 
 
-# tests/reference/paper-scale/: a recorded run at another configuration (netrepro.scale), not a reference
+# tests/reference/paper-scale/: a recorded run at another configuration (netrepro.scale.record), not a reference
 _RECORDED_RUNS = ("paper-scale",)
 
 
@@ -405,7 +405,7 @@ def update_tables(reference: Path, results: Path, papers=None) -> list[str]:
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.regression {compare,update}``: compare the build with the references, or refresh them.
+    """``python -m netrepro regression {compare,update}``: compare the build with the references, or refresh them.
 
     Parameters
     ----------
@@ -417,7 +417,7 @@ def main(argv=None) -> int:
     int
         Exit status: 0, or (``compare``) 1 when a table or figure differs or nothing was compared.
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.regression", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m netrepro regression", description=__doc__.splitlines()[0])
     parser.add_argument("command", choices=["compare", "update"])
     parser.add_argument("--reference", default="tests/reference")
     parser.add_argument("--results", default="results")
@@ -438,7 +438,7 @@ def main(argv=None) -> int:
             print(f"error: {exc}", file=sys.stderr)
             return 2
         if args.figures:
-            from .figurecheck import compare_figures, open_baseline
+            from ..figures.check import compare_figures, open_baseline
 
             _, diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures)
             for d in diffs:
@@ -455,7 +455,7 @@ def main(argv=None) -> int:
         return 0
     start = time.perf_counter()
     if args.html:  # a page from an earlier run would describe differences that may be gone
-        from .figurecheck import clear_difference_page
+        from ..figures.check import clear_difference_page
 
         clear_difference_page(Path(args.html).parent)
     details: list[dict] = []
@@ -466,7 +466,7 @@ def main(argv=None) -> int:
     print(f"regression: {count} reference tables compared, {len(problems)} differences")
     figure_diffs, failing, n_fig = [], [], 0
     if args.figures:
-        from .figurecheck import compare_figures, load_figure_rules, open_baseline
+        from ..figures.check import compare_figures, load_figure_rules, open_baseline
 
         n_fig, figure_diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures,
                                               rules=load_figure_rules(args.platform_rules or None))
@@ -481,7 +481,7 @@ def main(argv=None) -> int:
     failed = bool(problems or failing or count == 0 or (args.figures and n_fig == 0))
     if args.html:
         # written on every run, passing or not: the evidence of what was compared (issue 41 item 5)
-        from .figurecheck import write_difference_page
+        from ..figures.check import write_difference_page
 
         page = write_difference_page(Path(args.html).parent, failing, details, compared=figure_diffs,
                                      tables_compared=count)
@@ -513,7 +513,7 @@ def write_check_summary(out_dir: Path, failed: bool, tables_compared: int, table
     """
     import json
 
-    from .io import atomic_path
+    from ..pipeline.io import atomic_path
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

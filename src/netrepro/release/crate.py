@@ -35,7 +35,7 @@ import os
 import re
 from pathlib import Path
 
-from .io import atomic_path, sha256_file
+from ..pipeline.io import atomic_path, sha256_file
 
 __all__ = ["PROFILES", "CONTEXT", "iso", "write_crate", "data_id", "action_id"]
 
@@ -189,7 +189,7 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     out : str or Path, optional
         Where to write the metadata; default ``<crate_root>/ro-crate-metadata.json``.
     citations : list of dict, optional
-        The reproduced papers as contextual entities (:func:`netrepro.references.crate_citations`),
+        The reproduced papers as contextual entities (:func:`netrepro.release.citations.crate_citations`),
         listed by the root dataset's ``citation`` (RO-Crate 1.1, "Publications via citation property").
 
     Returns
@@ -256,7 +256,7 @@ def write_crate(crate_root: str | Path, *, sidecars: dict[str, dict], rule_of, r
     }
     values = [
         {"@id": "#config-hash", "@type": "PropertyValue", "name": "config_hash", "value": str(run.get("config_hash")),
-         "description": "SHA-256 (16 hex digits) of the run's configuration (netrepro.provenance.params_hash)"},
+         "description": "SHA-256 (16 hex digits) of the run's configuration (netrepro.pipeline.provenance.params_hash)"},
         {"@id": "#commit", "@type": "PropertyValue", "name": "git_commit", "value": str(run.get("commit")),
          "description": "git commit of the workflow" + (" (working tree dirty)" if run.get("dirty") else "")},
     ]

@@ -21,7 +21,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from .diff import paired_entries, same_value, tables_of
+from ..judging.diff import paired_entries, same_value, tables_of
 
 __all__ = ["SCALE_COLUMNS", "FINDING_COLUMNS", "STALE_COLUMNS", "NOT_RECORDED", "NOT_RUN", "compare_by_scale", "code_fingerprint",
            "stale_sources", "record", "scale_step", "main"]
@@ -233,7 +233,7 @@ def record(run, dest, configfiles, shards=None, wall_time_s=None, command: str =
     FileNotFoundError
         When the run has no claims tables.
     """
-    from .provenance import git_state, params_hash
+    from ..pipeline.provenance import git_state, params_hash
 
     run, dest = Path(run), Path(dest)
     claims = tables_of(run, "claims")  # raises FileNotFoundError, naming the run

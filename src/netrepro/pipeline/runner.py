@@ -10,7 +10,7 @@ The step function has the signature ``fn(params, inputs, outputs)`` where
 dict: values that are :class:`pandas.DataFrame` under an output's name are
 written (atomically) by the runner; a ``"provenance"`` entry adds to the
 sidecar. Files the function writes itself (figures) must be written through
-:func:`netrepro.io.atomic_path`. Every output then gets a provenance sidecar.
+:func:`netrepro.pipeline.io.atomic_path`. Every output then gets a provenance sidecar.
 Inputs that carry a sidecar are checked against their checksum first.
 
 Warnings the step raises are logged once per distinct warning, with a
@@ -40,7 +40,7 @@ import warnings
 from pathlib import Path
 
 from .processes import process_alive, snakemake_ancestor, starter_from_environment
-from .errors import LMIError, OrphanedJobError
+from ..errors import LMIError, OrphanedJobError
 from .io import write_table
 from .provenance import (PARTIAL_MARK, CorruptOutputError, StepRecord, sidecar_path, step_environment, verify_output,
                          verify_tree, write_sidecar, write_unfinished_sidecar)
@@ -163,7 +163,7 @@ def _refuse_undecided_step(rule: str, decisions: dict, statuses: dict) -> None:
     from a table) instead of the cause.
     """
     if decisions and set(decisions) == {"undecided"}:
-        from .engines.cvx import FAULT_MAX_ITER, SOLVER
+        from ..engines.cvx import FAULT_MAX_ITER, SOLVER
 
         named = ", ".join(f"{k}: {v}" for k, v in statuses.items()) or "none recorded"
         raise LMIError(f"rule {rule}: every one of its {decisions['undecided']} certified decisions is undecided "
@@ -241,7 +241,7 @@ def _own_package(cwd: Path | None = None) -> str:
     """The resolved directory of the imported netrepro package, refused when the job's checkout has its own.
 
     A ``.venv/`` moved or copied from another checkout imported that checkout's code, while the
-    provenance recorded this checkout's files (issue 40); ``make`` repoints it (src/netrepro/venv_paths.py).
+    provenance recorded this checkout's files (issue 40); ``make`` repoints it (src/netrepro/pipeline/venv_paths.py).
     """
     imported = Path(__file__).resolve().parent
     here = (cwd or Path.cwd()).resolve()
@@ -425,7 +425,7 @@ def main(argv=None) -> int:
         Exit status: 0, or 1 when the step failed (logged) or verification found a problem.
     """
     parser = argparse.ArgumentParser(prog="python -m netrepro", description=__doc__.splitlines()[0],
-                                     epilog="Also: new-paper, check-paper, diff (netrepro.commands; each with --help).")
+                                     epilog="Also: new-paper, check-paper, diff (netrepro.cli.main; each with --help).")
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run one pipeline step")
     run.add_argument("--rule", default="?", help="name of the Snakemake rule (its params.rule), for the sidecars")

@@ -6,7 +6,7 @@ version with its hashes; ``make lock`` writes them with uv (``uv pip compile``).
 them (``pip install --require-hashes -r ...``), so installing needs no other tool.
 
 :func:`conda_env` writes ``workflow/envs/netrepro.yaml`` (the software of ``--sdm conda``) with
-the same pins: ``python -m netrepro.lockfile conda-env requirements/default.txt
+the same pins: ``python -m netrepro lockfile conda-env requirements/default.txt
 workflow/envs/netrepro.yaml`` (run by ``make lock``).
 """
 
@@ -134,7 +134,7 @@ def conda_env(lock: str | Path, out: str | Path, python: str = "3.11") -> Path:
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.lockfile conda-env LOCK OUT``: write the conda environment file.
+    """``python -m netrepro lockfile conda-env LOCK OUT``: write the conda environment file.
 
     Parameters
     ----------
@@ -146,7 +146,7 @@ def main(argv=None) -> int:
     int
         Exit status 0.
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.lockfile")
+    parser = argparse.ArgumentParser(prog="python -m netrepro lockfile")
     sub = parser.add_subparsers(dest="command", required=True)
     env = sub.add_parser("conda-env", help="write the conda environment file with the pins of a lock file")
     env.add_argument("lock")

@@ -6,7 +6,7 @@ original's code while its provenance recorded the copy's files. A ``.pth`` line 
 its own directory (the ``site`` module joins it to the site-packages directory), so this rewrites
 the line as the relative path from site-packages to ``<checkout>/src``: the environment then moves
 with its checkout. Run by every ``make`` target that uses the environment (``python
-src/netrepro/venv_paths.py .venv``: a file, not a module, so that the package it repairs is not
+src/netrepro/pipeline/venv_paths.py .venv``: a file, not a module, so that the package it repairs is not
 imported through the stale path); silent when nothing is to be done.
 """
 

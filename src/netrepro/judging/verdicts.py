@@ -1,7 +1,7 @@
 """The one verdict function every paper uses, and the claims, errata, reconstructions and findings tables.
 
 The paper's side (claims, errata, reconstructions, findings) is loaded and validated by
-:mod:`netrepro.paperdata` (issue 15, split out in issue 29). Our side is computed by the paper's
+:mod:`netrepro.judging.paperdata` (issue 15, split out in issue 29). Our side is computed by the paper's
 evidence step into ``results/evidence/<slug>.csv`` (columns ``quantity, variant, value, note``;
 built with :func:`evidence_frame`): one ``nominal`` row per quantity at the configured settings,
 and one row per variant across the declared range of the reconstructions a claim or finding
@@ -20,7 +20,7 @@ values across the declared variants: a verdict that changes inside that range is
 ``conditional``, with the condition stated, and ``robust`` is ``no``. :func:`verdicts_step`
 writes the four tables of one paper.
 
-Loading and validating the data files is :mod:`netrepro.paperdata`.
+Loading and validating the data files is :mod:`netrepro.judging.paperdata`.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import ConfigError, InputError
+from ..errors import ConfigError, InputError
 from .paperdata import ClaimEntry, FindingEntry, PaperData, load_paper_data, render_statement, template_fields
 
 __all__ = [

@@ -25,7 +25,7 @@ __all__ = ["NOT_WORKFLOW_OUTPUTS", "OUTPUT_ROOTS", "main", "prune", "stale_outpu
 # the folders whose files the workflow writes
 OUTPUT_ROOTS = ("results", "figures")
 # written by tools outside the workflow, so never declared: the difference page of `make check`
-# (netrepro.regression) and `make bench`'s table with its sidecar (netrepro.bench)
+# (netrepro.judging.regression) and `make bench`'s table with its sidecar (netrepro.scale.bench)
 NOT_WORKFLOW_OUTPUTS = ("results/regeneration/", "results/benchmarks.csv", "results/benchmarks.csv.meta.json")
 SIDECAR = ".meta.json"
 

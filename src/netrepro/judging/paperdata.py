@@ -2,7 +2,7 @@
 
 Per paper, four data files beside its code hold what the paper says and what we add, each
 validated against a JSON schema in ``workflow/schemas/paper/`` before any job starts (the
-workflow loads them when it starts); :mod:`netrepro.verdicts` judges them against our evidence.
+workflow loads them when it starts); :mod:`netrepro.judging.verdicts` judges them against our evidence.
 
 ``claims.yaml``
     id, location in the paper, group (of the replication summary), the quoted statement, kind
@@ -58,9 +58,9 @@ from pathlib import Path
 
 import yaml
 
-from .errors import ConfigError
-from .io import load_yaml
-from .locations import PAPER_SCHEMA_DIR, PAPERS_DIR
+from ..errors import ConfigError
+from ..pipeline.io import load_yaml
+from ..locations import PAPER_SCHEMA_DIR, PAPERS_DIR
 
 __all__ = [
     "KINDS",
@@ -580,7 +580,7 @@ def render_statement(statement: str, cells: dict) -> str:
         The template (:func:`template_fields`).
     cells : dict
         ``{quantity: (value, note)}`` nominal evidence rows; a row with attributes
-        ``uncertainty`` (:class:`netrepro.verdicts.Cell`) fills ``#u``, ``#lo`` and ``#hi``.
+        ``uncertainty`` (:class:`netrepro.judging.verdicts.Cell`) fills ``#u``, ``#lo`` and ``#hi``.
 
     Returns
     -------
@@ -854,7 +854,7 @@ def _load_list(path: Path, kind: str) -> list[dict]:
 _LOCK_HEADER = """\
 # findings.lock: the registry of the findings' rules (issue 37). One entry per finding: the SHA-256 of
 # its registered fields (kind, asserted, rule without its source, quantity, evidence_quantities, test;
-# netrepro.paperdata.REGISTERED_FIELDS), the date and the commit on which it was registered.
+# netrepro.judging.paperdata.REGISTERED_FIELDS), the date and the commit on which it was registered.
 # Written by `python -m netrepro register-findings <slug>` before the runs that test a new finding; never
 # edited by hand and never rewritten. A registered rule that changes keeps its registration: the finding
 # gets an `amendments:` entry (the registered fields, why, when) and the report shows both verdicts.

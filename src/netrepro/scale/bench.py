@@ -1,6 +1,6 @@
 """Benchmarks of the project's hot paths, each against a simple reference measured in the same run.
 
-``python -m netrepro.bench --out results/benchmarks.csv [--quick]`` (``make bench``) writes one
+``python -m netrepro bench --out results/benchmarks.csv [--quick]`` (``make bench``) writes one
 table with the columns ``benchmark, metric, ours, reference, ratio, unit`` and a sidecar
 ``<out>.meta.json`` (machine, BLAS kernels, load, sizes, repeats, notes). Times are medians
 over repeats; because ours and the reference run in the same process, one after the other,
@@ -57,7 +57,7 @@ Benchmarks
 ``job_exit``
     One job process as the rules start it: interpreter, the imports of an LMI or figure step
     (numpy, scipy, pandas, numba, cvxpy, matplotlib) and exit, ending through
-    :func:`netrepro.runner.exit_process` (no interpreter teardown, what the pipeline's command
+    :func:`netrepro.pipeline.runner.exit_process` (no interpreter teardown, what the pipeline's command
     lines do) against the normal exit; the ratio is the time ratio per job.
 ``pipeline``
     Cold ``snakemake -j2 report`` in a scratch copy of the repository, a no-op rerun, one figure
@@ -86,7 +86,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .locations import checkout_file, checkout_root
+from ..locations import checkout_file, checkout_root
 
 __all__ = [
     "COLUMNS",
@@ -291,10 +291,10 @@ def bench_exact_mean(n_paths: int, horizon: int, repeats: int) -> list[dict]:
         Two :func:`BenchRow` rows: times, and the exact computation's relative error bound
         against the estimator's largest relative 95% half-width.
     """
-    from .engines.montecarlo import run_monte_carlo
-    from .papers.intermittent.exact import exact_mean
-    from .papers.intermittent.model import critical_probability
-    from .papers.intermittent.steps import _scalar_simulator
+    from ..engines.montecarlo import run_monte_carlo
+    from ..papers.intermittent.exact import exact_mean
+    from ..papers.intermittent.model import critical_probability
+    from ..papers.intermittent.steps import _scalar_simulator
 
     a, R1, R2, p0 = 1.5, 0.1, 0.5, 10.0
     lams = [critical_probability(a) + off for off in (0.1, -0.1)]
@@ -333,9 +333,9 @@ def bench_gainsched_moments(n_runs: int, repeats: int) -> list[dict]:
     Monte Carlo's largest relative error against the exact values over k (what the exact method
     removes: with the multiplicative noise the squared error is heavy-tailed).
     """
-    from .papers.gainsched.model import gains_from_dict, simulate, system_from_config
-    from .papers.gainsched.moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
-    from .papers.gainsched.steps import p_sequence
+    from ..papers.gainsched.model import gains_from_dict, simulate, system_from_config
+    from ..papers.gainsched.moments import error_mse, initial_moment, linear_gains, mode_matrices, second_moments
+    from ..papers.gainsched.steps import p_sequence
 
     cfg = _configured("gainsched")
     sys_ = system_from_config(cfg["system"])
@@ -375,8 +375,8 @@ def bench_markov_exact(depth: int, repeats: int) -> list[dict]:
     its own small Riccati map. Rows: the time ratio at the same depth, and the agreement of the
     two expectation polynomials on a (p, q) grid.
     """
-    from .papers.markov.exact import exact_moments, exact_moments_split, find_split
-    from .papers.markov.model import LinearSystem
+    from ..papers.markov.exact import exact_moments, exact_moments_split, find_split
+    from ..papers.markov.model import LinearSystem
 
     cfg = _configured("markov")
     ex = cfg["examples"]["II"]
@@ -483,7 +483,7 @@ def _system(n: int):
 
 
 def _arrivals(kind: str, rng, N: int, T: int):
-    from .engines.channels import gilbert_elliott_arrivals, iid_arrivals
+    from ..engines.channels import gilbert_elliott_arrivals, iid_arrivals
 
     if kind == "iid":
         return iid_arrivals(rng, N, T, 0.7)
@@ -524,7 +524,7 @@ def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak
     list of dict
         :func:`BenchRow` rows.
     """
-    from .engines.riccati import Sensor, covariance_paths, packed_flops_per_step
+    from ..engines.riccati import Sensor, covariance_paths, packed_flops_per_step
 
     rows = [] if rows_out is None else rows_out
     rng = np.random.default_rng(20261122)
@@ -552,7 +552,7 @@ def bench_riccati(n_paths: int, horizon: int, ref_paths: int, repeats: int, peak
             rows.append(BenchRow(name, "path_steps_per_s_vs_numpy_batched", rate, n_paths * horizon / t_np,
                                  t_np / t_ours, "path-steps/s"))
             if n > 1:  # against the batched dense form (np.linalg.solve per update)
-                from .engines.riccati import _dense_paths
+                from ..engines.riccati import _dense_paths
 
                 sub = arr[: max(ref_paths, n_paths // 8)]
                 with _single_thread_blas():
@@ -633,7 +633,7 @@ def bench_channels(n_paths: int, horizon: int, ref_paths: int, repeats: int) -> 
     list of dict
         One :func:`BenchRow`: path-steps per second.
     """
-    from .engines.channels import gilbert_elliott_arrivals
+    from ..engines.channels import gilbert_elliott_arrivals
 
     t_ours = median_time(lambda: gilbert_elliott_arrivals(np.random.default_rng(1), n_paths, horizon, 0.2, 0.6),
                          repeats)
@@ -679,8 +679,8 @@ def bench_lmi(n_sweep: int, grid_points: int, tol: float, repeats: int) -> list[
         If the parametrised and rebuilt LMIs certify differently, or a bracketed bisection
         returns another threshold than the plain one.
     """
-    from .engines.channels import arrival_patterns
-    from .engines.lmi import MareStabilizabilityLMI, sweep_thresholds
+    from ..engines.channels import arrival_patterns
+    from ..engines.lmi import MareStabilizabilityLMI, sweep_thresholds
 
     rows = []
     cases = {
@@ -723,8 +723,8 @@ def bench_lmi(n_sweep: int, grid_points: int, tol: float, repeats: int) -> list[
         results[label] = sweep_thresholds(make, grid, 0.0, 1.0, tol, warm_start=warm)
         timings[label] = time.perf_counter() - start
     # what the pipeline runs: each point bracketed from its own closed-form lower bound
-    from .engines.lmi import bisect_bracketed
-    from .papers.intermittent.two_sensor import two_sensor_lower_bound
+    from ..engines.lmi import bisect_bracketed
+    from ..papers.intermittent.two_sensor import two_sensor_lower_bound
 
     start = time.perf_counter()
     results["lower_bound"] = [bisect_bracketed(make(l1), 0.0, 1.0, g, 0.0, tol)
@@ -767,7 +767,7 @@ def _fisher_functions():
     are used only when ``netrepro.papers.onebit`` does not provide them.
     """
     try:
-        from .papers.onebit.fisher import expected_fisher_1bit, expected_fisher_1bit_quad
+        from ..papers.onebit.fisher import expected_fisher_1bit, expected_fisher_1bit_quad
         return expected_fisher_1bit, (lambda v: expected_fisher_1bit_quad(v)[0]), "netrepro.papers.onebit"
     except ImportError:  # pragma: no cover - only before the onebit paper exists
         pass
@@ -794,7 +794,7 @@ def _fisher_functions():
         f = lambda t: float(fisher(t)) * math.exp(-0.5 * (t / s) ** 2) / (s * math.sqrt(2 * math.pi))  # noqa: E731
         return integrate.quad(f, lo, hi, points=[0.0], epsabs=0.0, epsrel=1e-13, limit=500)[0]
 
-    return vectorised, quadrature, "netrepro.bench (local eqs. (29)-(30))"
+    return vectorised, quadrature, "netrepro.scale.bench (local eqs. (29)-(30))"
 
 
 def bench_fisher(snr_start: float, snr_stop: float, snr_step: float, repeats: int) -> tuple[list[dict], str]:
@@ -840,7 +840,7 @@ JOB_IMPORTS = "numpy, scipy.linalg, pandas, numba, cvxpy, matplotlib.pyplot"
 
 
 def bench_job_exit(repeats: int) -> list[dict]:
-    """Wall time of one job process ending through :func:`netrepro.runner.exit_process` against a normal exit.
+    """Wall time of one job process ending through :func:`netrepro.pipeline.runner.exit_process` against a normal exit.
 
     Each process starts, imports what a step imports (``JOB_IMPORTS``) and exits; the normal
     exit's teardown frees every imported module: what each of a cold build's ~100 jobs paid before.
@@ -856,8 +856,8 @@ def bench_job_exit(repeats: int) -> list[dict]:
         One :func:`BenchRow`: seconds per job.
     """
     env = _env_with_src(ROOT / "src")
-    codes = {"ours": f"import {JOB_IMPORTS}\nfrom netrepro.runner import exit_process\nexit_process(0)",
-             "reference": f"import {JOB_IMPORTS}\nimport netrepro.runner"}
+    codes = {"ours": f"import {JOB_IMPORTS}\nfrom netrepro.pipeline.runner import exit_process\nexit_process(0)",
+             "reference": f"import {JOB_IMPORTS}\nimport netrepro.pipeline.runner"}
 
     def job(which):
         return lambda: subprocess.run([sys.executable, "-c", codes[which]], env=env, check=True)
@@ -871,8 +871,8 @@ def bench_job_exit(repeats: int) -> list[dict]:
 def bench_grid_transition(n_runs: int, horizon: int, repeats: int) -> list[dict]:
     """The onebit grid filter/smoother (1-bit data, alpha = 1 - 1e-3, 0 dB): banded vs dense transition, and the
     compiled banded kernel (what the pipeline runs) against its numpy/scipy form (the tested reference)."""
-    from .papers.onebit.estimators import _grid_smoother_at_numpy, grid_smoother_at, simulate_block, state_grid
-    from .papers.onebit.model import sigma_z2_from_snr, stationary_variance
+    from ..papers.onebit.estimators import _grid_smoother_at_numpy, grid_smoother_at, simulate_block, state_grid
+    from ..papers.onebit.model import sigma_z2_from_snr, stationary_variance
 
     eps = 1e-3
     s = float(sigma_z2_from_snr(0.0, eps))
@@ -1187,7 +1187,7 @@ def run_all(quick: bool = False, pipeline: bool = True, scratch: Path | None = N
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.bench``: run the benchmarks and write the table and its ``.meta.json``.
+    """``python -m netrepro bench``: run the benchmarks and write the table and its ``.meta.json``.
 
     Parameters
     ----------
@@ -1199,7 +1199,7 @@ def main(argv=None) -> int:
     int
         Exit status 0.
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.bench", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m netrepro bench", description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="results/benchmarks.csv", help="CSV to write (plus <out>.meta.json)")
     parser.add_argument("--quick", action="store_true", help="small sizes, no pipeline benchmark (seconds)")
     parser.add_argument("--no-pipeline", action="store_true", help="skip the whole-pipeline benchmark")

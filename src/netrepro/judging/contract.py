@@ -39,7 +39,7 @@ from pathlib import Path
 
 import yaml
 
-from .registry import load_registry, schema_mismatches
+from ..pipeline.registry import load_registry, schema_mismatches
 
 __all__ = ["Violation", "ROLES", "DATA_FILES", "NOT_MATH", "check_paper", "math_modules", "main"]
 
@@ -112,7 +112,7 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
     required = {
         root / "workflow/rules" / f"{slug}.smk": "the paper's rules file",
         root / "workflow/schemas" / f"{slug}.schema.yaml": "the paper's configuration schema",
-        root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro.report make-notebook)",
+        root / "workflow/notebooks" / f"{slug}.ipynb": "the paper's notebook (python -m netrepro report make-notebook)",
         root / "tests/papers" / slug: "the paper's tests (tests/papers/<slug>/)",
         root / "tests/reference" / slug: f"the committed reference tables (tests/reference/<slug>/): after a "
                                           f"checked build (`make report`), `make update-references PAPER={slug}` "
@@ -132,7 +132,7 @@ def _check_roles(slug: str, root: Path) -> list[Violation]:
             out.append(Violation(_rel(registry, root), _line_of(registry.read_text(), f"{slug}:"), "citation",
                                  f"{slug}: the citation's authors ({', '.join(family)}) do not appear in its "
                                  f"authors line ({entry.get('authors')!r}): fill in citation.authors too, then "
-                                 "`python -m netrepro.references CITATION.cff`"))
+                                 "`python -m netrepro citations CITATION.cff`"))
     schema_file = root / "workflow/schemas/config.schema.yaml"
     schema = yaml.safe_load(schema_file.read_text())
     out += [Violation(_rel(schema_file, root), 0, "roles", msg)
@@ -275,7 +275,7 @@ def _evidence_quantities(slug: str, pkg: Path, root: Path):
         return set(), [], "evidence.py"
     tree = ast.parse(path.read_text())
     literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
-    # netrepro.verdicts.erratum_evidence("<id>", ...) names <id>.residual_printed and <id>.residual_corrected
+    # netrepro.judging.verdicts.erratum_evidence("<id>", ...) names <id>.residual_printed and <id>.residual_corrected
     for node in ast.walk(tree):
         if (isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", "")) == "erratum_evidence"
                 and node.args and isinstance(node.args[0], ast.Constant)):
@@ -325,7 +325,7 @@ def _check_findings_gate(slug: str, pkg: Path, root: Path) -> list[Violation]:
     and every numeric rule whose asserted value equals our value within its tolerance must name
     an independent source of its threshold.
     """
-    from .errors import NetreproError
+    from ..errors import NetreproError
     from .paperdata import load_paper_data, typed_numbers
     from .verdicts import NOMINAL, agrees, read_evidence
 
@@ -575,10 +575,10 @@ def _resolves(section, key: str) -> bool:
 def _check_config_references(slug: str, pkg: Path, root: Path) -> list[Violation]:
     """Configuration keys named in the data files' text, ``(config <key>``, that the configurations lack.
 
-    The entries are read as :func:`netrepro.paperdata.load_paper_data` loads them (YAML comments
+    The entries are read as :func:`netrepro.judging.paperdata.load_paper_data` loads them (YAML comments
     are not read); data files that do not load are the ``findings-gate`` check's to report.
     """
-    from .errors import NetreproError
+    from ..errors import NetreproError
     from .paperdata import load_paper_data
 
     try:

@@ -23,7 +23,7 @@ from importlib import metadata
 from pathlib import Path
 
 from .io import sha256_file, write_json
-from .errors import CorruptOutputError, UnfinishedOutputError
+from ..errors import CorruptOutputError, UnfinishedOutputError
 
 __all__ = [
     "params_hash",
@@ -44,10 +44,10 @@ __all__ = [
     "write_unfinished_sidecar",
 ]
 
-# Marker in the names of the temporary files of :func:`netrepro.io.atomic_path`.
+# Marker in the names of the temporary files of :func:`netrepro.pipeline.io.atomic_path`.
 PARTIAL_MARK = ".part"
 
-_LOG = logging.getLogger("netrepro.provenance")
+_LOG = logging.getLogger("netrepro.pipeline.provenance")
 _COMMAND_LOGGED = False
 
 TRACKED_PACKAGES = (

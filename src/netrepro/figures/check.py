@@ -1,12 +1,12 @@
 """Figures that are checked: compare every figure with its committed reference (issue 26).
 
 Each figure ``figures/<paper>/<id>.png`` has a data sidecar ``<id>.data.json``
-(:mod:`netrepro.figuredata`, written by :func:`netrepro.plotting.save_figure`). Both are
+(:mod:`netrepro.figures.data`, written by :func:`netrepro.figures.plotting.save_figure`). Both are
 committed; the committed versions are the references. :func:`compare_figures` checks, for
 every figure:
 
 1. **what it shows**: the data sidecar against the reference sidecar, with the tolerances of
-   the result tables (:data:`netrepro.regression.RTOL`, :data:`netrepro.regression.ATOL`).
+   the result tables (:data:`netrepro.judging.regression.RTOL`, :data:`netrepro.judging.regression.ATOL`).
    A changed curve, point, band, bar, label, legend entry, limit or scale is a difference
    naming the axes, the artist and the largest difference;
 2. **its pixels**: identical bytes pass; otherwise the RMS of the pixel difference
@@ -39,8 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .figuredata import SUFFIX, data_path
-from .io import atomic_path
+from .data import SUFFIX, data_path
+from ..pipeline.io import atomic_path
 
 __all__ = ["RMS_TOLERANCE", "FigureDifference", "Baseline", "open_baseline", "compare_figure_data", "clear_difference_page",
            "png_rms", "compare_figures", "load_figure_rules", "write_difference_page", "figure_jobs",
@@ -268,7 +268,7 @@ def _compare_values(where: str, ref, got, rtol: float, atol: float, out: list, f
 
     ``finite``: numbers are compared by shape and NaN/inf pattern only (a platform rule).
     """
-    from .regression import _texts_agree
+    from ..judging.regression import _texts_agree
 
     if isinstance(ref, dict) and isinstance(got, dict):
         for key in sorted(set(ref) | set(got)):
@@ -337,13 +337,13 @@ def compare_figure_data(reference: dict, result: dict, rtol: float | None = None
     Parameters
     ----------
     reference : dict
-        The committed figure description (a data sidecar, :func:`netrepro.figuredata.describe_figure`).
+        The committed figure description (a data sidecar, :func:`netrepro.figures.data.describe_figure`).
     result : dict
         The description of this build's figure.
     rtol : float, optional
-        Relative tolerance of numbers; :data:`netrepro.regression.RTOL` when None.
+        Relative tolerance of numbers; :data:`netrepro.judging.regression.RTOL` when None.
     atol : float, optional
-        Absolute tolerance of numbers; :data:`netrepro.regression.ATOL` when None.
+        Absolute tolerance of numbers; :data:`netrepro.judging.regression.ATOL` when None.
     rules : sequence of dict, default ()
         This figure's platform rules: a ``finite`` rule compares its artists (and the limits of the
         axes it names) by shape and NaN/inf pattern only.
@@ -353,7 +353,7 @@ def compare_figure_data(reference: dict, result: dict, rtol: float | None = None
     list of str
         One line per difference; empty when the figures agree.
     """
-    from .regression import ATOL, RTOL
+    from ..judging.regression import ATOL, RTOL
 
     rtol = RTOL if rtol is None else rtol
     atol = ATOL if atol is None else atol
@@ -390,7 +390,7 @@ def compare_figure_data(reference: dict, result: dict, rtol: float | None = None
 # ----------------------------------------------------------------------------- pixels
 def _bytes_io(data: bytes):
     """A binary stream of ``data`` (the standard library's ``io``, imported here: module-level
-    ``import io`` next to ``from .io import`` hides ``netrepro.io`` from modulefinder, see tests/test_codedeps.py)."""
+    ``import io`` next to ``from .io import`` hides ``netrepro.pipeline.io`` from modulefinder, see tests/test_codedeps.py)."""
     import io
 
     return io.BytesIO(data)
@@ -591,7 +591,7 @@ def write_difference_page(out_dir, figures: list[FigureDifference], tables: list
     out.mkdir(parents=True, exist_ok=True)
     clear_difference_page(out)
     failing = [d for d in figures if d.problems]
-    from .report.csp import csp_meta  # the difference page runs nothing either (issue 38)
+    from ..report.csp import csp_meta  # the difference page runs nothing either (issue 38)
 
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>{csp_meta()}<link rel='icon' href='data:,'>"
              f"<title>Regeneration differences</title><style>{_CSS}</style></head><body>",

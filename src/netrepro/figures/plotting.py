@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from .io import atomic_path
+from ..pipeline.io import atomic_path
 
 __all__ = ["OKABE_ITO", "PALETTE", "COLOURS", "palette", "STYLE", "new_figure", "save_figure"]
 
@@ -109,10 +109,10 @@ def new_figure(nrows=1, ncols=1, figsize=(6.4, 4.0), **kw):
 def save_figure(fig, path) -> None:
     """Save atomically as PNG without software/date metadata, then close the figure.
 
-    Beside the PNG goes its data sidecar ``<name>.data.json`` (:mod:`netrepro.figuredata`):
-    what the figure draws, the figure's reference for ``python -m netrepro.regression compare``.
+    Beside the PNG goes its data sidecar ``<name>.data.json`` (:mod:`netrepro.figures.data`):
+    what the figure draws, the figure's reference for ``python -m netrepro regression compare``.
     """
-    from .figuredata import write_figure_data
+    from .data import write_figure_data
 
     plt = _pyplot()
     with plt.rc_context(STYLE), atomic_path(path) as tmp:

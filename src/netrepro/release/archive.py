@@ -1,4 +1,4 @@
-"""One deposit of a release: ``make archive`` (``python -m netrepro.archive --out DIR``), issue 41 item 4.
+"""One deposit of a release: ``make archive`` (``python -m netrepro archive --out DIR``), issue 41 item 4.
 
 The deposit is a BagIt bag (RFC 8493, written with the ``bagit`` library) named after the commit,
 ``DIR/netrepro-<commit12>/``, holding under ``data/``:
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import yaml
 
-from .errors import ConfigError
+from ..errors import ConfigError
 
 __all__ = ["zenodo_json", "codemeta_json", "write_archive", "main"]
 
@@ -45,7 +45,7 @@ def _person_name(person: dict) -> str:
 
 
 def _ref_text(ref: dict) -> str:
-    from .references import format_reference
+    from .citations import format_reference
 
     venue = ref.get("journal") or (ref.get("conference") or {}).get("name") or ""
     return format_reference({"authors": ref.get("authors", []), "year": ref.get("year"), "title": ref["title"],
@@ -262,7 +262,7 @@ def write_archive(root: str | Path, out: str | Path, *, zip_bag: bool = False) -
 
 
 def main(argv=None) -> int:
-    """``python -m netrepro.archive --out DIR [--root DIR] [--zip]``: write the deposit bag.
+    """``python -m netrepro archive --out DIR [--root DIR] [--zip]``: write the deposit bag.
 
     Parameters
     ----------
@@ -274,7 +274,7 @@ def main(argv=None) -> int:
     int
         0 on success, 2 when the archive cannot be made (the message names why).
     """
-    parser = argparse.ArgumentParser(prog="python -m netrepro.archive",
+    parser = argparse.ArgumentParser(prog="python -m netrepro archive",
                                      description="one deposit: git archive of HEAD, report/, lock files, "
                                                  ".zenodo.json and codemeta.json, as a BagIt bag")
     parser.add_argument("--out", default="archive", help="output folder (default: archive)")

@@ -1,6 +1,6 @@
 """Processes of a build, read from Linux ``/proc``: which Snakemake runs in a checkout, which Snakemake
-started a job, and whether it still runs. Used by the build driver (:mod:`netrepro.build`) and by every
-job (:mod:`netrepro.runner`), so it is kept apart from the driver: an edit of the driver reruns no step.
+started a job, and whether it still runs. Used by the build driver (:mod:`netrepro.pipeline.build`) and by every
+job (:mod:`netrepro.pipeline.runner`), so it is kept apart from the driver: an edit of the driver reruns no step.
 Where ``/proc`` is not available, nothing is found and nothing is refused.
 """
 

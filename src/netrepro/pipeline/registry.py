@@ -2,7 +2,7 @@
 
 Every list of papers is read from it: the Snakefile's includes, the configuration schema's
 ``papers`` (checked against it by :func:`schema_mismatches`), the report's and the README's
-titles, ``CITATION.cff`` and the report's "Cite the originals" (:mod:`netrepro.references`), and
+titles, ``CITATION.cff`` and the report's "Cite the originals" (:mod:`netrepro.release.citations`), and
 the tests' slug lists. No module that a pipeline step imports reads it, so a title fix reruns the
 report only, and adding a paper reruns nothing of the others.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import yaml
 
-from .errors import ConfigError
+from ..errors import ConfigError
 
 __all__ = ["REGISTRY_FILE", "REQUIRED_FIELDS", "IDENTIFIER_TYPES", "load_registry", "paper_slugs", "valid_slug",
            "registry_entry_text", "schema_mismatches", "identifier_problems", "identifier_url"]

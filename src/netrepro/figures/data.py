@@ -7,12 +7,12 @@ ticks' labels, legend entries, and every artist with its data: lines and markers
 (``get_paths``), bars and other patches (their vertices and hatch), error bars (line
 collections), images (their array), and texts; with their colours, line styles and markers, and
 for the artists of a labelled bar or error-bar container that label (``container``), so a test
-can check what tells the legend entries apart (``tests/test_figure_colours.py``). :func:`netrepro.plotting.save_figure` writes it beside the PNG
+can check what tells the legend entries apart (``tests/test_figure_colours.py``). :func:`netrepro.figures.plotting.save_figure` writes it beside the PNG
 as ``<name>.data.json`` for every figure of the project, so a figure is checked by what it
 shows, not only by its pixels.
 
-The comparison lives in :mod:`netrepro.figurecheck`. This module imports nothing of the
-project but :mod:`netrepro.io`: it is a code dependency of every figure rule, so an edit to the
+The comparison lives in :mod:`netrepro.figures.check`. This module imports nothing of the
+project but :mod:`netrepro.pipeline.io`: it is a code dependency of every figure rule, so an edit to the
 comparison must not rerun the figures.
 """
 
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .io import atomic_path
+from ..pipeline.io import atomic_path
 
 __all__ = ["SUFFIX", "FORMAT", "data_path", "describe_figure", "write_figure_data"]
 

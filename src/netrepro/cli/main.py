@@ -1,6 +1,6 @@
 """``python -m netrepro new-paper | check-paper | register-findings | diff | scale-record | scaling``: the commands for people.
 
-Kept apart from :mod:`netrepro.runner`, which every pipeline job runs: a rule's code inputs are the
+Kept apart from :mod:`netrepro.pipeline.runner`, which every pipeline job runs: a rule's code inputs are the
 modules its job can reach, so the scaffold, the contract and the diff tool stay out of them (an
 edit to a template reruns nothing).
 """
@@ -16,8 +16,8 @@ COMMANDS = ("new-paper", "check-paper", "register-findings", "diff", "scale-reco
 
 
 def _new_paper(args) -> int:
-    from .errors import NetreproError
-    from .scaffold import new_paper, source_warnings
+    from ..errors import NetreproError
+    from ..scaffold import new_paper, source_warnings
 
     try:
         written = new_paper(args.slug, args.title, args.source, args.root, args.authors)
@@ -49,9 +49,9 @@ def _register_findings(args) -> int:
     import datetime
     from pathlib import Path
 
-    from .errors import NetreproError
-    from .paperdata import paper_dir, register_findings
-    from .registry import paper_slugs
+    from ..errors import NetreproError
+    from ..judging.paperdata import paper_dir, register_findings
+    from ..pipeline.registry import paper_slugs
 
     slugs = args.slugs or list(paper_slugs())
     commit = _git_head(args.root)
@@ -73,10 +73,10 @@ def _register_findings(args) -> int:
 def main(argv=None) -> int:
     """Run one of :data:`COMMANDS` (``argv`` without the program name); return its exit code.
 
-    ``diff``, ``scale-record`` and ``scaling`` are handed to :func:`netrepro.diff.main`,
-    :func:`netrepro.scale.main` and :func:`netrepro.scaling.main` (their own parsers); ``new-paper`` writes a
-    paper's skeleton; ``check-paper`` runs :func:`netrepro.contract.main`; ``register-findings`` registers
-    the rules of new findings (:func:`netrepro.paperdata.register_findings`).
+    ``diff``, ``scale-record`` and ``scaling`` are handed to :func:`netrepro.judging.diff.main`,
+    :func:`netrepro.scale.record.main` and :func:`netrepro.scale.projection.main` (their own parsers); ``new-paper`` writes a
+    paper's skeleton; ``check-paper`` runs :func:`netrepro.judging.contract.main`; ``register-findings`` registers
+    the rules of new findings (:func:`netrepro.judging.paperdata.register_findings`).
 
     Parameters
     ----------
@@ -91,15 +91,15 @@ def main(argv=None) -> int:
     """
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["diff"]:
-        from .diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
+        from ..judging.diff import main as diff_main  # its own parser: python -m netrepro diff RUN_A RUN_B
 
         return diff_main(argv[1:])
     if argv[:1] == ["scale-record"]:
-        from .scale import main as scale_main  # its own parser: python -m netrepro scale-record RUN
+        from ..scale.record import main as scale_main  # its own parser: python -m netrepro scale-record RUN
 
         return scale_main(argv[1:])
     if argv[:1] == ["scaling"]:
-        from .scaling import main as scaling_main  # its own parser: python -m netrepro scaling [--collect BUILD]
+        from ..scale.projection import main as scaling_main  # its own parser: python -m netrepro scaling [--collect BUILD]
 
         return scaling_main(argv[1:])
     parser = argparse.ArgumentParser(prog="python -m netrepro")
@@ -122,6 +122,6 @@ def main(argv=None) -> int:
         return _new_paper(args)
     if args.command == "register-findings":
         return _register_findings(args)
-    from .contract import main as check_main
+    from ..judging.contract import main as check_main
 
     return check_main(args.slugs, args.root)

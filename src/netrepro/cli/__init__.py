@@ -1,0 +1,1 @@
+"""The ``netrepro`` console script (``python -m netrepro``): one dispatcher of every verb."""

@@ -1,0 +1,1 @@
+"""Figures: deterministic drawing, the data a figure draws, the check against its reference."""

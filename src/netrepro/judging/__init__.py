@@ -1,0 +1,1 @@
+"""Judging: the paper's side, the verdicts, the paper contract, summaries and comparisons of runs."""

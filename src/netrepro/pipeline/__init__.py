@@ -1,0 +1,1 @@
+"""The pipeline: declared rules, the step runner, provenance, code inputs, configuration, files."""

@@ -1,0 +1,1 @@
+"""Release: the RO-Crate, the README's results table, lock files, citations and the archive."""

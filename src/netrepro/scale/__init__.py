@@ -1,0 +1,1 @@
+"""Scale: paper-scale runs against the default ones, cluster projections, benchmarks."""
