@@ -39,7 +39,7 @@ __all__ = ["PACKAGE", "RUNNER_MODULE", "module_file", "imported_modules", "modul
 PACKAGE = "netrepro"
 # the module every step runs in (it also imports io and provenance): part of every rule's code
 RUNNER_MODULE = "netrepro.pipeline.runner"
-_SRC = Path(__file__).resolve().parent.parent
+_SRC = Path(__file__).resolve().parents[2]
 # an import statement at any indentation; a parenthesised name list may span lines
 _IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+[.\w]+[ \t]+import[ \t]+(?:\([^)]*\)|[^\n]*)|import[ \t]+[^\n]*)",
                      re.MULTILINE)

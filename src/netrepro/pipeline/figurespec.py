@@ -30,7 +30,7 @@ from .io import load_yaml
 
 __all__ = ["FigureSpec", "load_figure_specs", "figure_list_path"]
 
-_SRC = Path(__file__).resolve().parent
+_SRC = Path(__file__).resolve().parents[1]  # the netrepro package
 _FIGURE_ID = re.compile(r"^fig(S?\d+)$")
 _KEYS = {"plot", "inputs", "params", "layout"}
 # fields that entries may still carry and that nothing reads (removed once no figures.yaml has them)

@@ -22,7 +22,7 @@ from ..errors import ConfigError
 __all__ = ["REGISTRY_FILE", "REQUIRED_FIELDS", "IDENTIFIER_TYPES", "load_registry", "paper_slugs", "valid_slug",
            "registry_entry_text", "schema_mismatches", "identifier_problems", "identifier_url"]
 
-REGISTRY_FILE = Path(__file__).with_name("papers.yaml")
+REGISTRY_FILE = Path(__file__).parents[1] / "papers.yaml"
 REQUIRED_FIELDS = ("source", "title", "authors", "citation")
 _CITATION_FIELDS = ("type", "title", "authors")
 # A persistent identifier of a paper: its type, the pattern its value must match, and the URL it resolves at.

@@ -243,7 +243,7 @@ def _own_package(cwd: Path | None = None) -> str:
     A ``.venv/`` moved or copied from another checkout imported that checkout's code, while the
     provenance recorded this checkout's files (issue 40); ``make`` repoints it (src/netrepro/pipeline/venv_paths.py).
     """
-    imported = Path(__file__).resolve().parent
+    imported = Path(__file__).resolve().parents[1]
     here = (cwd or Path.cwd()).resolve()
     own = here / "src" / "netrepro"
     if own.is_dir() and own != imported:

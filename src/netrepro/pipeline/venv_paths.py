@@ -96,5 +96,5 @@ def relocate(venv: Path, src: Path) -> list[str]:
 
 if __name__ == "__main__":
     venv = Path(sys.argv[1] if len(sys.argv) > 1 else ".venv")
-    for line in relocate(venv, Path(__file__).resolve().parents[1]):
+    for line in relocate(venv, Path(__file__).resolve().parents[2]):
         print(f"make: {line}", file=sys.stderr)
