@@ -6,6 +6,8 @@ reading the files (nothing is imported or run), and names the file and line of e
 * ``roles``: the package roles, data files, rules file, captions, schema section, registry entry,
   tests and committed reference tables are present;
 * ``figures-imports``: ``figures.py`` imports neither the model nor the steps;
+* ``analysis-role``: ``analysis.py`` (optional: the mathematics only the evidence quotes, see
+  :data:`ANALYSIS`) is imported by ``evidence.py`` and by no step or figure module;
 * ``math-io``: math modules do no file IO and import no pandas;
 * ``public-api``: every public top-level function is in ``__all__``, and every function of a math
   module in ``__all__`` has numpydoc sections (``Parameters`` when it takes arguments, ``Returns``
@@ -41,9 +43,15 @@ import yaml
 
 from ..pipeline.registry import load_registry, schema_mismatches
 
-__all__ = ["Violation", "ROLES", "DATA_FILES", "NOT_MATH", "check_paper", "math_modules", "main"]
+__all__ = ["Violation", "ROLES", "OPTIONAL_ROLES", "ANALYSIS", "DATA_FILES", "NOT_MATH", "check_paper", "math_modules",
+           "main"]
 
 ROLES = ("__init__.py", "model.py", "steps.py", "evidence.py", "figures.py", "checks.py")
+# the one role name of the papers' evidence mathematics: independent computations that only the evidence
+# step quotes (errata residuals, readings of the report's curves, brute-force checks), a math module
+ANALYSIS = "analysis.py"
+# roles a paper has when it needs them: the evidence mathematics, and the bookkeeping of sharded steps
+OPTIONAL_ROLES = (ANALYSIS, "shards.py")
 DATA_FILES = ("claims.yaml", "errata.yaml", "reconstructions.yaml", "findings.yaml", "figures.yaml")
 # shards.py (optional): which cases a sharded step runs and how its shard files merge back (IO, no mathematics)
 NOT_MATH = {"__init__", "steps", "evidence", "figures", "checks", "shards"}
@@ -103,6 +111,39 @@ def math_modules(package: Path) -> list[Path]:
         The package's ``*.py`` files whose stem is not in ``NOT_MATH``, sorted.
     """
     return sorted(p for p in package.glob("*.py") if p.stem not in NOT_MATH)
+
+
+def _check_analysis_role(pkg: Path, root: Path) -> list[Violation]:
+    """``analysis.py``, when present, is the evidence's: ``evidence.py`` imports it, no step or figure module does."""
+    analysis = pkg / ANALYSIS
+    if not analysis.is_file():
+        return []
+    stem = Path(ANALYSIS).stem
+
+    def imports_analysis(path: Path) -> int:
+        """The first line of ``path`` that imports the paper's analysis module (0: none)."""
+        if not path.is_file():
+            return 0
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            if isinstance(node, ast.ImportFrom) and node.level == 1 and (
+                    node.module == stem or node.module is None and any(a.name == stem for a in node.names)):
+                return node.lineno
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").endswith(
+                    f"papers.{pkg.name}.{stem}"):
+                return node.lineno
+        return 0
+
+    out = []
+    if not imports_analysis(pkg / "evidence.py"):
+        out.append(Violation(_rel(analysis, root), 0, "analysis-role",
+                             f"{ANALYSIS} holds the mathematics the evidence quotes, but evidence.py does not import it"))
+    for name in ("steps.py", "figures.py"):
+        line = imports_analysis(pkg / name)
+        if line:
+            out.append(Violation(_rel(pkg / name, root), line, "analysis-role",
+                                 f"{name} imports {ANALYSIS} (the evidence's mathematics): move what it needs to "
+                                 "model.py or a concept-named math module"))
+    return out
 
 
 def _check_roles(slug: str, root: Path) -> list[Violation]:
@@ -635,7 +676,8 @@ def check_paper(slug: str, root: str | Path = ".") -> list[Violation]:
     pkg = root / "src/netrepro/papers" / slug
     if not pkg.is_dir():
         return [Violation(_rel(pkg, root), 0, "roles", f"paper {slug!r} has no package")]
-    return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_math_io(pkg, root),
+    return [*_check_roles(slug, root), *_check_figures_imports(slug, pkg, root), *_check_analysis_role(pkg, root),
+            *_check_math_io(pkg, root),
             *_check_public_api(pkg, root), *_check_quantities(slug, pkg, root), *_check_findings_gate(slug, pkg, root),
             *_check_figures(slug, pkg, root), *_check_config_references(slug, pkg, root),
             *_check_rule_names(slug, root), *_check_config_keys(slug, root), *_check_whole_section(slug, root)]

@@ -1,4 +1,4 @@
-"""Evidence of `gainsched` (issue 15): the helpers of :mod:`.verification` against independent computations, the data files."""
+"""Evidence of `gainsched` (issue 15): the helpers of :mod:`.analysis` against independent computations, the data files."""
 
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 findings of ``claims.yaml`` / ``errata.yaml`` / ``reconstructions.yaml`` / ``findings.yaml`` compare with.
 
 One step, :func:`evidence_step`, writes ``results/evidence/gainsched.csv`` (quantity, variant, value,
-note). Assembly only (issue 29): the mathematics is in :mod:`.verification`, :mod:`.feasibility`,
+note). Assembly only (issue 29): the mathematics is in :mod:`.analysis`, :mod:`.feasibility`,
 :mod:`.design` and :mod:`.model`; the paper's settings of a claim come from its ``at:`` field in
 ``claims.yaml``. Nothing here states what the paper says: statements, paper values, tolerances,
 printed and corrected forms and reasons are in the YAML files. Variants re-judge a claim or finding
@@ -99,7 +99,7 @@ def evidence_step(params, inputs, outputs):
     """Step of rule ``gainsched_evidence``: the evidence table of every claim, erratum, reconstruction, finding.
 
     Reads the design, stability, exact-moment, sensitivity, scheduling and vertex-LMI tables and the
-    claims' ``at:`` settings; recomputes only light quantities through :mod:`.verification`
+    claims' ``at:`` settings; recomputes only light quantities through :mod:`.analysis`
     (second-moment radii and growth rates across sigma^2, horizon and omega, residuals of the errata).
 
     Parameters

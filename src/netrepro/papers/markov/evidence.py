@@ -2,7 +2,7 @@
 its claims, errata, reconstructions and findings (the YAML files beside this module) are judged on.
 
 Nothing here states a claim, a paper value or a tolerance, and nothing here is mathematics: the
-values come from the math modules (:mod:`.model`, :mod:`.enumeration`, :mod:`.certificates`,
+values come from the math modules (:mod:`.model`, :mod:`.analysis`, :mod:`.certificates`,
 :mod:`.stability`, :mod:`.lmis`) and the result tables; the paper's settings of a claim (its ``(p, q)``)
 come from the claim's ``at:`` field in ``claims.yaml`` / ``findings.yaml``.
 """
