@@ -89,7 +89,7 @@ CHECK = textwrap.dedent("""
     from netrepro import locations
     from netrepro.judging import paperdata, regression
     from netrepro.report import markup
-    from netrepro.scaffold import TEMPLATES
+    from netrepro.scaffold.skeleton import TEMPLATES
 
     out = {"file": netrepro.__file__, "sys_path": sys.path, "checkout": str(locations.checkout_root()),
            "schema_dir": str(locations.SCHEMA_DIR), "platform_rules": regression.load_platform_rules(), "papers": {}}

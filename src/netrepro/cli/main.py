@@ -46,7 +46,7 @@ _FAST_EXIT = ("run", "verify", "report")
 
 def _new_paper(args) -> int:
     from ..errors import NetreproError
-    from ..scaffold import new_paper, source_warnings
+    from ..scaffold.skeleton import new_paper, source_warnings
 
     try:
         written = new_paper(args.slug, args.title, args.source, args.root, args.authors)
