@@ -33,13 +33,16 @@ import re
 import textwrap
 from pathlib import Path
 
+from ..locations import package_root
+
 __all__ = ["PACKAGE", "RUNNER_MODULE", "module_file", "imported_modules", "module_closure", "function_closure",
            "code_inputs"]
 
 PACKAGE = "netrepro"
 # the module every step runs in (it also imports io and provenance): part of every rule's code
 RUNNER_MODULE = "netrepro.pipeline.runner"
-_SRC = Path(__file__).resolve().parents[2]
+# the folder that holds the package (src/ of a checkout)
+_SRC = package_root().resolve().parent
 # an import statement at any indentation; a parenthesised name list may span lines
 _IMPORT = re.compile(r"^[ \t]*(?:from[ \t]+[.\w]+[ \t]+import[ \t]+(?:\([^)]*\)|[^\n]*)|import[ \t]+[^\n]*)",
                      re.MULTILINE)

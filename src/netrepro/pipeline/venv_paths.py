@@ -96,5 +96,5 @@ def relocate(venv: Path, src: Path) -> list[str]:
 
 if __name__ == "__main__":
     venv = Path(sys.argv[1] if len(sys.argv) > 1 else ".venv")
-    for line in relocate(venv, Path(__file__).resolve().parents[2]):
+    for line in relocate(venv, next(p for p in Path(__file__).resolve().parents if p.name == "netrepro").parent):
         print(f"make: {line}", file=sys.stderr)
