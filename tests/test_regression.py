@@ -103,7 +103,7 @@ def test_committed_platform_rules_name_existing_reference_columns_with_a_reason(
 
 def test_a_result_table_without_a_reference_fails_naming_it(tmp_path):
     """Issue 30: a new table is never silently skipped (timings and shards have no reference)."""
-    from netrepro.judging.regression import main
+    from netrepro.cli.regression import main
 
     ref, got = _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
     for extra in ("p/new.csv", "benchmarks.csv", "p/shards/s0.csv"):
@@ -117,7 +117,7 @@ def test_a_result_table_without_a_reference_fails_naming_it(tmp_path):
 
 
 def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
-    from netrepro.judging.regression import main
+    from netrepro.cli.regression import main
 
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.5]}))
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}), name="p/same.csv")
@@ -133,7 +133,7 @@ def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
 
 
 def test_recorded_paper_scale_run_is_neither_compared_nor_removed_by_update(tmp_path, capsys):
-    from netrepro.judging.regression import main
+    from netrepro.cli.regression import main
 
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
     recorded = tmp_path / "ref" / "paper-scale" / "claims" / "p.csv"
@@ -165,7 +165,7 @@ def test_clearing_an_old_difference_page_touches_nothing_else(tmp_path):
 
 def test_compare_with_no_page_deletes_nothing_in_the_working_directory(tmp_path, monkeypatch):
     # `--html ''` once made compare remove Path('').parent, the working directory, with everything in it
-    from netrepro.judging.regression import main
+    from netrepro.cli.regression import main
 
     (tmp_path / "ref").mkdir()
     (tmp_path / "res").mkdir()
@@ -189,7 +189,8 @@ def _two_papers(root):
 
 def test_update_of_one_paper_leaves_every_other_reference_byte_identical(tmp_path, capsys):
     """Issue 40 A: `make update-references PAPER=a` touches a's tables (own and shared) only."""
-    from netrepro.judging.regression import main, paper_of
+    from netrepro.cli.regression import main
+    from netrepro.judging.regression import paper_of
 
     ref, res = _two_papers(tmp_path)
     (res / "a" / "new.csv").write_text("x\n3\n")

@@ -28,7 +28,7 @@ VERBS = {
     "register-findings": ("netrepro.cli.main:_register_findings", "here",
                           "register the rules of new findings in findings.lock, before the runs"),
     "diff": ("netrepro.judging.diff:main", "argv", "what changed in the verdicts between two runs"),
-    "regression": ("netrepro.judging.regression:main", "argv",
+    "regression": ("netrepro.cli.regression:main", "argv",
                    "compare a run with the committed references, or update them (compare | update)"),
     "scale-record": ("netrepro.scale.record:main", "argv", "record a paper-scale run's claims"),
     "scaling": ("netrepro.scale.projection:main", "argv", "per-rule work and projected cluster wall times"),

@@ -268,7 +268,7 @@ def _compare_values(where: str, ref, got, rtol: float, atol: float, out: list, f
 
     ``finite``: numbers are compared by shape and NaN/inf pattern only (a platform rule).
     """
-    from ..judging.regression import _texts_agree
+    from ..judging.regression import texts_agree
 
     if isinstance(ref, dict) and isinstance(got, dict):
         for key in sorted(set(ref) | set(got)):
@@ -279,7 +279,7 @@ def _compare_values(where: str, ref, got, rtol: float, atol: float, out: list, f
         return
     if isinstance(ref, (str, bool)) or isinstance(got, (str, bool)) or ref is None or got is None:
         if isinstance(ref, str) and isinstance(got, str):
-            if not _texts_agree(ref, got, rtol, atol):
+            if not texts_agree(ref, got, rtol, atol):
                 out.append(f"{where}: {got!r}, reference {ref!r}")
         elif ref != got:
             out.append(f"{where}: {got!r}, reference {ref!r}")

@@ -11,6 +11,9 @@ differences only come from floating-point details of the platform).
 prints what changed (the figures' references are the committed files under ``figures/``);
 ``--paper SLUG`` (repeatable; ``make update-references PAPER=slug``) touches only that paper's
 tables: ``<slug>/...`` and the shared ``claims/<slug>.csv``, ``errata/<slug>.csv``, ... .
+The comparison is this module's: the tolerances, numbers inside text (:func:`texts_agree`), the
+tables; :mod:`netrepro.figures.check` calls it for what a figure draws, and the command that runs both
+is :mod:`netrepro.cli.regression`.
 Measured times (the columns :data:`TIMING_COLUMNS` names, e.g. ``solve_time_s``, ``seconds``)
 are no part of any reference: ``update`` does not copy them and ``compare`` ignores them; the
 free-text ``note`` of claims tables is copied but not compared. Numbers printed inside text are compared
@@ -22,12 +25,9 @@ and the weaker check they get, in ``tests/platform_dependent.yaml``.
 
 from __future__ import annotations
 
-import argparse
 import csv
 import fnmatch
 import re
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -36,8 +36,8 @@ import yaml
 
 from ..locations import checkout_file
 
-__all__ = ["TIMING_COLUMNS", "compare_tables", "compare_trees", "is_timing_column", "load_platform_rules", "main",
-           "paper_of", "update_tables", "write_check_summary"]
+__all__ = ["RTOL", "ATOL", "TIMING_COLUMNS", "FIGURES", "PLATFORM_RULES", "compare_tables", "compare_trees",
+           "is_timing_column", "load_platform_rules", "paper_of", "texts_agree", "update_tables"]
 
 RTOL = 1e-6
 ATOL = 1e-9
@@ -137,7 +137,7 @@ def _split_numbers(text: str) -> tuple[list[str], np.ndarray]:
     return NUMBER.split(text), np.array([float(x) for x in NUMBER.findall(text)])
 
 
-def _texts_agree(a: str, b: str, rtol: float, atol: float, numbers: bool = True) -> bool:
+def texts_agree(a: str, b: str, rtol: float, atol: float, numbers: bool = True) -> bool:
     """Same words, and (with ``numbers``) the same numbers within the tolerance."""
     if a == b:
         return True
@@ -154,7 +154,7 @@ def _weak_agree(check: str, a: pd.Series, b: pd.Series, rtol: float, atol: float
         return np.ones(len(a), dtype=bool)
     if not (pd.api.types.is_numeric_dtype(a) and pd.api.types.is_numeric_dtype(b)) or check == "text":
         sa, sb = a.fillna("").astype(str).to_numpy(), b.fillna("").astype(str).to_numpy()
-        return np.array([_texts_agree(x, y, rtol, atol, numbers=False) for x, y in zip(sa, sb)], dtype=bool)
+        return np.array([texts_agree(x, y, rtol, atol, numbers=False) for x, y in zip(sa, sb)], dtype=bool)
     x, y = a.to_numpy(dtype=float), b.to_numpy(dtype=float)
     same_pattern = (np.isnan(x) == np.isnan(y)) & (np.isinf(x) == np.isinf(y))
     if check == "sign":
@@ -233,7 +233,7 @@ def compare_tables(reference: Path, result: Path, rtol=RTOL, atol=ATOL, rules=()
             ok = np.isclose(x, y, rtol=rtol, atol=atol, equal_nan=True) | (np.isinf(x) & (x == y))
         else:
             sa, sb = a.fillna("").astype(str).to_numpy(), b.fillna("").astype(str).to_numpy()
-            ok = np.array([_texts_agree(u, v, rtol, atol) for u, v in zip(sa, sb)], dtype=bool)
+            ok = np.array([texts_agree(u, v, rtol, atol) for u, v in zip(sa, sb)], dtype=bool)
         for rows, check in weak.get(col, []):
             ok = np.where(rows, _weak_agree(check, a, b, rtol, atol), ok)
         if not ok.all():
@@ -402,145 +402,3 @@ def update_tables(reference: Path, results: Path, papers=None) -> list[str]:
     return ([f"table added: {reference / r}" for r in sorted(set(new) - set(old))]
             + [f"table removed: {reference / r}" for r in sorted(set(old) - set(new))]
             + [f"table changed: {reference / r}" for r in sorted(set(old) & set(new)) if old[r] != new[r]])
-
-
-def main(argv=None) -> int:
-    """``python -m netrepro regression {compare,update}``: compare the build with the references, or refresh them.
-
-    Parameters
-    ----------
-    argv : list of str, optional
-        Command-line arguments (default ``sys.argv[1:]``).
-
-    Returns
-    -------
-    int
-        Exit status: 0, or (``compare``) 1 when a table or figure differs or nothing was compared.
-    """
-    parser = argparse.ArgumentParser(prog="python -m netrepro regression", description=__doc__.splitlines()[0])
-    parser.add_argument("command", choices=["compare", "update"])
-    parser.add_argument("--reference", default="tests/reference")
-    parser.add_argument("--results", default="results")
-    parser.add_argument("--platform-rules", default=str(PLATFORM_RULES),
-                        help="values that differ between CPUs and their weaker checks ('' for none)")
-    parser.add_argument("--figures", default="figures", help="the built figures ('' to compare tables only)")
-    parser.add_argument("--figure-reference", default="git:HEAD",
-                        help="the figures' references: git:REV (committed files under figures/) or a folder")
-    parser.add_argument("--html", default="results/regeneration/index.html",
-                        help="the difference page, written when anything differs")
-    parser.add_argument("--paper", action="append", default=None, metavar="SLUG",
-                        help="update: only this paper's tables (repeatable; default every paper)")
-    args = parser.parse_args(argv)
-    if args.command == "update":
-        try:
-            changes = update_tables(Path(args.reference), Path(args.results), papers=args.paper)
-        except ValueError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
-        if args.figures:
-            from ..figures.check import compare_figures, open_baseline
-
-            _, diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures)
-            for d in diffs:
-                if args.paper and d.name.split("/")[0] not in args.paper:
-                    continue
-                changes.append(f"figure changed: figures/{d.name}.png (and its .data.json): " + "; ".join(
-                    (d.problems + d.notes)[:2]))
-            if args.figure_reference.startswith("git:"):
-                changes.append("figure references are the files under figures/: commit them with the tables")
-        for line in changes or ["nothing changed"]:
-            print(line)
-        print(f"reference tables written to {args.reference}"
-              + (f" (papers {', '.join(args.paper)} only)" if args.paper else ""))
-        return 0
-    start = time.perf_counter()
-    if args.html:  # a page from an earlier run would describe differences that may be gone
-        from ..figures.check import clear_difference_page
-
-        clear_difference_page(Path(args.html).parent)
-    details: list[dict] = []
-    count, problems = compare_trees(Path(args.reference), Path(args.results),
-                                    platform_rules=args.platform_rules or None, details=details)
-    for line in problems:
-        print("DIFF", line)
-    print(f"regression: {count} reference tables compared, {len(problems)} differences")
-    figure_diffs, failing, n_fig = [], [], 0
-    if args.figures:
-        from ..figures.check import compare_figures, load_figure_rules, open_baseline
-
-        n_fig, figure_diffs = compare_figures(open_baseline(args.figure_reference, FIGURES), args.figures,
-                                              rules=load_figure_rules(args.platform_rules or None))
-        failing = [d for d in figure_diffs if d.problems]
-        for d in figure_diffs:
-            for line in d.problems:
-                print("DIFF", line)
-            for line in d.notes:
-                print("NOTE", line)
-        print(f"regression: {n_fig} figures compared, {len(failing)} differ "
-              f"({time.perf_counter() - start:.1f} s with the tables)")
-    failed = bool(problems or failing or count == 0 or (args.figures and n_fig == 0))
-    if args.html:
-        # written on every run, passing or not: the evidence of what was compared (issue 41 item 5)
-        from ..figures.check import write_difference_page
-
-        page = write_difference_page(Path(args.html).parent, failing, details, compared=figure_diffs,
-                                     tables_compared=count)
-        summary = write_check_summary(Path(args.html).parent, failed, count, details, figure_diffs)
-        print(f"regression: the comparison, figure by figure: {page} (summary: {summary})")
-    return 1 if failed else 0
-
-
-def write_check_summary(out_dir: Path, failed: bool, tables_compared: int, tables: list[dict], figures: list) -> Path:
-    """Write ``summary.json`` and ``summary.md`` of a comparison beside its page; return the JSON's path.
-
-    Parameters
-    ----------
-    out_dir : Path
-        The comparison page's folder.
-    failed : bool
-        Whether the check fails.
-    tables_compared : int
-        How many reference tables were compared.
-    tables : list of dict
-        The differing tables (``{"table", "problems", "cells"}``).
-    figures : list of FigureDifference
-        Every figure compared (those with problems differ).
-
-    Returns
-    -------
-    Path
-        ``out_dir/summary.json``.
-    """
-    import json
-
-    from ..pipeline.io import atomic_path
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    rms = [d.rms for d in figures if d.rms is not None]
-    doc = {
-        "status": "fail" if failed else "pass",
-        "tables": {"compared": tables_compared, "differing": len(tables),
-                   "differences": [{"table": str(t["table"]), "problems": list(t["problems"])} for t in tables]},
-        "figures": {"compared": len(figures), "differing": sum(1 for d in figures if d.problems),
-                    "largest_pixel_rms": max(rms) if rms else None,
-                    "each": [{"figure": d.name, "status": "differs" if d.problems else "same", "pixel_rms": d.rms,
-                              "problems": list(d.problems), "notes": list(d.notes)} for d in figures]},
-    }
-    path = out_dir / "summary.json"
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
-    largest = f"{doc['figures']['largest_pixel_rms']:.3g}" if rms else "n/a"
-    lines = [f"## make check: {doc['status']}", "",
-             f"* tables: {tables_compared} compared, {len(tables)} differ",
-             f"* figures: {len(figures)} compared, {doc['figures']['differing']} differ "
-             f"(largest pixel RMS {largest})", ""]
-    lines += [f"* table `{t['table']}`: {'; '.join(t['problems'])[:300]}" for t in tables]
-    lines += [f"* figure `{d.name}`: {'; '.join(d.problems)[:300]}" for d in figures if d.problems]
-    with atomic_path(out_dir / "summary.md") as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
-    return path
-
-
-if __name__ == "__main__":
-    sys.exit(main())
