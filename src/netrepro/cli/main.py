@@ -121,7 +121,13 @@ def _own_parser(argv: list[str]):
 
 
 def usage() -> str:
-    """The list of verbs, one line each."""
+    """The command's usage: the list of verbs, one line each with its help.
+
+    Returns
+    -------
+    str
+        The text ``netrepro --help`` prints.
+    """
     width = max(map(len, VERBS))
     return "usage: netrepro VERB [ARGS...]   (or python -m netrepro VERB ...; netrepro VERB --help)\n\nverbs:\n" + \
         "\n".join(f"  {verb:<{width}}  {help_}" for verb, (_, _, help_) in VERBS.items())

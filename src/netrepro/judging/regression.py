@@ -138,7 +138,25 @@ def _split_numbers(text: str) -> tuple[list[str], np.ndarray]:
 
 
 def texts_agree(a: str, b: str, rtol: float, atol: float, numbers: bool = True) -> bool:
-    """Same words, and (with ``numbers``) the same numbers within the tolerance."""
+    """Same words, and (with ``numbers``) the same numbers within the tolerance.
+
+    The comparison of text that every check of a regenerated output uses: table cells here, the
+    text a figure draws in :mod:`netrepro.figures.check`.
+
+    Parameters
+    ----------
+    a, b : str
+        The reference text and the regenerated one.
+    rtol, atol : float
+        Relative and absolute tolerance of the numbers printed in the text.
+    numbers : bool
+        Compare the numbers too (False: the words alone).
+
+    Returns
+    -------
+    bool
+        Whether the two texts agree.
+    """
     if a == b:
         return True
     words_a, nums_a = _split_numbers(a)
