@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from netrepro.papers.intermittent import readings
+from netrepro.papers.intermittent import analysis as readings
 
 A, R1 = 1.5, 0.1
 LAM = 1 - 1 / A**2 + 0.1
