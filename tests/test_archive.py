@@ -105,7 +105,7 @@ def test_the_makefile_has_an_archive_target_that_installs_bagit_from_a_lock():
     makefile = (ROOT / "Makefile").read_text()
     assert "\narchive:" in makefile
     assert "--require-hashes -r $(LOCK)/archive.txt" in makefile
-    assert "netrepro.release.archive" in makefile
+    assert "-m netrepro archive " in makefile
     assert "bagit" in (ROOT / "requirements/archive.txt").read_text()
 
 
