@@ -23,7 +23,7 @@ $(STAMP): $(LOCK)/bootstrap.txt $(LOCK)/default.txt pyproject.toml
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/bootstrap.txt
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/default.txt
 	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
-	$(BIN)/python src/netrepro/venv_paths.py $(VENV)
+	$(BIN)/python src/netrepro/pipeline/venv_paths.py $(VENV)
 	$(BIN)/python -m ipykernel install --prefix $(VENV) --name python3 >/dev/null
 	touch $(STAMP)
 
@@ -36,7 +36,7 @@ $(STAMP_TEST): $(STAMP) $(LOCK)/test.txt
 # The tools are started through the environment's python, not their scripts, whose first line names
 # the interpreter by its absolute path at install time.
 venv-paths: $(STAMP)
-	@$(BIN)/python src/netrepro/venv_paths.py $(VENV)
+	@$(BIN)/python src/netrepro/pipeline/venv_paths.py $(VENV)
 
 # Console: one line per finished job and the warnings (workflow/profiles/default); each job's
 # full command is in its log (logs/) and its provenance sidecar (*.meta.json).
@@ -48,7 +48,7 @@ PROFILE ?= default
 SHARDS ?=
 SMK_OPTS = --profile workflow/profiles/$(PROFILE) $(if $(filter default,$(PROFILE)),-j$(JOBS)) \
 	$(if $(SHARDS),--config 'shards=$(SHARDS)') $(if $(CONFIG),--configfile config/config.yaml config/$(CONFIG).yaml)
-# The build driver (netrepro.build) runs `snakemake report $(SMK_OPTS)`: it says "interrupted; rerun" after
+# The build driver (netrepro.pipeline.build) runs `snakemake report $(SMK_OPTS)`: it says "interrupted; rerun" after
 # Ctrl-C, refuses to start beside a running build of this checkout, and says whose a lock is.
 BUILD = $(BIN)/python -m netrepro
 
@@ -60,14 +60,14 @@ BUILD = $(BIN)/python -m netrepro
 report: $(STAMP) venv-paths
 	$(BIN)/python -m compileall -q src
 	$(BUILD) build -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
-	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
+	$(BIN)/python -m netrepro report relocate report/snakemake_report.html
 
 # A damaged build repaired in one command: removes every output `verify` finds corrupt, unfinished or
 # unverifiable, rebuilds those and every declared output that is missing, and what depends on them.
 repair: $(STAMP) venv-paths
 	$(BIN)/python -m compileall -q src
 	$(BUILD) repair -- $(SMK_OPTS) --report report/snakemake_report.html --report-after-run
-	$(BIN)/python -m netrepro.report relocate report/snakemake_report.html
+	$(BIN)/python -m netrepro report relocate report/snakemake_report.html
 
 # Removes the lock a killed build left (Snakemake's --unlock); refuses while a build of this checkout runs.
 unlock: $(STAMP) venv-paths
@@ -100,11 +100,11 @@ lint: $(STAMP_TEST) venv-paths
 # against this build (`make readme` rewrites it).
 check: $(STAMP) venv-paths
 	$(BIN)/python -m netrepro verify
-	status=0; $(BIN)/python -m netrepro.regression compare --reference tests/reference --results results \
+	status=0; $(BIN)/python -m netrepro regression compare --reference tests/reference --results results \
 		|| status=$$?; $(BIN)/python -m netrepro prune --check -- $(SMK_OPTS) || status=1; \
-		$(BIN)/python -m netrepro.readme --check README.md || status=1; exit $$status
+		$(BIN)/python -m netrepro readme --check README.md || status=1; exit $$status
 
-# Removes the stale outputs (netrepro.stale): files in results/ and figures/ that no rule of the current
+# Removes the stale outputs (netrepro.pipeline.stale): files in results/ and figures/ that no rule of the current
 # workflow produces (a renamed or removed step's), with their sidecars; `make prune PRUNE_ARGS=--dry-run` lists them.
 PRUNE_ARGS ?=
 prune: $(STAMP) venv-paths
@@ -114,10 +114,10 @@ prune: $(STAMP) venv-paths
 # figures and their data sidecars are already in figures/). Prints what changed; then commit both.
 # `make update-references PAPER=markov` (or PAPER='markov hinf'): only those papers' tables (their folder and
 # their rows of the shared claims/, errata/, findings/, evidence/, reconstructions/); every other reference
-# stays byte-identical. Timing columns (netrepro.regression.TIMING_COLUMNS) are never copied.
+# stays byte-identical. Timing columns (netrepro.judging.regression.TIMING_COLUMNS) are never copied.
 PAPER ?=
 update-references: $(STAMP) venv-paths
-	$(BIN)/python -m netrepro.regression update --reference tests/reference --results results \
+	$(BIN)/python -m netrepro regression update --reference tests/reference --results results \
 		$(foreach p,$(PAPER),--paper $(p))
 
 # Refresh the lock files from pyproject.toml (pins kept unless UPGRADE=1); then `make test`.
@@ -127,16 +127,16 @@ lock: $(STAMP)
 	$(BIN)/uv pip compile pyproject.toml $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -o $(LOCK)/default.txt
 	$(BIN)/uv pip compile pyproject.toml --extra test $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/test.txt
 	$(BIN)/uv pip compile pyproject.toml --extra archive $(LOCK_FLAGS) $(if $(UPGRADE),--upgrade) -c $(LOCK)/default.txt -o $(LOCK)/archive.txt
-	$(BIN)/python -m netrepro.lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
+	$(BIN)/python -m netrepro lockfile conda-env $(LOCK)/default.txt workflow/envs/netrepro.yaml
 
 # Rewrite the results table of README.md from the claims, errata and figures of the last build.
 readme: $(STAMP) venv-paths
-	$(BIN)/python -m netrepro.readme README.md
+	$(BIN)/python -m netrepro readme README.md
 
 # Benchmarks with ratios against simple references (issue 9); `make bench BENCH_ARGS=--quick` skips the pipeline.
 BENCH_ARGS ?=
 bench: $(STAMP) venv-paths
-	$(BIN)/python -m netrepro.bench --out results/benchmarks.csv $(BENCH_ARGS)
+	$(BIN)/python -m netrepro bench --out results/benchmarks.csv $(BENCH_ARGS)
 
 # Everything the pipeline makes: tables, logs, figures (committed, but rebuilt), the report and
 # Snakemake's metadata (its conda/container caches stay). `make report` afterwards runs every job.
@@ -155,4 +155,4 @@ clean-results: clean
 # from it, .zenodo.json and codemeta.json. bagit is installed on demand from its own lock (hashes).
 archive: $(STAMP) venv-paths $(LOCK)/archive.txt
 	$(BIN)/python -m pip install --quiet --require-hashes -r $(LOCK)/archive.txt
-	$(BIN)/python -m netrepro.archive --out archive --zip
+	$(BIN)/python -m netrepro archive --out archive --zip

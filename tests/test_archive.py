@@ -13,7 +13,7 @@ import jsonschema
 import pytest
 import yaml
 
-from netrepro.archive import codemeta_json, main, write_archive, zenodo_json
+from netrepro.release.archive import codemeta_json, main, write_archive, zenodo_json
 from netrepro.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -72,7 +72,7 @@ def test_identifiers_of_the_references_become_related_identifiers():
 
 
 def test_the_registry_identifiers_reach_the_deposit_metadata():
-    from netrepro.references import load_identifiers
+    from netrepro.release.citations import load_identifiers
 
     related = {r["identifier"] for r in zenodo_json(CFF).get("related_identifiers", [])}
     for slug, idents in load_identifiers().items():
@@ -105,7 +105,7 @@ def test_the_makefile_has_an_archive_target_that_installs_bagit_from_a_lock():
     makefile = (ROOT / "Makefile").read_text()
     assert "\narchive:" in makefile
     assert "--require-hashes -r $(LOCK)/archive.txt" in makefile
-    assert "netrepro.archive" in makefile
+    assert "-m netrepro archive " in makefile
     assert "bagit" in (ROOT / "requirements/archive.txt").read_text()
 
 
@@ -152,7 +152,7 @@ def test_the_archive_is_a_valid_bag_with_every_part(scratch, tmp_path):
                             text=True).stdout.strip()
     _fake_report(scratch, commit)
     out = tmp_path / "out"
-    proc = subprocess.run([sys.executable, "-m", "netrepro.archive", "--root", str(scratch), "--out", str(out),
+    proc = subprocess.run([sys.executable, "-m", "netrepro", "archive", "--root", str(scratch), "--out", str(out),
                            "--zip"], capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
     assert proc.returncode == 0, proc.stderr

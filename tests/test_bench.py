@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from netrepro import bench
+from netrepro.scale import bench
 from netrepro.engines.riccati import Sensor, covariance_paths
 
 

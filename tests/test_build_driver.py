@@ -1,4 +1,4 @@
-"""The build driver (netrepro.build, issue 38 items 2 and 5): builds of this checkout found by their
+"""The build driver (netrepro.pipeline.build, issue 38 items 2 and 5): builds of this checkout found by their
 processes, the lock and the interrupt told truly, `unlock` refused while a build runs, and a job that
 notices its Snakemake is gone. Fake Snakemake processes (a script named ``snakemake``) stand in for real
 builds; the workflow-level repair and kill tests are in tests/test_reliability_workflow.py."""
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from netrepro import build, processes
+from netrepro.pipeline import build, processes
 
 ROOT = Path(__file__).resolve().parents[1]
 SLEEPER = "import time, sys\nprint('started', flush=True)\ntime.sleep(float(sys.argv[1]) if len(sys.argv) > 1 else 60)\n"
@@ -134,7 +134,7 @@ def test_sigterm_to_the_driver_alone_reaches_snakemake_and_reads_interrupted(tmp
 CHILD = """
 import sys
 sys.path.insert(0, {src!r})
-from netrepro.processes import snakemake_ancestor
+from netrepro.pipeline.processes import snakemake_ancestor
 import os
 print(os.getppid(), snakemake_ancestor(), flush=True)
 """
@@ -166,7 +166,7 @@ def test_a_job_finds_the_snakemake_that_started_it_and_sees_it_die(tmp_path):
 
 def test_an_orphaned_step_writes_nothing(tmp_path, monkeypatch):
     # the runner's check before writing: the Snakemake that started the job is gone
-    from netrepro import runner
+    from netrepro.pipeline import runner
     from netrepro.errors import OrphanedJobError
 
     monkeypatch.chdir(tmp_path)
@@ -199,7 +199,7 @@ def test_the_starter_is_read_from_the_environment_on_this_host_only():
 def test_a_job_started_after_its_snakemake_died_does_no_work(tmp_path, monkeypatch):
     # Snakemake killed between starting the job's shell and the job's interpreter: no ancestor is left to
     # find, but the environment names it, and the job stops before it reads or computes anything
-    from netrepro import runner
+    from netrepro.pipeline import runner
     from netrepro.errors import OrphanedJobError
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])

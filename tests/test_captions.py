@@ -6,8 +6,8 @@ from pathlib import Path
 import docutils.core
 import pytest
 
-from netrepro.figurespec import load_figure_specs
-from netrepro.registry import load_registry
+from netrepro.pipeline.figurespec import load_figure_specs
+from netrepro.pipeline.registry import load_registry
 
 PAPERS = load_registry()
 

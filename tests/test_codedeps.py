@@ -1,6 +1,6 @@
 """Every rule's code inputs are the modules its function reaches, within its import closure.
 
-The module-level import closure is read from the source with ``ast`` (:mod:`netrepro.codedeps`);
+The module-level import closure is read from the source with ``ast`` (:mod:`netrepro.pipeline.codedeps`);
 here it is recomputed independently from the compiled byte code by :mod:`modulefinder`. The
 function-level closure (what a rule lists) lies within it, and an edit to a module reruns only
 the rules whose function reaches it: checked on a scratch copy of the workflow, whose plan after
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from netrepro.codedeps import code_inputs, function_closure, imported_modules, module_closure
+from netrepro.pipeline.codedeps import code_inputs, function_closure, imported_modules, module_closure
 
 from .conftest import copy_repo, run_snakemake
 
@@ -90,7 +90,7 @@ def test_closure_matches_bytecode_reading_for_every_module():
 @pytest.mark.slow  # a dry run of the whole workflow
 def test_every_rule_lists_its_function_closure_within_the_import_closure(planned_jobs):
     assert len(planned_jobs) > 50
-    runner = bytecode_closure("netrepro.runner")
+    runner = bytecode_closure("netrepro.pipeline.runner")
     narrower = 0
     for rule, (func, listed) in planned_jobs.items():
         module = func.split(":")[0]
@@ -177,7 +177,7 @@ def test_plotting_modules_stay_out_of_compute_steps(planned_jobs):
     """An edit to a plotting module must not rerun a computation."""
     for rule, (func, listed) in planned_jobs.items():
         if ".figures:" not in func and not re.search(r"_fig(S?\d+)$", rule):
-            assert "src/netrepro/plotting.py" not in listed or ".steps:" not in func, rule
+            assert "src/netrepro/figures/plotting.py" not in listed or ".steps:" not in func, rule
 
 
 def test_relative_and_nested_imports_are_found(tmp_path):

@@ -4,7 +4,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from netrepro.config import ConfigError, require_pd, validate_config
+from netrepro.pipeline.config import ConfigError, require_pd, validate_config
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -28,7 +28,7 @@ def test_load_yaml_gives_what_the_pure_python_parser_gives():
 
     import yaml
 
-    from netrepro.io import load_yaml, yaml_loader_class
+    from netrepro.pipeline.io import load_yaml, yaml_loader_class
 
     root = Path(__file__).resolve().parents[1]
     files = [*root.glob("src/**/*.yaml"), *root.glob("workflow/**/*.yaml"), *root.glob("config/*.yaml")]
@@ -61,7 +61,7 @@ def test_shard_count_in_a_paper_section_points_to_the_shards_section():
 
 
 def test_command_line_shard_counts_become_integers():
-    from netrepro.config import coerce_shard_counts, shard_count
+    from netrepro.pipeline.config import coerce_shard_counts, shard_count
 
     # what `--config 'shards={a: 8, b: x}'` gives: YAML's base loader keeps scalars as strings
     cfg = coerce_shard_counts({"shards": {"onebit_estimator": "8", "hinf_kalman_best": "x"}})
@@ -104,7 +104,7 @@ def test_a_number_yaml_reads_as_text_is_named_with_its_fix():
 
     import yaml
 
-    from netrepro.config import validate_config
+    from netrepro.pipeline.config import validate_config
     from netrepro.errors import ConfigError
 
     root = Path(__file__).resolve().parents[1]

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from netrepro.config import ConfigError, validate_config
+from netrepro.pipeline.config import ConfigError, validate_config
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMAS = ROOT / "workflow" / "schemas"

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from netrepro.contract import check_paper
-from netrepro.registry import paper_slugs
+from netrepro.judging.contract import check_paper
+from netrepro.pipeline.registry import paper_slugs
 
 ROOT = Path(__file__).resolve().parents[1]
 SLUG = "intermittent"
@@ -223,7 +223,7 @@ def test_params_passing_a_whole_section_are_named_with_file_and_line(hinf_checko
 
 def _unpicked(text: str) -> str:
     """The hinf rules as they were before issue 39: every ``pick(HCFG, ...)`` replaced by ``HCFG``."""
-    from netrepro.contract import _calls
+    from netrepro.judging.contract import _calls
     calls = [(offset, source) for offset, source in _calls(text, "pick") if re.match(r"pick\(\s*HCFG\s*,", source)]
     for offset, source in reversed(calls):
         text = text[:offset] + "HCFG" + text[offset + len(source):]
@@ -288,3 +288,20 @@ def test_reconstruction_keys_and_settings_are_not_configuration_paths(scratch):
     recon = scratch / f"src/netrepro/papers/{SLUG}/reconstructions.yaml"
     _append(recon, '- key: scalar.not_a_config_key\n  reason: "a modelling choice named by its key"\n')
     assert not _named(check_paper(SLUG, scratch), "config-reference", f"src/netrepro/papers/{SLUG}/reconstructions.yaml")
+
+
+def test_analysis_role_is_the_evidences(tmp_path):
+    """``analysis.py`` (the evidence mathematics): evidence.py imports it, a step module may not."""
+    from netrepro.judging.contract import ANALYSIS, _check_analysis_role
+
+    pkg = tmp_path / "src/netrepro/papers/demo"
+    pkg.mkdir(parents=True)
+    (pkg / ANALYSIS).write_text('"""Evidence mathematics."""\n')
+    (pkg / "evidence.py").write_text("from .analysis import residual\n")
+    (pkg / "steps.py").write_text("import numpy as np\n")
+    assert _check_analysis_role(pkg, tmp_path) == []
+    (pkg / "steps.py").write_text("import numpy as np\n\nfrom .analysis import residual\n")
+    (pkg / "evidence.py").write_text("from .model import f\n")
+    found = {(v.path, v.line, v.check) for v in _check_analysis_role(pkg, tmp_path)}
+    assert found == {("src/netrepro/papers/demo/analysis.py", 0, "analysis-role"),
+                     ("src/netrepro/papers/demo/steps.py", 3, "analysis-role")}

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from netrepro.diff import DIFF_COLUMNS, diff_runs
+from netrepro.judging.diff import DIFF_COLUMNS, diff_runs
 
 ROOT = Path(__file__).resolve().parents[1]
 CLAIMS = ["paper", "claim_id", "reproduced_value", "verdict", "robust"]

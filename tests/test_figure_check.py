@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from netrepro.figurecheck import (RMS_TOLERANCE, compare_figures, figure_jobs, load_figure_rules, open_baseline,
+from netrepro.figures.check import (RMS_TOLERANCE, compare_figures, figure_jobs, load_figure_rules, open_baseline,
                                   regenerate_figures)
-from netrepro.regression import PLATFORM_RULES
+from netrepro.judging.regression import PLATFORM_RULES
 
 ROOT = Path(__file__).resolve().parents[1]
 # every test reads the figure jobs from a dry run of the workflow (Snakemake), hence slow
@@ -156,12 +156,12 @@ def test_pixels_alone_fail_beyond_the_tolerance(tmp_path, rebuilt):
 
 
 def test_the_command_fails_and_writes_the_difference_page(tmp_path, rebuilt):
-    """``python -m netrepro.regression compare`` (CI's command) on a drifted figure: exit 1 and the page."""
+    """``python -m netrepro regression compare`` (CI's command) on a drifted figure: exit 1 and the page."""
     figures = tmp_path / "figures"
     shutil.copytree(rebuilt, figures)
     (figures / "markov" / "fig6.png").unlink()
     page = tmp_path / "regeneration"
-    cmd = [sys.executable, "-m", "netrepro.regression", "compare", "--reference", "tests/reference",
+    cmd = [sys.executable, "-m", "netrepro", "regression", "compare", "--reference", "tests/reference",
            "--results", "tests/reference", "--figures", str(figures), "--html", str(page / "index.html")]
     proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     assert proc.returncode == 1, proc.stdout + proc.stderr

@@ -1,6 +1,6 @@
 """Figures for every reader (issue 41 item 2): no meaning carried by a red/green difference alone.
 
-Over the committed data sidecars (``figures/*/*.data.json``, :mod:`netrepro.figuredata`): any two
+Over the committed data sidecars (``figures/*/*.data.json``, :mod:`netrepro.figures.data`): any two
 labelled artists of one panel (a legend entry: an artist's own label, or the label of the bar or
 error-bar container it belongs to) must differ in form (marker, line style, kind of artist or
 hatch), or their colours must stay apart for readers with deuteranopia and protanopia: CIEDE2000
@@ -190,14 +190,14 @@ def test_the_check_fails_on_a_red_green_pair_with_identical_markers():
 
 
 def test_okabe_ito_blue_and_vermillion_stay_apart_where_red_and_green_do_not():
-    from netrepro.plotting import COLOURS
+    from netrepro.figures.plotting import COLOURS
 
     assert min(colour_distance([COLOURS["bounded"]], [COLOURS["unbounded"]]).values()) >= MIN_DELTA_E
     assert min(colour_distance(["#2ca02c"], ["#d62728"]).values()) < MIN_DELTA_E
 
 
 def test_the_default_colour_cycle_is_okabe_ito():
-    from netrepro.plotting import OKABE_ITO, PALETTE, STYLE, new_figure
+    from netrepro.figures.plotting import OKABE_ITO, PALETTE, STYLE, new_figure
 
     assert [c.lower() for c in STYLE["axes.prop_cycle"].by_key()["color"]] == [c.lower() for c in PALETTE]
     assert set(PALETTE) == set(OKABE_ITO.values())

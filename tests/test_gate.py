@@ -8,10 +8,10 @@ import pandas as pd
 import pytest
 
 from netrepro.errors import ConfigError, InputError
-from netrepro.paperdata import (ClaimEntry, FindingEntry, check_tolerance, load_paper_data, register_findings,
+from netrepro.judging.paperdata import (ClaimEntry, FindingEntry, check_tolerance, load_paper_data, register_findings,
                                 registered_fields, render_statement, rule_hash, template_fields, typed_numbers)
-from netrepro.summary import scorecard
-from netrepro.verdicts import (AGREES, DISAGREES, UNDECIDED, Cell, compare, evidence_frame, findings_table, judge,
+from netrepro.judging.summary import scorecard
+from netrepro.judging.verdicts import (AGREES, DISAGREES, UNDECIDED, Cell, compare, evidence_frame, findings_table, judge,
                                read_evidence)
 
 from .test_paperdata import PAPER, write_paper
@@ -217,12 +217,12 @@ def test_an_observation_is_measured_not_judged(tmp_path):
                "  kind: observation\n")
     with pytest.raises(ConfigError, match="registered"):  # a registered rule changed: needs an amendment
         load_paper_data("p", write_paper(tmp_path, findings=[observe]))
-    from netrepro.paperdata import load_findings
+    from netrepro.judging.paperdata import load_findings
 
     f1 = load_findings(write_paper(tmp_path, findings=[observe]) / "findings.yaml")[0]
     assert f1.observation and f1.asserted is None
     ev = {"gain_vs_none": {"nominal": Cell(3.2, "", 0.1), "horizon=100": Cell(3.1, "")}, "gain": {"nominal": Cell(1.5, "")}}
-    from netrepro.paperdata import PaperData
+    from netrepro.judging.paperdata import PaperData
 
     table = findings_table(PaperData("p", [], [], [], [f1]), ev)
     assert table.loc[0, ["verdict", "kind", "uncertainty"]].tolist() == ["observed", "observation", "0.1"]
@@ -232,14 +232,14 @@ def test_an_observation_is_measured_not_judged(tmp_path):
 
 def test_a_causal_finding_names_its_isolating_control(tmp_path):
     no_control = (', control: {holds_fixed: "the plant and the noise", changes: "only the gain"}', "")
-    from netrepro.paperdata import load_findings
+    from netrepro.judging.paperdata import load_findings
 
     with pytest.raises(ConfigError, match=r"entry 1 \(id 'F2'\): field 'cause.control' is required"):
         load_findings(write_paper(tmp_path, findings=[no_control]) / "findings.yaml")
 
 
 def test_a_numeric_rule_names_the_source_of_its_threshold(tmp_path):
-    from netrepro.paperdata import load_findings
+    from netrepro.judging.paperdata import load_findings
 
     unsourced = (', source: {kind: effect_size, ref: "a factor of 3 set before the runs"}', "")
     with pytest.raises(ConfigError, match="rule.source.*independently of our value"):
@@ -276,7 +276,7 @@ def test_check_paper_refuses_a_typed_statement_and_the_build_does_not(tmp_path):
     import shutil
     from pathlib import Path
 
-    from netrepro.contract import _check_findings_gate
+    from netrepro.judging.contract import _check_findings_gate
 
     root = Path(__file__).resolve().parents[1]
     pkg = tmp_path / "src/netrepro/papers/intermittent"
@@ -328,7 +328,7 @@ def test_solves_are_counted_capped_and_a_step_that_decides_nothing_stops(monkeyp
     from netrepro.engines import cvx
     from netrepro.engines.certify import CertifiedLMI
     from netrepro.errors import LMIError
-    from netrepro.runner import _refuse_undecided_step
+    from netrepro.pipeline.runner import _refuse_undecided_step
 
     cp = cvx.cp
     monkeypatch.setattr(cvx, "_STATUSES", __import__("collections").Counter())
@@ -354,7 +354,7 @@ def test_solves_are_counted_capped_and_a_step_that_decides_nothing_stops(monkeyp
 
 
 def test_a_statement_may_print_any_evidence_quantity_but_only_an_existing_one(tmp_path):
-    from netrepro.paperdata import PaperData, load_findings
+    from netrepro.judging.paperdata import PaperData, load_findings
 
     f1 = load_findings(write_paper(tmp_path, findings=[("by a factor of about 3", "by a factor of {gain:.1f}")])
                        / "findings.yaml")[0]
@@ -369,7 +369,7 @@ def test_a_statement_may_print_any_evidence_quantity_but_only_an_existing_one(tm
 
 def test_the_skeletons_example_finding_may_be_replaced(tmp_path):
     """The example finding new-paper registers is a placeholder: replacing it is no deletion."""
-    from netrepro.paperdata import SKELETON_COMMIT
+    from netrepro.judging.paperdata import SKELETON_COMMIT
 
     root = write_paper(tmp_path)
     lock = (root / "findings.lock").read_text().replace('commit: "fixture"', f'commit: "{SKELETON_COMMIT}"')

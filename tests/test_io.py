@@ -1,4 +1,4 @@
-"""Atomic outputs (netrepro.io): the mode of what the atomic writer creates (issue 41, item 3)."""
+"""Atomic outputs (netrepro.pipeline.io): the mode of what the atomic writer creates (issue 41, item 3)."""
 
 import os
 import stat
@@ -6,7 +6,7 @@ import stat
 import pandas as pd
 import pytest
 
-from netrepro.io import atomic_path, current_umask, new_file_mode, write_json, write_table
+from netrepro.pipeline.io import atomic_path, current_umask, new_file_mode, write_json, write_table
 
 
 @pytest.fixture
@@ -54,7 +54,7 @@ def test_a_figure_saved_under_umask_022_is_0644(umask, tmp_path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from netrepro.plotting import save_figure
+    from netrepro.figures.plotting import save_figure
 
     umask(0o022)
     fig, ax = plt.subplots()

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from netrepro.errors import InputError
-from netrepro.scaffold import plan_new_paper
+from netrepro.scaffold.skeleton import plan_new_paper
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -60,7 +60,8 @@ def test_the_plan_creates_every_role_and_registers_the_paper(tmp_path):
 
 def test_a_source_outside_the_shared_papers_folder_is_warned_about(tmp_path, monkeypatch, capsys):
     """The registry records only the source's file name, looked up in ../shared/papers/: elsewhere it dangles."""
-    from netrepro import commands, scaffold
+    from netrepro.cli import main as commands
+    from netrepro.scaffold import skeleton as scaffold
 
     root = tmp_path / "checkout"
     shared = tmp_path / "shared/papers"

@@ -70,4 +70,4 @@ def test_the_check_finds_a_timed_assert_and_leaves_a_hang_guard():
 def test_no_test_asserts_on_the_wall_clock(path):
     lines = timed_asserts(path.read_text())
     assert not lines, (f"{path.relative_to(TESTS)} asserts on the wall clock at line(s) {lines}: "
-                       "measure speed with a benchmark (src/netrepro/bench.py) instead")
+                       "measure speed with a benchmark (src/netrepro/scale/bench.py) instead")

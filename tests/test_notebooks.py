@@ -25,7 +25,7 @@ def _notebook(path, source):
 def test_a_notebook_that_sleeps_is_stopped_by_the_timeout(tmp_path):
     notebook = _notebook(tmp_path / "sleeps.ipynb", "import time\ntime.sleep(120)")
     # the subprocess timeout (100 s, below the cell's 120 s sleep) fails the test if the notebook is waited out
-    proc = subprocess.run([sys.executable, "-m", "netrepro.report", "notebook", "--slug", "x", "--notebook",
+    proc = subprocess.run([sys.executable, "-m", "netrepro", "report", "notebook", "--slug", "x", "--notebook",
                            str(notebook), "--html", str(tmp_path / "x.html"), "--timeout", "1"],
                           cwd=tmp_path, capture_output=True, text=True, timeout=100)
     assert proc.returncode == 1

@@ -1,4 +1,4 @@
-"""Loading and validating the four data files of a paper (netrepro.paperdata; issues 15, 27, 29)."""
+"""Loading and validating the four data files of a paper (netrepro.judging.paperdata; issues 15, 27, 29)."""
 
 from dataclasses import replace
 from pathlib import Path
@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from netrepro.errors import ConfigError
-from netrepro.paperdata import CAUSAL_WORDING, FindingEntry, load_claims, load_errata, load_findings, load_paper_data
+from netrepro.judging.paperdata import CAUSAL_WORDING, FindingEntry, load_claims, load_errata, load_findings, load_paper_data
 
 GOOD = """
 - id: C1
@@ -145,7 +145,7 @@ def registry_text(findings_yaml: str) -> str:
     """A findings.lock registering the rules of ``findings_yaml`` as written."""
     import yaml
 
-    from netrepro.paperdata import registered_fields, rule_hash
+    from netrepro.judging.paperdata import registered_fields, rule_hash
 
     return "".join(f'{e["id"]}: {{rule: "{rule_hash(registered_fields(e))}", registered: "2026-12-02", '
                    f'commit: "fixture"}}\n' for e in yaml.safe_load(findings_yaml))

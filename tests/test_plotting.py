@@ -1,13 +1,13 @@
-"""The plotting helpers (netrepro.plotting) and the figure data sidecar (netrepro.figuredata)."""
+"""The plotting helpers (netrepro.figures.plotting) and the figure data sidecar (netrepro.figures.data)."""
 
 import hashlib
 import json
 
 import numpy as np
 
-from netrepro.figurecheck import compare_figure_data
-from netrepro.figuredata import describe_figure
-from netrepro.plotting import new_figure, save_figure
+from netrepro.figures.check import compare_figure_data
+from netrepro.figures.data import describe_figure
+from netrepro.figures.plotting import new_figure, save_figure
 
 
 def _draw(path):

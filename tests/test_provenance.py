@@ -4,7 +4,7 @@ import subprocess
 
 import pytest
 
-from netrepro.provenance import git_state
+from netrepro.pipeline.provenance import git_state
 
 
 def _git(repo, *args):

@@ -1,7 +1,7 @@
 """The difference page of the figure check, as a person sees it: opened in headless Chromium (issue 26).
 
 A real planted edit (the exact E||P_k|| curve of markov fig3 doubled, in a scratch copy of the
-paper's ``figures.py``) and a changed table cell; ``python -m netrepro.regression compare`` fails
+paper's ``figures.py``) and a changed table cell; ``python -m netrepro regression compare`` fails
 and writes ``index.html``, served from its folder alone. Every image loads (reference, new and
 pixel difference per figure), the data differences and the table's differing cell are shown, and
 the page makes no request outside its folder and logs no error.
@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro.figurecheck import figure_jobs, open_baseline, regenerate_figures
+from netrepro.figures.check import figure_jobs, open_baseline, regenerate_figures
 
 from .test_figure_check import EDITS, _edited
 from .test_report_browser import browser, console_errors, load, serve  # noqa: F401 (fixture)
@@ -44,7 +44,7 @@ def page(tmp_path_factory):
     frame.loc[0, column] = frame.loc[0, column] * 1.5 + 1.0
     frame.to_csv(table, index=False)
     html = tmp / "regeneration" / "index.html"
-    proc = subprocess.run([sys.executable, "-m", "netrepro.regression", "compare", "--reference", "tests/reference",
+    proc = subprocess.run([sys.executable, "-m", "netrepro", "regression", "compare", "--reference", "tests/reference",
                            "--results", str(results), "--figures", str(figures), "--html", str(html)],
                           cwd=ROOT, capture_output=True, text=True)
     assert proc.returncode == 1, proc.stdout + proc.stderr

@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from netrepro.errors import ConfigError
-from netrepro.registry import load_registry, paper_slugs, schema_mismatches, valid_slug
+from netrepro.pipeline.registry import load_registry, paper_slugs, schema_mismatches, valid_slug
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -70,7 +70,7 @@ def test_a_broken_registry_is_refused_naming_the_problem(tmp_path, text, message
 def test_every_identifier_names_its_source_and_check_date_and_papers_without_say_why():
     import datetime as dt
 
-    from netrepro.registry import IDENTIFIER_TYPES, identifier_problems
+    from netrepro.pipeline.registry import IDENTIFIER_TYPES, identifier_problems
 
     for slug, entry in load_registry().items():
         assert identifier_problems(entry) == [], slug

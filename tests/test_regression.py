@@ -1,6 +1,6 @@
 import pandas as pd
 
-from netrepro.regression import compare_tables, compare_trees
+from netrepro.judging.regression import compare_tables, compare_trees
 
 
 def test_identical_tables_agree_and_changes_are_caught(tmp_path):
@@ -72,7 +72,7 @@ def test_platform_rules_weaken_only_the_rows_and_columns_they_name(tmp_path):
 def test_malformed_platform_rules_are_named(tmp_path):
     import pytest
 
-    from netrepro.regression import load_platform_rules
+    from netrepro.judging.regression import load_platform_rules
 
     path = tmp_path / "rules.yaml"
     path.write_text("- {table: p/t.csv, columns: [x], check: loose, reason: r}\n")
@@ -89,7 +89,7 @@ def test_malformed_platform_rules_are_named(tmp_path):
 def test_committed_platform_rules_name_existing_reference_columns_with_a_reason():
     from pathlib import Path
 
-    from netrepro.regression import PLATFORM_RULES, load_platform_rules
+    from netrepro.judging.regression import PLATFORM_RULES, load_platform_rules
 
     reference = Path(__file__).parent / "reference"
     rules = load_platform_rules(PLATFORM_RULES)
@@ -103,7 +103,7 @@ def test_committed_platform_rules_name_existing_reference_columns_with_a_reason(
 
 def test_a_result_table_without_a_reference_fails_naming_it(tmp_path):
     """Issue 30: a new table is never silently skipped (timings and shards have no reference)."""
-    from netrepro.regression import main
+    from netrepro.cli.regression import main
 
     ref, got = _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
     for extra in ("p/new.csv", "benchmarks.csv", "p/shards/s0.csv"):
@@ -117,7 +117,7 @@ def test_a_result_table_without_a_reference_fails_naming_it(tmp_path):
 
 
 def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
-    from netrepro.regression import main
+    from netrepro.cli.regression import main
 
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.5]}))
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}), name="p/same.csv")
@@ -133,7 +133,7 @@ def test_update_writes_the_references_and_prints_what_changed(tmp_path, capsys):
 
 
 def test_recorded_paper_scale_run_is_neither_compared_nor_removed_by_update(tmp_path, capsys):
-    from netrepro.regression import main
+    from netrepro.cli.regression import main
 
     _pair(tmp_path, pd.DataFrame({"x": [1.0]}), pd.DataFrame({"x": [1.0]}))
     recorded = tmp_path / "ref" / "paper-scale" / "claims" / "p.csv"
@@ -151,7 +151,7 @@ def test_recorded_paper_scale_run_is_neither_compared_nor_removed_by_update(tmp_
     assert (count, problems) == (1, [])
 
 def test_clearing_an_old_difference_page_touches_nothing_else(tmp_path):
-    from netrepro.figurecheck import clear_difference_page
+    from netrepro.figures.check import clear_difference_page
 
     keep = [tmp_path / "README.md", tmp_path / "figure.png", tmp_path / "sub" / "x_result.png"]
     gone = [tmp_path / "index.html", tmp_path / "markov_fig2_reference.png", tmp_path / "markov_fig2_result.png",
@@ -165,7 +165,7 @@ def test_clearing_an_old_difference_page_touches_nothing_else(tmp_path):
 
 def test_compare_with_no_page_deletes_nothing_in_the_working_directory(tmp_path, monkeypatch):
     # `--html ''` once made compare remove Path('').parent, the working directory, with everything in it
-    from netrepro.regression import main
+    from netrepro.cli.regression import main
 
     (tmp_path / "ref").mkdir()
     (tmp_path / "res").mkdir()
@@ -189,7 +189,8 @@ def _two_papers(root):
 
 def test_update_of_one_paper_leaves_every_other_reference_byte_identical(tmp_path, capsys):
     """Issue 40 A: `make update-references PAPER=a` touches a's tables (own and shared) only."""
-    from netrepro.regression import main, paper_of
+    from netrepro.cli.regression import main
+    from netrepro.judging.regression import paper_of
 
     ref, res = _two_papers(tmp_path)
     (res / "a" / "new.csv").write_text("x\n3\n")
@@ -217,7 +218,7 @@ def test_update_of_one_paper_leaves_every_other_reference_byte_identical(tmp_pat
 
 def test_a_timing_column_difference_is_not_reported_and_not_copied(tmp_path):
     """Issue 40 A: measured times are no part of a reference (TIMING_COLUMNS, one list)."""
-    from netrepro.regression import is_timing_column, update_tables
+    from netrepro.judging.regression import is_timing_column, update_tables
 
     timings = ["wall_time_s", "solve_time_s", "total_time_s", "seconds", "solves_per_second", "elapsed",
                "elapsed_s", "build_seconds", "extrapolated_1000_s", "fit_exponent"]
@@ -238,7 +239,7 @@ def test_a_timing_column_difference_is_not_reported_and_not_copied(tmp_path):
 def test_no_committed_reference_has_a_timing_column():
     from pathlib import Path
 
-    from netrepro.regression import _reference_tables, is_timing_column
+    from netrepro.judging.regression import _reference_tables, is_timing_column
 
     reference = Path(__file__).parent / "reference"
     found = [(t.relative_to(reference).as_posix(), c) for t in _reference_tables(reference)

@@ -13,13 +13,13 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro.crate import PROFILES, data_id
-from netrepro.io import sha256_file
-from netrepro.registry import load_registry
+from netrepro.release.crate import PROFILES, data_id
+from netrepro.pipeline.io import sha256_file
+from netrepro.pipeline.registry import load_registry
 
 PAPERS = load_registry()
-from netrepro.readme import END, START
-from netrepro.verdicts import TESTABLE_VERDICTS, VERDICTS
+from netrepro.release.readme import END, START
+from netrepro.judging.verdicts import TESTABLE_VERDICTS, VERDICTS
 
 from .conftest import run_snakemake
 
@@ -125,7 +125,7 @@ def test_report_cites_the_originals(built_repo):
 def test_readme_results_table_from_the_claims(built_repo, tmp_path):
     readme = tmp_path / "README.md"
     readme.write_text(f"intro\n{START}\nold\n{END}\nrest\n")
-    subprocess.run([sys.executable, "-m", "netrepro.readme", str(readme), "--root", str(built_repo)], check=True,
+    subprocess.run([sys.executable, "-m", "netrepro", "readme", str(readme), "--root", str(built_repo)], check=True,
                    capture_output=True, text=True)
     text = readme.read_text()
     assert text.startswith("intro\n") and text.endswith(f"{END}\nrest\n") and "old" not in text
@@ -137,7 +137,7 @@ def test_readme_results_table_from_the_claims(built_repo, tmp_path):
         cells = [c.strip() for c in row.strip("|").split("|")]
         assert cells[2:4 + len(VERDICTS)] == [str(len(frame)), str(testable),
                                               *(str(int(counts.get(v, 0))) for v in VERDICTS)]
-    check = subprocess.run([sys.executable, "-m", "netrepro.readme", str(readme), "--root", str(built_repo),
+    check = subprocess.run([sys.executable, "-m", "netrepro", "readme", str(readme), "--root", str(built_repo),
                             "--check"], capture_output=True, text=True)
     assert check.returncode == 0
 

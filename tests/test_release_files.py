@@ -10,9 +10,9 @@ import pytest
 import yaml
 from packaging.requirements import Requirement
 
-from netrepro.lockfile import normalize, read_lock
-from netrepro.readme import END, START
-from netrepro.references import citation_cff, load_references
+from netrepro.release.lockfile import normalize, read_lock
+from netrepro.release.readme import END, START
+from netrepro.release.citations import citation_cff, load_references
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
@@ -100,14 +100,14 @@ def test_citation_cff_validates_against_the_cff_1_2_0_schema():
 
 def test_citation_cff_is_written_from_the_references():
     doc = yaml.safe_load((ROOT / "CITATION.cff").read_text())
-    assert doc == citation_cff(), "CITATION.cff is stale: run `python -m netrepro.references CITATION.cff`"
+    assert doc == citation_cff(), "CITATION.cff is stale: run `python -m netrepro citations CITATION.cff`"
     titles = {ref["title"] for ref in doc["references"]}
     for slug, ref in load_references().items():
         assert ref["title"] in titles, slug
 
 
 def test_every_paper_has_a_reference():
-    from netrepro.registry import load_registry
+    from netrepro.pipeline.registry import load_registry
 
     refs = load_references()
     for slug, meta in load_registry().items():
@@ -164,7 +164,7 @@ def test_notebook_cells_have_unique_ids(notebook):
 
 
 def test_references_print_one_full_stop_and_a_year_or_nd():
-    from netrepro.references import format_reference
+    from netrepro.release.citations import format_reference
 
     for slug, ref in load_references().items():
         text = format_reference(ref)
@@ -173,8 +173,8 @@ def test_references_print_one_full_stop_and_a_year_or_nd():
 
 
 def test_identifiers_flow_into_citation_cff_the_report_and_the_crate():
-    from netrepro.references import crate_citations, load_identifiers, references_html
-    from netrepro.registry import identifier_url
+    from netrepro.release.citations import crate_citations, load_identifiers, references_html
+    from netrepro.pipeline.registry import identifier_url
 
     doc = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert doc["date-released"]

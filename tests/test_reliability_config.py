@@ -1,6 +1,6 @@
 """Reliability (issue 8), part 1 and 7: bad configurations and missing dependencies are refused at start.
 
-Every bad configuration must raise :class:`netrepro.config.ConfigError` whose message names the
+Every bad configuration must raise :class:`netrepro.pipeline.config.ConfigError` whose message names the
 key, the value and what is expected. The explicit table below holds 40 distinct bad
 configurations; the property-based tests generate many more over the `intermittent` section and
 the top level. The whole-workflow counterpart (nothing under results/ changes when snakemake
@@ -19,8 +19,8 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from netrepro.config import ConfigError, DependencyError, check_dependencies, validate_config
-from netrepro.registry import paper_slugs
+from netrepro.pipeline.config import ConfigError, DependencyError, check_dependencies, validate_config
+from netrepro.pipeline.registry import paper_slugs
 
 ROOT = Path(__file__).resolve().parents[1]
 # 40 examples, or fewer under a lighter hypothesis profile (`make test-fast`)
@@ -312,7 +312,7 @@ def run_blocked(tmp_path, blocked, code):
 @pytest.mark.parametrize("blocked", [["cvxpy"], ["clarabel"], ["papermill"], ["numba"], ["cvxpy", "nbconvert"]])
 def test_blocked_import_gives_clear_message(tmp_path, blocked):
     proc = run_blocked(tmp_path, blocked, """
-        from netrepro.config import check_dependencies, DependencyError
+        from netrepro.pipeline.config import check_dependencies, DependencyError
         try:
             check_dependencies()
         except DependencyError as exc:
@@ -333,7 +333,7 @@ def test_a_crippled_solver_is_refused_at_start_up_with_the_reinstall_command(tmp
     (fake / "__init__.py").write_text("raise ImportError('libclarabel.so: cannot open shared object file')\n")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path / "site"), os.environ.get("PYTHONPATH", "")]))
     proc = subprocess.run([sys.executable, "-c", textwrap.dedent("""
-        from netrepro.config import check_dependencies, DependencyError
+        from netrepro.pipeline.config import check_dependencies, DependencyError
         try:
             check_dependencies()
         except DependencyError as exc:
@@ -346,7 +346,7 @@ def test_a_crippled_solver_is_refused_at_start_up_with_the_reinstall_command(tmp
 
 
 def test_the_solver_of_the_lmi_engine_is_imported_at_start_up():
-    from netrepro.config import IMPORTED_AT_START
+    from netrepro.pipeline.config import IMPORTED_AT_START
     from netrepro.engines.cvx import SOLVER
 
     assert SOLVER.lower() in IMPORTED_AT_START
@@ -359,7 +359,7 @@ def test_paper_needing_a_missing_package_is_not_reported_as_a_missing_paper(tmp_
     proc = run_blocked(tmp_path, ["pandas"], """
         import importlib.abc, importlib.util, sys
         import yaml
-        from netrepro.config import validate_config, DependencyError
+        from netrepro.pipeline.config import validate_config, DependencyError
 
         class NeedsPandas(importlib.abc.MetaPathFinder, importlib.abc.Loader):
             def find_spec(self, name, path, target=None):

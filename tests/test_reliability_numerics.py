@@ -20,13 +20,13 @@ from netrepro.engines import lmi as lmi_mod
 from netrepro.engines.channels import arrival_patterns, iid_arrivals
 from netrepro.engines.montecarlo import merge_block_sums, n_blocks, run_blocks, run_monte_carlo
 from netrepro.engines.riccati import Sensor, covariance_paths, iterate_expected_riccati
-from netrepro.io import atomic_path, write_table
+from netrepro.pipeline.io import atomic_path, write_table
 from netrepro.papers.intermittent import estimators as inter_est
 from netrepro.papers.intermittent import model as inter
 from netrepro.papers.intermittent import two_sensor as inter_two
-from netrepro.provenance import CorruptOutputError, sidecar_path, verify_output, verify_tree
-from netrepro.runner import main as runner_main
-from netrepro.runner import run_step, verify_main
+from netrepro.pipeline.provenance import CorruptOutputError, sidecar_path, verify_output, verify_tree
+from netrepro.pipeline.runner import main as runner_main
+from netrepro.pipeline.runner import run_step, verify_main
 
 ROOT = Path(__file__).resolve().parents[1]
 A, R1, R2, P0 = 1.5, 0.1, 0.5, 10.0
@@ -43,7 +43,7 @@ def table_step(params, inputs, outputs):
 KILLER = """
 import os, signal, sys
 sys.path.insert(0, {root!r})
-import netrepro.io, netrepro.runner
+import netrepro.pipeline.io, netrepro.pipeline.runner
 where = {where!r}
 if where == "before-rename":  # of the table (its sidecar's unfinished mark is renamed before)
     real = os.replace
@@ -51,12 +51,12 @@ if where == "before-rename":  # of the table (its sidecar's unfinished mark is r
         if str(dst).endswith("t.csv"):
             os.kill(os.getpid(), signal.SIGKILL)
         real(src, dst)
-    netrepro.io.os.replace = boom
+    netrepro.pipeline.io.os.replace = boom
 elif where == "before-sidecar":
     def boom(*a, **k):
         os.kill(os.getpid(), signal.SIGKILL)
-    netrepro.runner.write_sidecar = boom
-netrepro.runner.run_step("demo", "tests.test_reliability_numerics:table_step", {{"x": 5.0}}, {{}},
+    netrepro.pipeline.runner.write_sidecar = boom
+netrepro.pipeline.runner.run_step("demo", "tests.test_reliability_numerics:table_step", {{"x": 5.0}}, {{}},
                          {{"table": "results/t.csv"}})
 """
 

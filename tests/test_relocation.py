@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from netrepro import runner
-from netrepro.venv_paths import editable_pth_files, interpreter, relocate
+from netrepro.pipeline import runner
+from netrepro.pipeline.venv_paths import editable_pth_files, interpreter, relocate
 
 from .conftest import run_snakemake
 

@@ -9,7 +9,7 @@ import pandas as pd
 from netrepro.report.markup import relocate, strip_external_scripts
 from netrepro.report.panel import config_keys, rule_name
 from netrepro.report.sections import table_view
-from netrepro.summary import scorecard
+from netrepro.judging.summary import scorecard
 
 
 def test_scorecard_counts_and_total():
@@ -86,7 +86,7 @@ def test_source_pages_in_two_processes_equal_the_serial_pages():
     from netrepro.report.site import source_page, source_pages
 
     root = Path(__file__).resolve().parents[1]
-    rels = ["src/netrepro/io.py", "src/netrepro/errors.py", "src/netrepro/report/site.py", "src/netrepro/runner.py"]
+    rels = ["src/netrepro/pipeline/io.py", "src/netrepro/errors.py", "src/netrepro/report/site.py", "src/netrepro/pipeline/runner.py"]
     serial = [source_page(rel, (root / rel).read_text()) for rel in rels]
     assert source_pages(root, rels, workers=2) == serial
     assert source_pages(root, rels, workers=1) == serial

@@ -30,7 +30,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro.verdicts import VERDICTS  # every category of the vocabulary is a scorecard column
+from netrepro.judging.verdicts import VERDICTS  # every category of the vocabulary is a scorecard column
 
 from .conftest import run_snakemake
 
@@ -242,7 +242,7 @@ def test_every_figure_panel_names_an_existing_rule_and_function(built_report):
     """Each figure's provenance panel names a rule of the workflow and an importable source function."""
     import re
 
-    from netrepro.runner import resolve
+    from netrepro.pipeline.runner import resolve
 
     rules = set(snakemake(built_report, "--list-rules").stdout.split())
     # every paper's page, where its figures are (report/paper-<slug>.html)
@@ -280,7 +280,7 @@ def test_snakemakes_report_sealed_by_relocate_runs_in_chromium(built_report, bro
 
     out = built_report / "report" / "snakemake_report.html"
     snakemake(built_report, "--report", str(out.relative_to(built_report)), "report")
-    subprocess.run([sys.executable, "-m", "netrepro.report", "relocate", str(out.relative_to(built_report))],
+    subprocess.run([sys.executable, "-m", "netrepro", "report", "relocate", str(out.relative_to(built_report))],
                    cwd=built_report, check=True)
     assert out.read_text().count('http-equiv="Content-Security-Policy"') == 1
     with serve(out.parent) as base:

@@ -153,7 +153,7 @@ def test_snakemakes_report_sealed_by_relocate_runs_only_snakemakes_scripts(tmp_p
     (tmp_path / "report" / "cap.rst").write_text(BREAKOUT)
     for args in (["-j1", "all"], ["--report", "report.html"]):
         subprocess.run([sys.executable, "-m", "snakemake", *args], cwd=tmp_path, check=True, capture_output=True)
-    subprocess.run([sys.executable, "-m", "netrepro.report", "relocate", "report.html"], cwd=tmp_path, check=True)
+    subprocess.run([sys.executable, "-m", "netrepro", "report", "relocate", "report.html"], cwd=tmp_path, check=True)
     page = (tmp_path / "report.html").read_text()
     policies = LivePage(page).policies
     assert len(policies) == 1

@@ -7,8 +7,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro.provenance import CorruptOutputError, read_sidecar, verify_output
-from netrepro.runner import resolve, run_step
+from netrepro.pipeline.provenance import CorruptOutputError, read_sidecar, verify_output
+from netrepro.pipeline.runner import resolve, run_step
 
 
 def table_step(params, inputs, outputs):
@@ -39,7 +39,7 @@ def test_resolve_errors_name_the_problem():
     with pytest.raises(ValueError, match="module:function"):
         resolve("no_colon")
     with pytest.raises(ValueError, match="no function"):
-        resolve("netrepro.io:nope")
+        resolve("netrepro.pipeline.io:nope")
 
 
 def test_failing_step_leaves_no_output(tmp_path, monkeypatch):
@@ -94,6 +94,6 @@ def test_command_line_exit_keeps_outputs_logs_and_exit_code(tmp_path):
 
 def test_exit_process_flushes_buffered_output_and_keeps_the_code(tmp_path):
     # stdout is a pipe here, hence block-buffered: without the flush the text would be lost.
-    code = "import sys; from netrepro.runner import exit_process; sys.stdout.write('unflushed'); exit_process(3)"
+    code = "import sys; from netrepro.pipeline.runner import exit_process; sys.stdout.write('unflushed'); exit_process(3)"
     proc = _command_line([], tmp_path, code=code)
     assert proc.returncode == 3 and proc.stdout == "unflushed"

@@ -20,7 +20,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro.contract import check_paper
+from netrepro.judging.contract import check_paper
 
 from .conftest import run_snakemake
 
@@ -428,7 +428,7 @@ def untouched(built_repo, tmp_path_factory):
     assert "wrote CITATION.cff" in written and "wrote config/README.md" in written
     run_snakemake(work, "-j2", "report")
     # the copy is no git checkout, so the figures' committed references cannot be read here: tables only
-    run("netrepro.regression", "update", "--reference", "tests/reference", "--results", "results",
+    run("netrepro.judging.regression", "update", "--reference", "tests/reference", "--results", "results",
         "--paper", "skeleton_only", "--figures", "")
     return work, env
 
@@ -452,7 +452,7 @@ def test_the_untouched_skeleton_passes_make_check(untouched):
     assert verify.returncode == 0, verify.stdout[-3000:]
     # the test configuration's tables are not the committed references of the other papers: compare the new
     # paper's own folder, as `make check` does for every paper
-    compare = subprocess.run([sys.executable, "-m", "netrepro.regression", "compare", "--reference",
+    compare = subprocess.run([sys.executable, "-m", "netrepro", "regression", "compare", "--reference",
                               "tests/reference/skeleton_only", "--results", "results/skeleton_only",
                               "--figures", "", "--html", "", "--platform-rules", ""],
                              cwd=work, capture_output=True, text=True, env=env, check=False, timeout=300)

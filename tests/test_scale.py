@@ -6,7 +6,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from netrepro import scale
+from netrepro.scale import record as scale
 
 ROOT = Path(__file__).resolve().parents[1]
 CLAIM_COLS = ["paper", "claim_id", "reproduced_value", "verdict", "robust", "condition", "note"]
@@ -111,7 +111,7 @@ def test_record_writes_tables_and_provenance(tmp_path, two_runs):
     assert written["code"] == {"p": {"src/a.py": "h1"}} and written["commit"] == "abc"
     assert written["wall_time_s"] == 12.0 and written["shards"] == {"x": 5} and written == prov
     # the hash is of the merged science (the overlay applied key by key), not of the shard counts
-    from netrepro.provenance import params_hash
+    from netrepro.pipeline.provenance import params_hash
 
     assert written["config_hash"] == params_hash({"papers": ["p"], "p": {"n": 1, "m": {"k": 10}}})
     with pytest.raises(FileNotFoundError, match="no claims tables"):

@@ -1,4 +1,4 @@
-"""docs/scaling.md and its arithmetic (netrepro.scaling).
+"""docs/scaling.md and its arithmetic (netrepro.scale.projection).
 
 The projection is checked against a DAG small enough to schedule by hand; the per-rule table
 against sidecars written here; the committed page against a regeneration from the committed CSVs.
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from netrepro import scaling
+from netrepro.scale import projection as scaling
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,7 +12,7 @@ import re
 import pytest
 import yaml
 
-from netrepro.registry import paper_slugs
+from netrepro.pipeline.registry import paper_slugs
 
 from .conftest import run_snakemake
 

@@ -15,7 +15,7 @@ checks that
   partition, so a job without it would be refused); the sbatch calls are one per array plus one
   per plain job, fewer than the jobs; the run ends with no job left in the queue;
 * the tables equal those of a local run of ``config/test.yaml`` in another scratch copy
-  (``netrepro.regression.compare_tables``), although the Slurm run splits every sharded step into
+  (``netrepro.judging.regression.compare_tables``), although the Slurm run splits every sharded step into
   one shard more (each count of ``shards:`` + 1): results do not depend on the split.
 
 Needs root and the Debian packages munge, slurmctld, slurmd and slurm-client (CI installs
@@ -40,9 +40,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from netrepro.registry import paper_slugs
-from netrepro.regression import compare_tables
-from netrepro.stepspec import load_step_specs
+from netrepro.pipeline.registry import paper_slugs
+from netrepro.judging.regression import compare_tables
+from netrepro.pipeline.stepspec import load_step_specs
 from tests.conftest import copy_repo
 from tests.slurm.cluster import PARTITION, LocalSlurm, SlurmUnavailable, unavailable_reason
 from tests.slurm.measure import TARGETS, submissions

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from netrepro.stale import prune, stale_outputs
+from netrepro.pipeline.stale import prune, stale_outputs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -83,5 +83,5 @@ def test_make_check_reports_stale_outputs_and_make_prune_exists():
     out = subprocess.run(["make", "-n", "check", "prune", "BIN=bin", "STAMP="], cwd=ROOT, capture_output=True,
                          text=True, check=True).stdout
     assert "-m netrepro prune --check -- --profile workflow/profiles/default" in out
-    assert "-m netrepro.regression compare" in out and "-m netrepro verify" in out
+    assert "-m netrepro regression compare" in out and "-m netrepro verify" in out
     assert "-m netrepro prune  -- --profile" in out or "-m netrepro prune -- --profile" in out

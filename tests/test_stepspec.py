@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from netrepro.errors import ConfigError
-from netrepro.registry import paper_slugs
-from netrepro.stepspec import compose_config, config_keys, load_step_specs, step_list_path
+from netrepro.pipeline.registry import paper_slugs
+from netrepro.pipeline.stepspec import compose_config, config_keys, load_step_specs, step_list_path
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,8 +1,8 @@
-"""Scorecard and replication summaries (netrepro.summary): counted from tables, never typed."""
+"""Scorecard and replication summaries (netrepro.judging.summary): counted from tables, never typed."""
 
 import pandas as pd
 
-from netrepro.summary import replication_summary, scorecard, summary_sentences
+from netrepro.judging.summary import replication_summary, scorecard, summary_sentences
 
 
 def claims(*rows):

@@ -4,8 +4,8 @@ import pandas as pd
 import pytest
 
 from netrepro.errors import ConfigError
-from netrepro.paperdata import ClaimEntry, FindingEntry
-from netrepro.verdicts import FINDING_VERDICTS, VERDICTS, judge, lookup, split_variants, variant_key
+from netrepro.judging.paperdata import ClaimEntry, FindingEntry
+from netrepro.judging.verdicts import FINDING_VERDICTS, VERDICTS, judge, lookup, split_variants, variant_key
 
 
 def numeric(tol=0.05, relative=False, paper=0.4, erratum="", depends_on=("horizon",)):
@@ -124,8 +124,8 @@ import math  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 from netrepro.errors import InputError  # noqa: E402
-from netrepro.paperdata import load_paper_data  # noqa: E402
-from netrepro.verdicts import (  # noqa: E402
+from netrepro.judging.paperdata import load_paper_data  # noqa: E402
+from netrepro.judging.verdicts import (  # noqa: E402
     CLAIM_COLUMNS, FINDING_COLUMNS, claims_table, errata_table, evidence_frame, findings_table, reconstructions_table)
 
 from .test_paperdata import write_paper  # noqa: E402  (the synthetic paper's four data files)
@@ -248,7 +248,7 @@ def test_a_claim_that_depends_on_a_reconstruction_needs_variants_of_its_range(tm
 
 
 def test_the_step_writes_the_four_tables(tmp_path, monkeypatch):
-    from netrepro.verdicts import verdicts_step
+    from netrepro.judging.verdicts import verdicts_step
 
     root = write_paper(tmp_path)
     monkeypatch.chdir(tmp_path)
@@ -272,8 +272,8 @@ SLUGS = sorted(p.parent.name for p in Path(__file__).resolve().parents[1].glob("
 @pytest.mark.parametrize("slug", SLUGS)
 def test_every_claim_of_a_paper_points_to_a_quantity_a_step_produces(slug):
     """Each claim has a tolerance reason and resolves against the committed reference tables."""
-    from netrepro.paperdata import referenced_tables
-    from netrepro.verdicts import read_evidence
+    from netrepro.judging.paperdata import referenced_tables
+    from netrepro.judging.verdicts import read_evidence
 
     data = load_paper_data(slug)
     for entry in data.claims:
@@ -307,8 +307,8 @@ def test_a_long_condition_is_counted_not_spelled_out():
 @pytest.mark.parametrize("slug", SLUGS)
 def test_no_statement_or_printed_form_is_typed_in_python(slug):
     """The paper's side lives only in the data files: no statement or printed form is repeated in the code."""
-    from netrepro.io import load_yaml
-    from netrepro.paperdata import paper_dir
+    from netrepro.pipeline.io import load_yaml
+    from netrepro.judging.paperdata import paper_dir
 
     def entries(name):
         path = paper_dir(slug) / f"{name}.yaml"
@@ -326,7 +326,7 @@ def test_no_statement_or_printed_form_is_typed_in_python(slug):
 def test_integers_of_the_evidence_table_stay_integers(tmp_path):
     path = tmp_path / "evidence.csv"
     path.write_text("quantity,variant,value,note\nseed,nominal,20150101,\nx,nominal,2.5,\nflag,nominal,True,\n")
-    from netrepro.verdicts import read_evidence
+    from netrepro.judging.verdicts import read_evidence
 
     evidence = read_evidence(path)
     assert evidence["seed"]["nominal"][0] == 20150101 and isinstance(evidence["seed"]["nominal"][0], int)

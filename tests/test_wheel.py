@@ -20,7 +20,7 @@ import pytest
 import yaml
 
 from netrepro import locations
-from netrepro.registry import paper_slugs
+from netrepro.pipeline.registry import paper_slugs
 
 from .conftest import _ignore
 
@@ -85,9 +85,11 @@ CHECK = textwrap.dedent("""
     import yaml
 
     import netrepro
-    from netrepro import config, figurespec, locations, paperdata, registry, regression
+    from netrepro.pipeline import config, figurespec, registry
+    from netrepro import locations
+    from netrepro.judging import paperdata, regression
     from netrepro.report import markup
-    from netrepro.scaffold import TEMPLATES
+    from netrepro.scaffold.skeleton import TEMPLATES
 
     out = {"file": netrepro.__file__, "sys_path": sys.path, "checkout": str(locations.checkout_root()),
            "schema_dir": str(locations.SCHEMA_DIR), "platform_rules": regression.load_platform_rules(), "papers": {}}
@@ -172,3 +174,16 @@ def test_the_installed_wheel_loads_every_paper_without_the_checkout(wheel, tmp_p
     assert out["stylesheet"] > 0 and out["templates"]
     # the check ran on the real configuration
     assert set(yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["papers"]) <= set(out["papers"])
+    # the console script: installed beside the package, and the same command as python -m netrepro
+    assert (target / "bin" / "netrepro").is_file()
+    proc = subprocess.run([sys.executable, "-S", "-m", "netrepro", "--help"], cwd=elsewhere, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and "check-paper" in proc.stdout and "regression" in proc.stdout, proc.stderr
+
+
+@pytest.mark.slow
+def test_the_wheel_declares_the_netrepro_console_script(wheel):
+    archive = zipfile.ZipFile(wheel)
+    (entry_points,) = [n for n in archive.namelist() if n.endswith(".dist-info/entry_points.txt")]
+    text = archive.read(entry_points).decode()
+    assert "[console_scripts]" in text and "netrepro = netrepro.cli.main:console" in text, text

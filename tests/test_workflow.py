@@ -15,8 +15,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from netrepro.verdicts import VERDICTS
-from netrepro.registry import paper_slugs
+from netrepro.judging.verdicts import VERDICTS
+from netrepro.pipeline.registry import paper_slugs
 
 from .conftest import run_snakemake
 
@@ -66,7 +66,7 @@ def test_report_and_interface_tables(built):
 def test_every_output_has_the_mode_of_a_new_file(built):
     """Issue 41: every table, figure, sidecar and page is readable as the umask allows (0644 under
     umask 022), not 0600 as mkstemp creates it."""
-    from netrepro.io import current_umask, new_file_mode
+    from netrepro.pipeline.io import current_umask, new_file_mode
 
     expected = new_file_mode(current_umask())  # the build ran in this process's umask
     outputs = [p for folder in ("results", "figures", "report") for p in (built / folder).rglob("*") if p.is_file()]
@@ -111,7 +111,7 @@ def test_a_template_edit_reruns_only_the_report(built):
 def test_source_pages_are_made_ahead_of_the_report(built):
     # the report's source pages come from report_sources (it highlights once per change of the code or of
     # the source-page template, in parallel with the other jobs), not from the report itself
-    assert (built / "report/files/source/src/netrepro/runner.py.html").is_file()
+    assert (built / "report/files/source/src/netrepro/pipeline/runner.py.html").is_file()
     template = built / "src/netrepro/report/templates/source.html"
     original, stat = template.read_text(), template.stat()
     template.write_text(original + "\n")

@@ -3,7 +3,7 @@
 The package holds all the mathematics of the pipeline. Shared engines live in
 :mod:`netrepro.engines` (loss channels, batched Riccati recursions, Monte Carlo,
 LMI helpers); each paper has one module in :mod:`netrepro.papers`. The
-Snakemake rules call into the package through :mod:`netrepro.runner`.
+Snakemake rules call into the package through :mod:`netrepro.pipeline.runner`.
 """
 
 __all__ = ["__version__"]

@@ -1,27 +1,11 @@
-"""``python -m netrepro``: the pipeline runner's command line (:func:`netrepro.runner.main`), and the
-commands for people (:mod:`netrepro.commands`: new-paper, check-paper, register-findings, diff, scale-record, scaling),
-the build driver behind ``make report``/``repair``/``unlock`` (:mod:`netrepro.build`), and ``prune``
-(:mod:`netrepro.stale`: the outputs no rule produces any more, ``make prune``)."""
+"""``python -m netrepro VERB``: the ``netrepro`` console script (:func:`netrepro.cli.main.console`).
 
-import sys
+Every verb imports its own module when it runs: ``python -m netrepro run`` (each pipeline job) imports
+the runner alone, the build driver (``build``, ``repair``, ``unlock``) and ``prune`` nothing of the pipeline.
+"""
+
+from .cli.main import console
 
 __all__: list[str] = []
 
-if sys.argv[1:2] and sys.argv[1] in ("build", "repair", "unlock"):
-    # the build driver (netrepro.build) imports nothing of the pipeline: it starts before Snakemake
-    from .build import main as build_main
-
-    sys.exit(build_main(sys.argv[1:]))
-if sys.argv[1:2] == ["prune"]:
-    # like the build driver, it runs Snakemake and imports nothing of the pipeline
-    from .stale import main as prune_main
-
-    sys.exit(prune_main(sys.argv[1:]))
-
-from .runner import exit_process, main  # noqa: E402 - after the build driver's early exit
-
-if sys.argv[1:2] and sys.argv[1] in ("new-paper", "check-paper", "register-findings", "diff", "scale-record", "scaling"):
-    from .commands import main as commands_main
-
-    exit_process(commands_main(sys.argv[1:]))
-exit_process(main())
+console()

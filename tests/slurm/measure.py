@@ -153,7 +153,7 @@ def measure_once(cluster, mode: str, repeat: int, timeout: float, shards: dict |
     """One cold run of :data:`TARGETS` through the Slurm profile in a fresh scratch copy."""
     import yaml
 
-    from netrepro.scaling import job_times
+    from netrepro.scale.projection import job_times
     from tests.conftest import copy_repo
     from tests.slurm.cluster import PARTITION
 

@@ -9,7 +9,7 @@ each job's rule, wildcards, inputs and outputs), takes each job's time from one 
 * ``--results DIR``: the provenance sidecars (``<output>.meta.json``, ``wall_time_s``) of a
   run, plus ``--overhead`` seconds per job for the start-up a sidecar does not see,
 
-and list-schedules the DAG (longest remaining path first; :func:`netrepro.scaling.schedule`) on
+and list-schedules the DAG (longest remaining path first; :func:`netrepro.scale.projection.schedule`) on
 N nodes with ``--cores`` job slots each. ``python -m netrepro scaling`` does the same from committed
 tables for ``docs/scaling.md``. Prints the job count, the summed job time, the critical path and the makespan
 per N. Jobs without a measured time get ``--default`` seconds (plus the overhead).
@@ -25,7 +25,7 @@ import re
 import sys
 from pathlib import Path
 
-from netrepro.scaling import parse_dry_run, schedule  # the one implementation (tested in tests/test_scaling.py)
+from netrepro.scale.projection import parse_dry_run, schedule  # the one implementation (tested in tests/test_scaling.py)
 
 __all__ = ["parse_dry_run", "schedule", "main"]
 

@@ -9,20 +9,20 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 try:
-    from netrepro.codedeps import code_inputs
-    from netrepro.config import (
+    from netrepro.pipeline.codedeps import code_inputs
+    from netrepro.pipeline.config import (
         check_dependencies,
         coerce_shard_counts,
         shard_count,
         validate_config,
     )
     from netrepro.errors import NetreproError
-    from netrepro.figurespec import load_figure_specs
-    from netrepro.stepspec import compose_config, load_step_specs
-    from netrepro.registry import paper_slugs
-    from netrepro.venv_paths import interpreter
-    from netrepro.processes import STARTER_VARIABLE, starter_mark
-    from netrepro.paperdata import (
+    from netrepro.pipeline.figurespec import load_figure_specs
+    from netrepro.pipeline.stepspec import compose_config, load_step_specs
+    from netrepro.pipeline.registry import paper_slugs
+    from netrepro.pipeline.venv_paths import interpreter
+    from netrepro.pipeline.processes import STARTER_VARIABLE, starter_mark
+    from netrepro.judging.paperdata import (
         DATA_FILES,
         LOCK_FILE,
         load_paper_data,
@@ -48,7 +48,7 @@ try:
 except NetreproError as exc:
     raise WorkflowError(str(exc)) from None
 
-# every job knows the Snakemake that started it (netrepro.processes): one whose Snakemake is gone stops
+# every job knows the Snakemake that started it (netrepro.pipeline.processes): one whose Snakemake is gone stops
 # without writing; an environment variable, not a command-line argument, so no command changes
 os.environ[STARTER_VARIABLE] = starter_mark()
 
@@ -126,7 +126,7 @@ def notebook(slug="{params.slug}"):
     """
     return (
         f"{PYTHON} -m netrepro verify --inputs {{input}} > {{log}} 2>&1 && "
-        f"{PYTHON} -m netrepro.report notebook --slug {slug} "
+        f"{PYTHON} -m netrepro report notebook --slug {slug} "
         "--notebook {input.notebook} --html {output.html} >> {log} 2>&1"
     )
 

@@ -19,7 +19,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
                     caption=f"../report/{_slug}/{_spec.figure_id}.rst",
                     category=_slug,
                 ),
-                # what the figure draws (netrepro.plotting.save_figure), compared by `make check`
+                # what the figure draws (netrepro.figures.plotting.save_figure), compared by `make check`
                 data=f"figures/{_slug}/{_spec.figure_id}.data.json",
             log:
                 f"logs/{_slug}/{_spec.figure_id}.log",

@@ -1,11 +1,11 @@
 # The combined report: report/index.html from every paper's claims, errata, figures and sidecars,
 # plus report/files/ (copies of every table and figure with their sidecars, the workflow and its
 # configuration, browsable source files), so that report/ works offline as static files, and
-# report/ro-crate-metadata.json, the Workflow Run Crate of the run (netrepro.crate). `snakemake --report` uses the description below.
+# report/ro-crate-metadata.json, the Workflow Run Crate of the run (netrepro.release.crate). `snakemake --report` uses the description below.
 import os
 import platform
 
-from netrepro.provenance import params_hash
+from netrepro.pipeline.provenance import params_hash
 
 
 report: "../report/workflow.rst"
@@ -13,7 +13,7 @@ report: "../report/workflow.rst"
 
 rule scale_verdicts:
     input:
-        code=code("netrepro.scale:scale_step"),
+        code=code("netrepro.scale.record:scale_step"),
         claims=[spec["claims"] for spec in PAPER_OUTPUTS.values()],
         findings=[spec["findings"] for spec in PAPER_OUTPUTS.values()],
         provenance=f"{SCALE_REFERENCE}/provenance.json",
@@ -33,7 +33,7 @@ rule scale_verdicts:
         rule="scale_verdicts",
         io=io_json,
     shell:
-        step("netrepro.scale:scale_step")
+        step("netrepro.scale.record:scale_step")
 
 
 # The report's source pages (report/files/source/), highlighted ahead of the report, which did this last

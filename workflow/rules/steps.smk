@@ -1,5 +1,5 @@
 # Generated rules: one per compute step of each paper's step list
-# (src/netrepro/papers/<slug>/steps.yaml, read by netrepro.stepspec), a `<rule>_shard` rule per
+# (src/netrepro/papers/<slug>/steps.yaml, read by netrepro.pipeline.stepspec), a `<rule>_shard` rule per
 # sharded step, and the paper's result tables (PAPER_TABLES). Every paper of the registry gets its
 # rules (the figures and the report pick the enabled ones); PAPER_TABLES lists the enabled papers.
 

@@ -11,7 +11,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             f"{_slug}_claims"
         input:
             **paper_data_files(_slug),
-            code=code("netrepro.verdicts:verdicts_step"),
+            code=code("netrepro.judging.verdicts:verdicts_step"),
             evidence=getattr(rules, f"{_slug}_evidence").output.table,
             tables=paper_claim_tables(_slug),
         output:
@@ -29,7 +29,7 @@ for _slug in [s for s in config["papers"] if s in PAPER_TABLES]:
             mem_mb=500,
             runtime=1,
         params:
-            func="netrepro.verdicts:verdicts_step",
+            func="netrepro.judging.verdicts:verdicts_step",
             cfg=as_json({"slug": _slug}),
             rule=f"{_slug}_claims",
             io=io_json,

@@ -268,7 +268,7 @@ def save_sums(path, named: dict) -> None:
     named : dict
         Name -> :class:`MonteCarloSums` (names and keys must not contain ``|``).
     """
-    from ..io import atomic_path
+    from ..pipeline.io import atomic_path
 
     arrays = {}
     for name, res in named.items():

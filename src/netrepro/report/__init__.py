@@ -7,7 +7,7 @@
 * :mod:`.sections`: scorecard, paper sections, claims, figures.
 * :mod:`.panel`: the provenance panel of a figure.
 * :mod:`.build`: the report rule's step (:func:`build_index`), with the RO-Crate.
-* :mod:`.cli`: ``python -m netrepro.report``.
+* :mod:`.cli`: ``python -m netrepro report``.
 """
 
 __all__: list[str] = []

@@ -1,6 +1,6 @@
-"""``python -m netrepro.report`` (:func:`netrepro.report.cli.main`)."""
+"""``python -m netrepro report`` (:func:`netrepro.report.cli.main`)."""
 
-from ..runner import exit_process
+from ..pipeline.runner import exit_process
 from .cli import main
 
 __all__: list[str] = []

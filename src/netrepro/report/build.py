@@ -1,6 +1,6 @@
 """The report rule's step: ``report/index.html`` (summary, scorecard, claims explorer), one page per
 paper (``report/paper-<slug>.html``), the copies under ``report/files/`` and the Workflow Run Crate
-``report/ro-crate-metadata.json`` (written by :mod:`netrepro.crate`)."""
+``report/ro-crate-metadata.json`` (written by :mod:`netrepro.release.crate`)."""
 
 from __future__ import annotations
 
@@ -12,14 +12,14 @@ from pathlib import Path
 import pandas as pd
 from markupsafe import Markup
 
-from ..crate import iso, write_crate
+from ..release.crate import iso, write_crate
 from ..errors import ConfigError
-from ..figurespec import load_figure_specs
-from ..io import atomic_path
-from ..provenance import git_state, package_versions
-from ..references import crate_citations, references_html
-from ..registry import load_registry
-from ..summary import scorecard
+from ..pipeline.figurespec import load_figure_specs
+from ..pipeline.io import atomic_path
+from ..pipeline.provenance import git_state, package_versions
+from ..release.citations import crate_citations, references_html
+from ..pipeline.registry import load_registry
+from ..judging.summary import scorecard
 from .csp import page_policy, policy_attribute
 from .markup import read_csv, relocate_json, render, script, stylesheet
 from .sections import table_view

@@ -1,4 +1,4 @@
-"""``python -m netrepro.report``: write a paper's default notebook, execute a notebook into
+"""``python -m netrepro report``: write a paper's default notebook, execute a notebook into
 ``report/<slug>.html``, or relocate pages (no path of this checkout; an HTML page is also sealed
 by a content security policy, :mod:`netrepro.report.csp`)."""
 
@@ -38,7 +38,7 @@ def relocate_page(page: str, root: str | Path) -> str:
 
 def main(argv=None) -> int:
     """Run the command line; returns the exit status (1 when a notebook fails or times out)."""
-    parser = argparse.ArgumentParser(prog="python -m netrepro.report")
+    parser = argparse.ArgumentParser(prog="python -m netrepro report")
     sub = parser.add_subparsers(dest="command", required=True)
     mk = sub.add_parser("make-notebook", help="write the default thin notebook of a paper")
     mk.add_argument("--slug", required=True)

@@ -8,7 +8,7 @@ is what the browser lets the page load and run whatever text ends up in it:
   (:data:`PAGE_POLICY`); a page that ships a script of its own (``report/index.html``'s claims
   explorer, ``templates/explorer.js``) allows that script alone, by its hash
   (:func:`page_policy`, :func:`script_hash`), never ``'unsafe-inline'``;
-* Snakemake's report (``report/snakemake_report.html``, sealed by ``python -m netrepro.report
+* Snakemake's report (``report/snakemake_report.html``, sealed by ``python -m netrepro report
   relocate``) is a JavaScript application: its policy (:func:`snakemake_report_policy`) allows
   exactly the scripts that Snakemake's installed template and libraries put there, and the data
   scripts that only assign JSON (``var results = {...};``); a script that came with a caption

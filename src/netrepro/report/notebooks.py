@@ -20,7 +20,7 @@ from pathlib import Path
 from markupsafe import Markup
 
 from ..errors import NetreproError
-from ..io import atomic_path
+from ..pipeline.io import atomic_path
 from .captions import caption_html
 from .csp import with_csp
 from .markup import relocate, strip_external_scripts
@@ -273,7 +273,7 @@ def page_notebook(nb, slug: str, title: str | None = None):
     if any("injected-parameters" in tags(c) for c in nb.cells):
         nb.cells = [c for c in nb.cells if "parameters" not in tags(c) or "injected-parameters" in tags(c)]
     if title is None:
-        from ..registry import load_registry
+        from ..pipeline.registry import load_registry
 
         title = load_registry().get(slug, {}).get("title") or slug
     nb.metadata["title"] = f"{slug}: {title} \u2014 notebook"

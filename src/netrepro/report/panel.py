@@ -13,7 +13,7 @@ import json
 import shlex
 from pathlib import Path
 
-from ..provenance import sidecar_path
+from ..pipeline.provenance import sidecar_path
 from .confine import confine_sidecar
 from .markup import fmt_value, render
 

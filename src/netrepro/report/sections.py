@@ -10,11 +10,11 @@ from pathlib import Path
 import pandas as pd
 from markupsafe import Markup
 
-from ..registry import load_registry
-from ..scale import NOT_RECORDED, NOT_RUN
-from ..provenance import sidecar_path
-from ..summary import FINDING_COUNT_COLUMNS, replication_summary, summary_sentences
-from ..verdicts import FINDING_VERDICTS, TESTABLE_VERDICTS, VERDICTS
+from ..pipeline.registry import load_registry
+from ..scale.record import NOT_RECORDED, NOT_RUN
+from ..pipeline.provenance import sidecar_path
+from ..judging.summary import FINDING_COUNT_COLUMNS, replication_summary, summary_sentences
+from ..judging.verdicts import FINDING_VERDICTS, TESTABLE_VERDICTS, VERDICTS
 from .markup import img, read_csv, render, rst_html
 from .notebooks import figure_captions, figure_sort_key
 from .panel import provenance_panel, rule_name
@@ -118,7 +118,7 @@ def claims_html(frame: pd.DataFrame, slug: str) -> str:
 
 
 def summary_html(slug: str, spec: dict, frame: pd.DataFrame | None) -> str:
-    """The replication summary that opens a paper's section (counted by :mod:`netrepro.summary`).
+    """The replication summary that opens a paper's section (counted by :mod:`netrepro.judging.summary`).
 
     Parameters
     ----------
@@ -335,7 +335,7 @@ def scorecard_html(score: pd.DataFrame, papers: dict, explore: bool = False, pag
     Parameters
     ----------
     score : pandas.DataFrame
-        :func:`netrepro.summary.scorecard` (its last row is the total).
+        :func:`netrepro.judging.summary.scorecard` (its last row is the total).
     papers : dict
         Slug -> registered outputs.
     explore : bool, default False
@@ -382,7 +382,7 @@ def scale_html(scale: dict) -> str:
     ----------
     scale : dict
         Paths from the report rule: ``table`` (``verdicts_by_scale.csv``), ``findings``,
-        ``stale`` (:func:`netrepro.scale.scale_step`) and ``reference`` (the recorded run's folder,
+        ``stale`` (:func:`netrepro.scale.record.scale_step`) and ``reference`` (the recorded run's folder,
         holding ``provenance.json``).
 
     Returns

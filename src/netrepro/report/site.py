@@ -11,7 +11,7 @@ from pathlib import Path
 
 from markupsafe import Markup
 
-from ..provenance import sidecar_path
+from ..pipeline.provenance import sidecar_path
 from .confine import confined
 from .markup import relocate_json, render
 from .panel import repo_relative

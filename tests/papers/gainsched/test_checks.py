@@ -6,7 +6,7 @@ import copy
 
 import pytest
 
-from netrepro.config import ConfigError
+from netrepro.pipeline.config import ConfigError
 from netrepro.papers.gainsched.checks import check_config
 
 

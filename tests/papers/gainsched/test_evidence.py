@@ -1,4 +1,4 @@
-"""Evidence of `gainsched` (issue 15): the helpers of :mod:`.verification` against independent computations, the data files."""
+"""Evidence of `gainsched` (issue 15): the helpers of :mod:`.analysis` against independent computations, the data files."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from netrepro.engines.certify import LMICoefficients
 from netrepro.papers.gainsched.design import FixedGainsVertexLMI, Theorem3, zero_diagonal_blocks
 from netrepro.papers.gainsched.evidence import feasible_flag
-from netrepro.papers.gainsched.verification import (
+from netrepro.papers.gainsched.analysis import (
     convergence_rate,
     missing_fraction,
     ms_stability_index,
@@ -16,7 +16,7 @@ from netrepro.papers.gainsched.verification import (
 )
 from netrepro.papers.gainsched.feasibility import with_sigma2
 from netrepro.papers.gainsched.model import Gains, sector_cases, theorem1_matrix, zero_gains
-from netrepro.paperdata import load_paper_data
+from netrepro.judging.paperdata import load_paper_data
 
 from .conftest import random_gains
 

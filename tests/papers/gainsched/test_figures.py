@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from netrepro.figurespec import load_figure_specs
+from netrepro.pipeline.figurespec import load_figure_specs
 from netrepro.papers.gainsched import figures
 
 DESIGNS = ["paper", "theorem3", "performance", "tuned_scheduled", "zero"]

@@ -10,7 +10,7 @@ from netrepro.papers.gainsched.design import Theorem3, certified_cost, guarantee
 from netrepro.papers.gainsched.feasibility import with_sigma2, worst_sector_gain
 from netrepro.papers.gainsched.model import augmented_initial_moment, p_schedule, zero_gains
 from netrepro.papers.gainsched.moments import error_mse, linear_gains, mode_matrices, second_moments
-from netrepro.papers.gainsched.verification import frozen_ms_radius, ms_stable_decision
+from netrepro.papers.gainsched.analysis import frozen_ms_radius, ms_stable_decision
 
 X0 = augmented_initial_moment(np.eye(2), 2)
 

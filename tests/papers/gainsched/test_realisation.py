@@ -8,7 +8,7 @@ import pytest
 from netrepro.papers.gainsched.model import GainschedError, augmented_initial_moment, p_schedule, realisation, zero_gains
 from netrepro.papers.gainsched.moments import error_mse, mode_matrices, second_moments
 from netrepro.papers.gainsched.tuning import best_exact_gains, exact_cost
-from netrepro.papers.gainsched.verification import eq15_residuals, gap_relative
+from netrepro.papers.gainsched.analysis import eq15_residuals, gap_relative
 
 from .conftest import random_gains
 
@@ -91,7 +91,7 @@ def test_eq15_residuals_signs(sys, t3):
 
 
 def test_relative_spread_and_rms_ratio():
-    from netrepro.papers.gainsched.verification import relative_spread, rms_ratio
+    from netrepro.papers.gainsched.analysis import relative_spread, rms_ratio
 
     assert relative_spread([3.6947, 12.419, 2.9671]) == pytest.approx(12.419 / 2.9671 - 1, rel=1e-15)
     assert relative_spread([2.0]) == 0.0

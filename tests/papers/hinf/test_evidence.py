@@ -11,8 +11,8 @@ import pytest
 from scipy import stats
 
 from netrepro.papers.hinf import evidence
-from netrepro.paperdata import load_paper_data
-from netrepro.verdicts import read_evidence, verdicts_step
+from netrepro.judging.paperdata import load_paper_data
+from netrepro.judging.verdicts import read_evidence, verdicts_step
 
 INPUTS = ("consensus", "attenuation", "checks", "summary", "paired", "errors", "trajectories", "per_run_static_fixed",
           "per_run_static_mobile", "connectivity", "sensitivity", "sensitivity_evasive", "paired_evasive", "per_agent",

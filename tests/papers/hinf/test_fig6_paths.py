@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from netrepro.config import validate_config
+from netrepro.pipeline.config import validate_config
 from netrepro.errors import ConfigError
 from netrepro.papers.hinf import evidence
 from netrepro.papers.hinf.motion import path_statistics

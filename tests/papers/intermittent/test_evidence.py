@@ -5,7 +5,7 @@ import pytest
 
 from netrepro.errors import InputError
 from netrepro.papers.intermittent import evidence
-from netrepro.paperdata import load_paper_data
+from netrepro.judging.paperdata import load_paper_data
 
 REFERENCE = Path(__file__).resolve().parents[2] / "reference"
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pandas as pd
 
-from netrepro.io import write_table
+from netrepro.pipeline.io import write_table
 from netrepro.papers.intermittent import figures
 
 

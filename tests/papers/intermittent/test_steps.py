@@ -3,7 +3,7 @@ import pandas as pd
 import pytest
 
 from netrepro.errors import InputError
-from netrepro.io import write_table
+from netrepro.pipeline.io import write_table
 from netrepro.papers.intermittent import steps
 
 A, R1, R2, P0 = 1.5, 0.1, 0.5, 10.0

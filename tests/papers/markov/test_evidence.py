@@ -11,9 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from netrepro.papers.markov import enumeration, evidence, exact, model, stability
-from netrepro.paperdata import load_paper_data
-from netrepro.verdicts import claims_table, errata_table, findings_table, read_evidence
+from netrepro.papers.markov import analysis as enumeration, evidence, exact, model, stability
+from netrepro.judging.paperdata import load_paper_data
+from netrepro.judging.verdicts import claims_table, errata_table, findings_table, read_evidence
 
 from .systems import EX1, EX2
 from .tables import PKG

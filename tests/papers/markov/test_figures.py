@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from netrepro.figurespec import load_figure_specs
+from netrepro.pipeline.figurespec import load_figure_specs
 from netrepro.papers.markov import figures
 
 

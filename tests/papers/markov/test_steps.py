@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from netrepro.errors import ModelError
-from netrepro.papers.markov import enumeration, lmis, steps
+from netrepro.papers.markov import analysis as enumeration, lmis, steps
 
 from .systems import EX2
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from netrepro.config import ConfigError
+from netrepro.pipeline.config import ConfigError
 from netrepro.papers.onebit import checks
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -39,7 +39,7 @@ def test_check_config_rejects_bad_sections(cfg):
 def test_config_sections_validate(name):
     import jsonschema
 
-    from netrepro.config import load_schemas
+    from netrepro.pipeline.config import load_schemas
 
     section = yaml.safe_load((ROOT / "config" / name).read_text())["onebit"]
     _, registry = load_schemas()
@@ -51,7 +51,7 @@ def test_config_sections_validate(name):
 def test_schema_requires_five_time_constants_before_the_window(cfg):
     import jsonschema
 
-    from netrepro.config import load_schemas
+    from netrepro.pipeline.config import load_schemas
 
     _, registry = load_schemas()
     schema = registry.get_or_retrieve("onebit.schema.yaml").value.contents

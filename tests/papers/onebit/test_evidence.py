@@ -11,8 +11,8 @@ import pytest
 import yaml
 
 from netrepro.papers.onebit import evidence, steps
-from netrepro.paperdata import load_paper_data
-from netrepro.verdicts import NOMINAL, read_evidence, verdicts_step
+from netrepro.judging.paperdata import load_paper_data
+from netrepro.judging.verdicts import NOMINAL, read_evidence, verdicts_step
 
 ROOT = Path(__file__).resolve().parents[3]
 

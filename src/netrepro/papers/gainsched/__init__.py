@@ -14,7 +14,7 @@ Modules
     Exact second moments for linear f.
 ``feasibility``
     Certified feasible / infeasible / undecided decisions, plant LMI, brackets.
-``verification``
+``analysis``
     Independent checks behind the evidence (stability indices, residuals of the errata).
 ``tuning``
     Gains of form (9) tuned by Monte Carlo or on the exact cost (yardsticks, not the paper's).

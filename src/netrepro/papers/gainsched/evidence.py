@@ -2,7 +2,7 @@
 findings of ``claims.yaml`` / ``errata.yaml`` / ``reconstructions.yaml`` / ``findings.yaml`` compare with.
 
 One step, :func:`evidence_step`, writes ``results/evidence/gainsched.csv`` (quantity, variant, value,
-note). Assembly only (issue 29): the mathematics is in :mod:`.verification`, :mod:`.feasibility`,
+note). Assembly only (issue 29): the mathematics is in :mod:`.analysis`, :mod:`.feasibility`,
 :mod:`.design` and :mod:`.model`; the paper's settings of a claim come from its ``at:`` field in
 ``claims.yaml``. Nothing here states what the paper says: statements, paper values, tolerances,
 printed and corrected forms and reasons are in the YAML files. Variants re-judge a claim or finding
@@ -17,13 +17,13 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ...io import read_table
-from ...paperdata import load_paper_data
-from ...verdicts import erratum_evidence, evidence_frame
+from ...pipeline.io import read_table
+from ...judging.paperdata import load_paper_data
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .feasibility import plant_vertex_radius, with_sigma2
 from .model import gains_from_dict, p_schedule, system_from_config
 from .steps import MATRICES, gains_from_table, load_solutions, p_sequence
-from .verification import (
+from .analysis import (
     convergence_rate,
     eq15_residuals,
     frozen_ms_radius,
@@ -101,7 +101,7 @@ def evidence_step(params, inputs, outputs):
     """Step of rule ``gainsched_evidence``: the evidence table of every claim, erratum, reconstruction, finding.
 
     Reads the design, stability, exact-moment, sensitivity, scheduling and vertex-LMI tables and the
-    claims' ``at:`` settings; recomputes only light quantities through :mod:`.verification`
+    claims' ``at:`` settings; recomputes only light quantities through :mod:`.analysis`
     (second-moment radii and growth rates across sigma^2, horizon and omega, residuals of the errata).
 
     Parameters
@@ -120,7 +120,7 @@ def evidence_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame}`` from :func:`netrepro.verdicts.evidence_frame`.
+        ``{"table": DataFrame}`` from :func:`netrepro.judging.verdicts.evidence_frame`.
     """
     ctx = _evidence_inputs(inputs, params)
     rows = []

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...io import read_table
-from ...plotting import COLOURS, OKABE_ITO
+from ...pipeline.io import read_table
+from ...figures.plotting import COLOURS, OKABE_ITO
 
 __all__ = ["figure_errors", "figure_mse", "figure_sensitivity"]
 
@@ -26,7 +26,7 @@ def figure_errors(params, inputs, outputs):
     """Figs 1-2: e_i(k) under Algorithm 1: one sample path (as the paper), the Monte Carlo mean with a band
     for the configured x0, and the Monte Carlo RMS error sqrt(E e_i(k)^2) for x(0) ~ N(0, I) (whose mean
     error is zero by symmetry); cut at ``k_max`` where the errors have decayed."""
-    from ...plotting import new_figure, save_figure
+    from ...figures.plotting import new_figure, save_figure
 
     comp = int(params["component"])
     kmax = int(params.get("k_max", 10 ** 9))
@@ -63,7 +63,7 @@ def figure_errors(params, inputs, outputs):
 
 def figure_mse(params, inputs, outputs):
     """Fig S1: exact E||e(k)||^2 per design (linear f, log scale) and sum_k E||e||^2, exact and Monte Carlo (sine f)."""
-    from ...plotting import new_figure, save_figure
+    from ...figures.plotting import new_figure, save_figure
 
     per_k = read_table(inputs["exact_mse"])
     exact = read_table(inputs["exact"])
@@ -110,7 +110,7 @@ def figure_sensitivity(params, inputs, outputs):
     brackets, sufficient (LMI) and necessary (worst linear gain of the class) ends, for the
     paper's class (3) and for componentwise sectors.
     """
-    from ...plotting import new_figure, save_figure
+    from ...figures.plotting import new_figure, save_figure
 
     sens = read_table(inputs["sensitivity"])
     limits = read_table(inputs["limits"]).set_index("design")

@@ -33,7 +33,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from ...io import read_table
+from ...pipeline.io import read_table
 from .model import (
     Gains,
     GainschedError,

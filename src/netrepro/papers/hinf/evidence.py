@@ -2,8 +2,8 @@
 
 The paper's side (statements, paper values, tolerances, printed and corrected forms, reasons) is in
 ``claims.yaml``, ``errata.yaml``, ``reconstructions.yaml`` and ``findings.yaml`` beside this module;
-the shared step :func:`netrepro.verdicts.verdicts_step` judges them against the table written here
-(``results/evidence/hinf.csv``, see :func:`netrepro.verdicts.evidence_frame`).
+the shared step :func:`netrepro.judging.verdicts.verdicts_step` judges them against the table written here
+(``results/evidence/hinf.csv``, see :func:`netrepro.judging.verdicts.evidence_frame`).
 
 Quantities (``variant`` ``nominal`` unless stated): the errata residuals ``E<n>.residual_printed``
 / ``.residual_corrected``; ``reconstruction.<key>`` (configured value, sweep summary); and the claim
@@ -24,8 +24,8 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...paperdata import load_claims, load_findings
-from ...verdicts import erratum_evidence, evidence_frame
+from ...judging.paperdata import load_claims, load_findings
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .analysis import (E9_RADII, ERRATA_POINT, covariance_sampling_scale, difference_correlation, disturbance_weight, errata_residuals,
                        information_at_positions, mean_gain_norms, order_violation, settles_first, sweet_spot_grid)
 from .filters import FilterDoesNotExist
@@ -967,7 +967,7 @@ def evidence_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame}``: the evidence rows (columns ``quantity, variant, value, note``,
-        :func:`netrepro.verdicts.evidence_frame`).
+        :func:`netrepro.judging.verdicts.evidence_frame`).
     """
     cfg = params
     z_sig = float(cfg["claims"]["z_significant"])

@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...plotting import OKABE_ITO, new_figure, palette, save_figure
+from ...figures.plotting import OKABE_ITO, new_figure, palette, save_figure
 
 __all__ = ["figure_noise", "figure_errors", "figure_fig2", "figure_network",
            "figure_hinf_vs_kalman", "figure_sensitivity", "figure_consensus", "figure_paired",

@@ -22,7 +22,7 @@ Modules
     Sample paths and tails of p_k: the loss-run probability (log-scaled repeated squaring of the
     substochastic run-length block, with two independent checks), the tail index of p_inf and the
     moment thresholds 1 - 1/a^{2n}, quantiles of a discrete law.
-``readings``
+``analysis``
     How the report's figures and words are read: settling and forgetting steps, the worst
     relative error, the one-step growth ratio.
 ``two_sensor``

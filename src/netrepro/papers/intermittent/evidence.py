@@ -16,14 +16,14 @@ import numpy as np
 
 from ...engines.riccati import Sensor, expected_riccati_map
 from ...errors import InputError
-from ...io import read_table
-from ...paperdata import load_claims
-from ...verdicts import erratum_evidence, evidence_frame
+from ...pipeline.io import read_table
+from ...judging.paperdata import load_claims
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .exact import exact_mean
 from .model import (condition_11_corrected, condition_11_printed, critical_probability, estimate_with_true_mean,
                     exact_mean_enumeration, lower_bound_sequence, mare_fixed_point, report_estimate_sequence,
                     riccati_step, sinopoli_operator, upper_bound_sequence)
-from .readings import forget_step, growth_ratio, settle_step, worst_relative_error
+from .analysis import forget_step, growth_ratio, settle_step, worst_relative_error
 from .tails import (loss_run_probability, loss_run_probability_dominant_root, loss_run_survival_log, losses_to_exceed,
                     moment_finite_threshold, tail_index)
 from .two_sensor import two_sensor_lower_bound, two_sensor_upper_bound
@@ -534,7 +534,7 @@ def evidence_step(params, inputs, outputs):
     Returns
     -------
     dict
-        ``{"table": DataFrame}`` from :func:`netrepro.verdicts.evidence_frame`.
+        ``{"table": DataFrame}`` from :func:`netrepro.judging.verdicts.evidence_frame`.
     """
     sc, ts, ev = params["scalar"], params["two_sensor"], params["evidence"]
     a, R1, R2 = sc["a"], sc["R1"], sc["R2"]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...io import read_table
-from ...plotting import OKABE_ITO, new_figure, save_figure
+from ...pipeline.io import read_table
+from ...figures.plotting import OKABE_ITO, new_figure, save_figure
 
 __all__ = ["figure_bounds", "figure_region", "figure_estimators", "figure_stationary"]
 

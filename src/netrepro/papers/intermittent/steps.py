@@ -39,7 +39,7 @@ from ...engines.channels import iid_arrivals
 from ...engines.montecarlo import load_sums, merge_block_sums, run_blocks, run_monte_carlo, save_sums, shard_blocks
 from ...engines.riccati import Sensor, covariance_paths
 from ...errors import InputError
-from ...io import read_table
+from ...pipeline.io import read_table
 from .estimators import conditional_mean_paths
 from .exact import exact_mean, stationary_mean
 from .model import (critical_probability, exact_mean_enumeration, lower_bound_limit, lower_bound_sequence,

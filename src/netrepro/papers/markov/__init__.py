@@ -6,7 +6,7 @@ Modules
 ``model``
     The equations: system, observability index (Definition 2), Proposition 1 (eq. 8), ``H(K)``
     (eq. 7), ``L_K`` (eq. 9), the Riccati maps (eqs. 4-5), closed forms of the examples.
-``enumeration``
+``analysis``
     Exact E||P_k|| by enumerating the channel's paths (Proposition 2's finite-k check).
 ``lmis``
     The LMI (10)-(11) of Theorem 2 (iv), Theorem 5's bisection (eq. 12), the i.i.d. LMI bound.

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ...config import require_matrix, require_pd
+from ...pipeline.config import require_matrix, require_pd
 from ...errors import ConfigError
 from .model import observability_index
 

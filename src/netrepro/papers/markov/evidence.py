@@ -2,7 +2,7 @@
 its claims, errata, reconstructions and findings (the YAML files beside this module) are judged on.
 
 Nothing here states a claim, a paper value or a tolerance, and nothing here is mathematics: the
-values come from the math modules (:mod:`.model`, :mod:`.enumeration`, :mod:`.certificates`,
+values come from the math modules (:mod:`.model`, :mod:`.analysis`, :mod:`.certificates`,
 :mod:`.stability`, :mod:`.lmis`) and the result tables; the paper's settings of a claim (its ``(p, q)``)
 come from the claim's ``at:`` field in ``claims.yaml`` / ``findings.yaml``.
 """
@@ -15,10 +15,10 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from ...paperdata import load_claims
-from ...verdicts import erratum_evidence, evidence_frame
+from ...judging.paperdata import load_claims
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .certificates import parity_growth, parity_structure, two_reception_bound
-from .enumeration import enumerate_norms, mean_norms_enumerated, monotonicity_violation
+from .analysis import enumerate_norms, mean_norms_enumerated, monotonicity_violation
 from .lmis import schur_residual
 from .model import (
     H_matrix, L_operator, LinearSystem, defective_unit_circle_eigenvalues, gilbert_elliott_stationary_loss, h_radius,

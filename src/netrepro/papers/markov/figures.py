@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ...plotting import COLOURS, OKABE_ITO, new_figure, save_figure
+from ...figures.plotting import COLOURS, OKABE_ITO, new_figure, save_figure
 
 __all__ = ["figure_plane", "figure_path", "figure_mean", "figure_estimators", "figure_curves"]
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ...config import require_matrix, require_pd
+from ...pipeline.config import require_matrix, require_pd
 from ...errors import ConfigError
 
 __all__ = ["check_config"]
@@ -11,7 +11,7 @@ __all__ = ["check_config"]
 def check_config(section: dict) -> None:
     """Checks the schema cannot express: grids, the vector model's shapes and definiteness.
 
-    Called by :func:`netrepro.config.validate_config` after the schema check. Checked: the SNR
+    Called by :func:`netrepro.pipeline.config.validate_config` after the schema check. Checked: the SNR
     grid's ``stop`` exceeds its ``start``; ``fig1_one_minus_alpha`` is one of ``one_minus_alpha``;
     ``convergence.n_steps`` and ``convergence.n_lag_steps`` have one entry per ``one_minus_alpha``;
     ``estimator.snr_db`` is strictly increasing; the optional ``estimator.crossing`` has strictly

@@ -1,7 +1,7 @@
 """Evidence of the `onebit` paper: our side of every claim, erratum, reconstruction and finding.
 
 Table ``results/evidence/onebit.csv`` (``quantity, variant, value, note``), read by the shared
-verdict step (:func:`netrepro.verdicts.verdicts_step`) together with the paper's side in
+verdict step (:func:`netrepro.judging.verdicts.verdicts_step`) together with the paper's side in
 ``claims.yaml``, ``errata.yaml``, ``reconstructions.yaml`` and ``findings.yaml`` beside this
 module. Assembly only: every value comes from the math modules (:mod:`.randomwalk`,
 :mod:`.model`, :mod:`.fisher`, :mod:`.estimators`) or the result tables. Every claim that
@@ -20,7 +20,7 @@ key of ``reconstructions.yaml`` (issue 27, convention 2):
 
 Settings of the evidence (which SNRs a note quotes, where an erratum is demonstrated) are the
 ``at:`` fields of ``claims.yaml``, ``findings.yaml`` and ``errata.yaml`` beside the input
-``findings_file``, by id (:meth:`netrepro.paperdata.PaperData.settings`). No statement, paper value
+``findings_file``, by id (:meth:`netrepro.judging.paperdata.PaperData.settings`). No statement, paper value
 or tolerance is held here; notes are computed.
 """
 
@@ -33,8 +33,8 @@ import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-from ...paperdata import load_paper_data
-from ...verdicts import erratum_evidence, evidence_frame
+from ...judging.paperdata import load_paper_data
+from ...judging.verdicts import erratum_evidence, evidence_frame
 from .estimators import binomial_coverage, paired_ratio_interval, pooled_se_ratio
 from .fisher import (
     ACHIEVABLE_LIMIT_SNR_MAX_DB,
@@ -160,13 +160,13 @@ def errata_rows(params) -> list:
     ----------
     params : dict
         The ``onebit`` configuration section with ``_at``: the settings of the claims, findings and
-        errata by id (:meth:`netrepro.paperdata.PaperData.settings`); E4 and E5 are demonstrated at
+        errata by id (:meth:`netrepro.judging.paperdata.PaperData.settings`); E4 and E5 are demonstrated at
         the settings of their ``at`` fields in ``errata.yaml``.
 
     Returns
     -------
     list of dict
-        Evidence rows (:func:`netrepro.verdicts.erratum_evidence`).
+        Evidence rows (:func:`netrepro.judging.verdicts.erratum_evidence`).
     """
     vc = vector_check(params["vector_check"])
     rows = []
@@ -771,7 +771,7 @@ def evidence_step(params, inputs, outputs):
     -------
     dict
         ``{"table": DataFrame}``: the evidence rows (columns ``quantity, variant, value, note``,
-        :func:`netrepro.verdicts.evidence_frame`) of every claim, erratum, reconstruction and finding.
+        :func:`netrepro.judging.verdicts.evidence_frame`) of every claim, erratum, reconstruction and finding.
     """
     at, claims = _paper_side(inputs.get("findings_file"))
     params = dict(params, _at=at, _claims=claims)

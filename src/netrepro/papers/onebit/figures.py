@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ...plotting import OKABE_ITO, new_figure, palette, save_figure
+from ...figures.plotting import OKABE_ITO, new_figure, palette, save_figure
 
 __all__ = ["figure_rho_sl", "figure_rho_s_f", "figure_estimator", "figure_convergence", "figure_lag",
            "figure_estimator_ratios"]

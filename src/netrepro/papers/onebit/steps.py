@@ -421,7 +421,7 @@ def estimator_shard_step(params, inputs, outputs):
         case (every grid case has the same) and ``estimator.seed``; no table.
     """
     from ...engines.montecarlo import block_rng, shard_blocks
-    from ...io import atomic_path
+    from ...pipeline.io import atomic_path
 
     est = params["estimator"]
     arrays, used = {}, {}

@@ -1,0 +1,3 @@
+"""Release: the RO-Crate, the README's results table, lock files, citations and the archive."""
+
+__all__: list[str] = []

@@ -1,0 +1,3 @@
+"""Scale: paper-scale runs against the default ones, cluster projections, benchmarks."""
+
+__all__: list[str] = []
