@@ -3,7 +3,7 @@ Kalman Filtering over Markovian Channels*. Pipeline steps.
 
 The mathematics lives in the math modules of this package (:mod:`.model`, :mod:`.lmis`,
 :mod:`.exact`, :mod:`.estimators`, :mod:`.stability`); this module holds the step functions called
-by ``workflow/rules/markov.smk`` (signature ``fn(params, inputs, outputs)``).
+by the rules generated from ``steps.yaml`` (signature ``fn(params, inputs, outputs)``).
 
 Tables (``results/markov/``)
 ----------------------------
