@@ -121,8 +121,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ...paperdata import load_paper_data
-from ...verdicts import evidence_frame
+from ...judging.paperdata import load_paper_data
+from ...judging.verdicts import evidence_frame
 from .model import critical_arrival_probability, mare_fixed_point
 
 __all__ = ["evidence_step"]
@@ -152,7 +152,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ...plotting import new_figure, save_figure
+from ...figures.plotting import new_figure, save_figure
 
 __all__ = ["figure_fixed_point"]
 
@@ -428,7 +428,7 @@ def untouched(built_repo, tmp_path_factory):
     assert "wrote CITATION.cff" in written and "wrote config/README.md" in written
     run_snakemake(work, "-j2", "report")
     # the copy is no git checkout, so the figures' committed references cannot be read here: tables only
-    run("netrepro.judging.regression", "update", "--reference", "tests/reference", "--results", "results",
+    run("netrepro", "regression", "update", "--reference", "tests/reference", "--results", "results",
         "--paper", "skeleton_only", "--figures", "")
     return work, env
 
