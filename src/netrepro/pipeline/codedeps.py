@@ -36,7 +36,7 @@ from pathlib import Path
 from ..locations import package_root
 
 __all__ = ["PACKAGE", "RUNNER_MODULE", "module_file", "imported_modules", "module_closure", "function_closure",
-           "code_inputs"]
+           "code_inputs", "top_level_names"]
 
 PACKAGE = "netrepro"
 # the module every step runs in (it also imports io and provenance): part of every rule's code
@@ -283,6 +283,27 @@ def _summary(module: str, src: Path) -> dict:
     except OSError:  # a read-only checkout: no cache
         pass
     return summary
+
+
+def top_level_names(module: str, src: Path = _SRC) -> set[str]:
+    """The names a module defines at its top level (functions, classes, assignments; not its imports).
+
+    Read from the summary cached beside the module's byte code, so that checking a step list's
+    functions at every workflow start-up parses no module that has not changed.
+
+    Parameters
+    ----------
+    module : str
+        A dotted module name.
+    src : Path
+        The directory that holds the package.
+
+    Returns
+    -------
+    set of str
+        The names (empty for a module that does not exist).
+    """
+    return set(_summary(module, Path(src))["defs"])
 
 
 def function_closure(func_spec: str, src: Path = _SRC) -> list[str]:

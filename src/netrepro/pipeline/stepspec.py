@@ -44,13 +44,14 @@ kernels), and the rule list stays one readable file per paper, like ``figures.ya
 
 from __future__ import annotations
 
-import ast
+import functools
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from .codedeps import top_level_names
 from .io import load_yaml
 
 __all__ = ["StepSpec", "ShardSpec", "PaperSteps", "load_step_specs", "step_list_path", "compose_config",
@@ -219,6 +220,7 @@ def step_list_path(slug: str, src: Path = _SRC) -> Path:
     return Path(src) / "papers" / slug / "steps.yaml"
 
 
+@functools.lru_cache(maxsize=None)
 def _schema(src: Path) -> dict:
     for where in (Path(src) / "schemas", Path(src).parents[1] / "workflow/schemas"):
         path = where / "steps.schema.yaml"
@@ -314,9 +316,9 @@ def config_keys(config) -> list[tuple[tuple, str]]:
     return out
 
 
-def _functions(module: Path) -> set:
-    tree = ast.parse(module.read_text())
-    return {node.name for node in tree.body if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))}
+def _functions(src: Path, slug: str, module: str) -> set:
+    """The top-level names of a step module, from codedeps' cached summary (parsed only when it changed)."""
+    return top_level_names(f"netrepro.papers.{slug}.{module}", Path(src).parent)
 
 
 def _func(slug: str, text: str, src: Path, where: str, cache: dict) -> str:
@@ -328,7 +330,7 @@ def _func(slug: str, text: str, src: Path, where: str, cache: dict) -> str:
     if not path.is_file():
         raise ConfigError(f"{where}: func {text!r}: no module {path}")
     if path not in cache:
-        cache[path] = _functions(path)
+        cache[path] = _functions(src, slug, module)
     if name not in cache[path]:
         raise ConfigError(f"{where}: func {text!r}: {path} defines no function {name!r}")
     return f"netrepro.papers.{slug}.{module}:{name}"
